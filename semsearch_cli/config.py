@@ -1,0 +1,162 @@
+"""Scenario files: pydantic models, YAML loading and friendly errors (SPEC 1).
+
+A scenario file describes the world (map, start, door signs), the task (goals), the planners and
+the experiment. Paths inside it are relative to the file. Lengths are metres, angles degrees.
+Every structural problem becomes a :class:`~semsearch_cli.errors.ScenarioError` naming the file
+and the field; checks that need the map (start in a wall, goals reachable) live in
+:mod:`semsearch_cli.world.scenario`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal, Union
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from .errors import ScenarioError
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class MapSpec(Strict):
+    image: str = Field(description="PNG: dark (<100) wall, light (>=200) free, gray between = outside")
+    resolution: float = Field(0.1, gt=0.0, le=1.0, description="m/cell")
+    origin: tuple[float, float] = Field((0.0, 0.0), description="world (x, y) m of the image's bottom-left corner")
+
+
+class StartSpec(Strict):
+    x: float
+    y: float
+    heading: Union[float, Literal["random"]] = Field("random", description="degrees, or random")
+
+
+class DoorSpec(Strict):
+    number: Union[int, str]
+    x: float
+    y: float
+    facing: float = Field(description="degrees, the direction the sign faces")
+
+
+class PlannerSpec(BaseModel):
+    """``{name: ..., <parameter>: value | [values]}``; parameters are checked by the planner."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+    name: str
+
+    def params(self) -> dict[str, Any]:
+        return dict(self.model_extra or {})
+
+
+class RobotSpec(Strict):
+    radius: float = Field(0.25, gt=0.0, description="m, disk robot")
+    step: float = Field(0.1, gt=0.0, le=1.0, description="m travelled per simulation step")
+
+
+class LaserSpec(Strict):
+    fov: float = Field(180.0, gt=0.0, le=360.0, description="degrees")
+    beams: int = Field(181, ge=2, le=2000)
+    range: float = Field(10.0, gt=0.0, description="m")
+    noise_std: float = Field(0.0, ge=0.0, description="m, Gaussian range noise")
+
+
+class DoorCameraSpec(Strict):
+    fov: float = Field(60.0, gt=0.0, le=180.0, description="degrees, each of the left and right cameras")
+    range: float = Field(3.0, gt=0.0, description="m")
+    p_read: float = Field(0.95, ge=0.0, le=1.0, description="probability a visible sign is read")
+    p_misread: float = Field(0.0, ge=0.0, le=1.0, description="probability a read replaces one digit")
+
+
+class BeliefSpec(Strict):
+    visited_radius: float = Field(1.2, gt=0.0, description="m, kernel of the visited region")
+    density_radius: float = Field(2.4, gt=0.0, description="m, uniform kernel radius r of Eq. 4.2 (Manhattan)")
+    density_delta: float = Field(2.5, gt=0.0, description="m^2, delta of Eq. 4.4")
+    min_reads: int = Field(3, ge=1, description="reads before a sign feeds the planner's factors")
+    himm_inc: int = Field(3, ge=1, le=15)
+    himm_dec: int = Field(1, ge=1, le=15)
+    himm_max: int = Field(15, ge=1, le=255)
+    occupied_threshold: int = Field(3, ge=1, description="certainty at or above which a seen cell is occupied")
+
+
+class NavigationSpec(Strict):
+    navigator: Literal["geodesic", "harmonic"] = "geodesic"
+    replan_every: float = Field(1.0, gt=0.0, description="m travelled between periodic re-plans")
+
+
+class ExperimentSpec(Strict):
+    seeds: int = Field(10, ge=1)
+    base_seed: int = Field(0, ge=0)
+    max_distance: float = Field(2000.0, gt=0.0, description="m, budget per run")
+    max_steps: int | None = Field(None, ge=1)
+    out: str | None = Field(None, description="output folder (default results/<name>)")
+
+
+class Scenario(Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    map: MapSpec
+    start: StartSpec
+    doors: Union[str, list[DoorSpec]]
+    goals: list[Union[int, str]] = Field(min_length=1)
+    planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
+    experiment: ExperimentSpec = ExperimentSpec()
+    robot: RobotSpec = RobotSpec()
+    laser: LaserSpec = LaserSpec()
+    door_camera: DoorCameraSpec = DoorCameraSpec()
+    belief: BeliefSpec = BeliefSpec()
+    navigation: NavigationSpec = NavigationSpec()
+
+    @field_validator("goals")
+    @classmethod
+    def _unique_goals(cls, v):
+        if len(set(map(str, v))) != len(v):
+            raise ValueError("goals must not repeat")
+        return v
+
+
+def _loc(loc: tuple) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in ("int", "str", "float", "list[DoorSpec]", "literal['random']", "function-after[_unique_goals(), list[union[int,str]]]"):
+            continue
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def parse_scenario(data: Any, file: str | Path) -> Scenario:
+    """Validate a parsed YAML document; raise :class:`ScenarioError` on the first problem."""
+    if not isinstance(data, dict):
+        raise ScenarioError(str(file), "", "expected a YAML mapping (key: value) at the top level")
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        field = _loc(err["loc"])
+        msg = err["msg"]
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key (check its spelling; `semsearch validate --help` lists the scenario format)"
+        elif err["type"] == "missing":
+            msg = "required field is missing"
+        got = err.get("input")
+        if err["type"] not in ("extra_forbidden", "missing") and not isinstance(got, (dict, list)):
+            msg += f" (got {got!r})"
+        raise ScenarioError(str(file), field, msg) from None
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario YAML file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ScenarioError(str(path), "", "file not found")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise ScenarioError(str(path), "", f"not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    return parse_scenario(data, path)

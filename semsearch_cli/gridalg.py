@@ -1,0 +1,221 @@
+"""Pure grid kernels (numba): local flood fill, Dijkstra, skeleton branch walks.
+
+Free-space connectivity is 4-connected (walls rasterised as 8-connected lines must not leak);
+path moves are 8-connected, a diagonal move needing both orthogonal cells passable (no corner
+cutting). All distances are in cells unless a name says otherwise.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+from numba import njit
+
+SQRT2 = math.sqrt(2.0)
+_DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
+_DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
+
+
+@njit(cache=True)
+def local_reach(free, r0, c0, radius, manhattan):
+    """Free cells 4-connected to (r0, c0) without leaving a kernel of ``radius`` cells.
+
+    Parameters
+    ----------
+    free : (H, W) bool
+    r0, c0 : int
+        Seed cell; if it is not free the result is empty.
+    radius : float
+        Kernel radius, cells (Euclidean disk, or Manhattan diamond when ``manhattan``).
+
+    Returns
+    -------
+    rows, cols : (n,) int64
+        The reached cells (the thesis' T with Q = 1, Eqs. 4.1-4.3).
+    """
+    H, W = free.shape
+    R = int(math.ceil(radius))
+    S = 2 * R + 1
+    mark = np.zeros((S, S), np.bool_)
+    qr = np.empty(S * S, np.int64)
+    qc = np.empty(S * S, np.int64)
+    if r0 < 0 or r0 >= H or c0 < 0 or c0 >= W or not free[r0, c0]:
+        return qr[:0], qc[:0]
+    head = 0
+    tail = 1
+    qr[0] = r0
+    qc[0] = c0
+    mark[R, R] = True
+    rad2 = radius * radius
+    while head < tail:
+        r = qr[head]
+        c = qc[head]
+        head += 1
+        for k in range(4):
+            nr = r + _DR8[k]
+            nc = c + _DC8[k]
+            if nr < 0 or nr >= H or nc < 0 or nc >= W:
+                continue
+            lr = nr - r0 + R
+            lc = nc - c0 + R
+            if lr < 0 or lr >= S or lc < 0 or lc >= S or mark[lr, lc]:
+                continue
+            dr = nr - r0
+            dc = nc - c0
+            if manhattan:
+                if abs(dr) + abs(dc) > radius:
+                    continue
+            elif dr * dr + dc * dc > rad2:
+                continue
+            if not free[nr, nc]:
+                continue
+            mark[lr, lc] = True
+            qr[tail] = nr
+            qc[tail] = nc
+            tail += 1
+    return qr[:tail], qc[:tail]
+
+
+@njit(cache=True)
+def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
+    """Multi-source Dijkstra on an 8-connected grid with per-cell cost multipliers.
+
+    Moving into cell q costs ``step * cost[q]`` with step 1 or sqrt(2); ``cost`` of shape (1, 1)
+    means a uniform cost of 1. The search stops once ``n_stop`` cells with ``target`` set are
+    settled (0: never) or the cost exceeds ``max_cost``.
+
+    Returns
+    -------
+    dist : (H, W) float64
+        Cost-to-come (inf where not reached).
+    length : (H, W) float64
+        Geometric length (cells) of the cheapest path.
+    parent : (H, W) int64
+        Flat index of the predecessor (-1 for sources and unreached cells).
+    """
+    H, W = passable.shape
+    uniform = cost.shape[0] == 1
+    dist = np.full((H, W), np.inf)
+    length = np.full((H, W), np.inf)
+    parent = np.full((H, W), -1, np.int64)
+    done = np.zeros((H, W), np.bool_)
+    heap = [(0.0, np.int64(0))]
+    heap.pop()
+    for i in range(src_r.shape[0]):
+        r = src_r[i]
+        c = src_c[i]
+        if 0 <= r < H and 0 <= c < W and passable[r, c]:
+            dist[r, c] = 0.0
+            length[r, c] = 0.0
+            heapq.heappush(heap, (0.0, np.int64(r * W + c)))
+    settled_targets = 0
+    while len(heap) > 0:
+        d, idx = heapq.heappop(heap)
+        r = idx // W
+        c = idx - r * W
+        if done[r, c]:
+            continue
+        done[r, c] = True
+        if d > max_cost:
+            break
+        if target[r, c]:
+            settled_targets += 1
+            if n_stop > 0 and settled_targets >= n_stop:
+                break
+        for k in range(8):
+            nr = r + _DR8[k]
+            nc = c + _DC8[k]
+            if nr < 0 or nr >= H or nc < 0 or nc >= W or done[nr, nc] or not passable[nr, nc]:
+                continue
+            if k >= 4:
+                if not passable[r, nc] or not passable[nr, c]:
+                    continue
+                step = SQRT2
+            else:
+                step = 1.0
+            nd = d + (step if uniform else step * cost[nr, nc])
+            if nd < dist[nr, nc]:
+                dist[nr, nc] = nd
+                length[nr, nc] = length[r, c] + step
+                parent[nr, nc] = idx
+                heapq.heappush(heap, (nd, np.int64(nr * W + nc)))
+    return dist, length, parent
+
+
+@njit(cache=True)
+def backtrack(parent, r, c):
+    """Cells (rows, cols) from the Dijkstra source to (r, c), following ``parent``."""
+    W = parent.shape[1]
+    n = 0
+    idx = r * W + c
+    while idx >= 0:
+        n += 1
+        idx = parent[idx // W, idx % W]
+    rows = np.empty(n, np.int64)
+    cols = np.empty(n, np.int64)
+    idx = r * W + c
+    k = n - 1
+    while idx >= 0:
+        rows[k] = idx // W
+        cols[k] = idx % W
+        k -= 1
+        idx = parent[idx // W, idx % W]
+    return rows, cols
+
+
+@njit(cache=True)
+def branch_walk(skel, visited, r0, c0, depth):
+    """Walk the skeleton out of the visited region from candidate (r0, c0).
+
+    Breadth-first over 8-connected skeleton cells that are not visited, up to ``depth`` steps.
+
+    Returns
+    -------
+    dr, dc : float
+        Mean offset (cells, row and col) of the reached cells from (r0, c0): the branch direction.
+    n : int
+        Number of reached cells (excluding the start).
+    """
+    H, W = skel.shape
+    S = 2 * depth + 1
+    mark = np.zeros((S, S), np.bool_)
+    qr = np.empty(S * S, np.int64)
+    qc = np.empty(S * S, np.int64)
+    qd = np.empty(S * S, np.int64)
+    qr[0] = r0
+    qc[0] = c0
+    qd[0] = 0
+    mark[depth, depth] = True
+    head = 0
+    tail = 1
+    sr = 0.0
+    sc = 0.0
+    while head < tail:
+        r = qr[head]
+        c = qc[head]
+        d = qd[head]
+        head += 1
+        if d >= depth:
+            continue
+        for k in range(8):
+            nr = r + _DR8[k]
+            nc = c + _DC8[k]
+            if nr < 0 or nr >= H or nc < 0 or nc >= W:
+                continue
+            lr = nr - r0 + depth
+            lc = nc - c0 + depth
+            if mark[lr, lc] or not skel[nr, nc] or visited[nr, nc]:
+                continue
+            mark[lr, lc] = True
+            qr[tail] = nr
+            qc[tail] = nc
+            qd[tail] = d + 1
+            tail += 1
+            sr += nr - r0
+            sc += nc - c0
+    n = tail - 1
+    if n == 0:
+        return 0.0, 0.0, 0
+    return sr / n, sc / n, n

@@ -1,0 +1,179 @@
+"""Pure ray-casting kernels on occupancy grids (numba).
+
+Coordinates are continuous cell coordinates ``(v, u) = (row, col)``: cell (r, c) covers
+``[r, r+1) x [c, c+1)``, so a cell centre is at (r + .5, c + .5). A direction ``theta`` (radians,
+world frame, x right, y up) moves by ``(dv, du) = (-sin theta, cos theta)``. Distances are in cells.
+Traversal is exact (Amanatides and Woo 1987): every cell the ray passes through is visited once.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_INF = 1e30
+
+
+@njit(cache=True, inline="always")
+def _setup(v0, u0, dv, du):
+    r = int(math.floor(v0))
+    c = int(math.floor(u0))
+    if dv > 0:
+        sr, tmr, tdr = 1, (r + 1 - v0) / dv, 1.0 / dv
+    elif dv < 0:
+        sr, tmr, tdr = -1, (r - v0) / dv, -1.0 / dv
+    else:
+        sr, tmr, tdr = 0, _INF, _INF
+    if du > 0:
+        sc, tmc, tdc = 1, (c + 1 - u0) / du, 1.0 / du
+    elif du < 0:
+        sc, tmc, tdc = -1, (c - u0) / du, -1.0 / du
+    else:
+        sc, tmc, tdc = 0, _INF, _INF
+    return r, c, sr, sc, tmr, tmc, tdr, tdc
+
+
+@njit(cache=True)
+def cast_ray(occ, v0, u0, theta, max_cells):
+    """Distance (cells) from (v0, u0) along ``theta`` to the first occupied cell.
+
+    Parameters
+    ----------
+    occ : (H, W) bool
+        True where a cell blocks the beam. Leaving the grid counts as a miss.
+    v0, u0 : float
+        Start, continuous cell coordinates (row, col).
+    theta : float
+        Beam direction, radians, world frame.
+    max_cells : float
+        Maximum range, cells.
+
+    Returns
+    -------
+    dist : float
+        Distance to the entry point of the first occupied cell, or ``max_cells`` on a miss.
+    hit : bool
+        Whether an occupied cell was met within range.
+    """
+    H, W = occ.shape
+    dv = -math.sin(theta)
+    du = math.cos(theta)
+    r, c, sr, sc, tmr, tmc, tdr, tdc = _setup(v0, u0, dv, du)
+    t = 0.0
+    while t <= max_cells:
+        if r < 0 or r >= H or c < 0 or c >= W:
+            return max_cells, False
+        if occ[r, c]:
+            return t, True
+        if tmr < tmc:
+            t = tmr
+            tmr += tdr
+            r += sr
+        else:
+            t = tmc
+            tmc += tdc
+            c += sc
+    return max_cells, False
+
+
+@njit(cache=True)
+def cast_rays(occ, v0, u0, thetas, max_cells):
+    """:func:`cast_ray` for each beam angle; returns (dist (n,) float64, hit (n,) bool)."""
+    n = thetas.shape[0]
+    dist = np.empty(n)
+    hit = np.zeros(n, np.bool_)
+    for i in range(n):
+        dist[i], hit[i] = cast_ray(occ, v0, u0, thetas[i], max_cells)
+    return dist, hit
+
+
+@njit(cache=True)
+def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
+    """Histogramic in-motion mapping update (Borenstein and Koren 1991) for one scan.
+
+    Cells a beam passes through before its end lose ``dec`` certainty (not below 0); the cell at
+    the end of a beam that hit something gains ``inc`` (not above ``cv_max``). Every touched cell
+    becomes ``seen``. The growth-rate operator of the original paper is not applied (the seeds'
+    simulations have noise-free odometry, where it only thickens walls).
+
+    Parameters
+    ----------
+    cv : (H, W) uint8
+        Certainty values, modified in place.
+    seen : (H, W) bool
+        Cells observed at least once, modified in place.
+    v0, u0 : float
+        Sensor position, continuous cell coordinates.
+    thetas, dist, hit : (n,) float64, (n,) float64, (n,) bool
+        Beam angles (radians), measured ranges (cells), hit flags.
+    inc, dec, cv_max : int
+        HIMM increment, decrement and cap.
+    bbox : (4,) int64
+        ``[rmin, rmax, cmin, cmax]`` of touched cells, grown in place.
+    """
+    H, W = cv.shape
+    for i in range(thetas.shape[0]):
+        dv = -math.sin(thetas[i])
+        du = math.cos(thetas[i])
+        R = dist[i]
+        hr = -1
+        hc = -1
+        if hit[i]:
+            hr = int(math.floor(v0 + (R + 1e-6) * dv))
+            hc = int(math.floor(u0 + (R + 1e-6) * du))
+        r, c, sr, sc, tmr, tmc, tdr, tdc = _setup(v0, u0, dv, du)
+        t = 0.0
+        while t < R - 1e-9:
+            if r < 0 or r >= H or c < 0 or c >= W:
+                break
+            if not (r == hr and c == hc):
+                x = int(cv[r, c]) - dec
+                cv[r, c] = 0 if x < 0 else x
+                seen[r, c] = True
+                if r < bbox[0]:
+                    bbox[0] = r
+                if r > bbox[1]:
+                    bbox[1] = r
+                if c < bbox[2]:
+                    bbox[2] = c
+                if c > bbox[3]:
+                    bbox[3] = c
+            if tmr < tmc:
+                t = tmr
+                tmr += tdr
+                r += sr
+            else:
+                t = tmc
+                tmc += tdc
+                c += sc
+        if hr >= 0 and hr < H and hc >= 0 and hc < W:
+            x = int(cv[hr, hc]) + inc
+            cv[hr, hc] = cv_max if x > cv_max else x
+            seen[hr, hc] = True
+            if hr < bbox[0]:
+                bbox[0] = hr
+            if hr > bbox[1]:
+                bbox[1] = hr
+            if hc < bbox[2]:
+                bbox[2] = hc
+            if hc > bbox[3]:
+                bbox[3] = hc
+
+
+@njit(cache=True)
+def line_of_sight(occ, v0, u0, v1, u1, stop_short):
+    """True when no occupied cell lies on the segment (v0, u0) -> (v1, u1).
+
+    The last ``stop_short`` cells of length are not checked, so a target lying on a wall face
+    (a door sign) is visible from the free side.
+    """
+    dv = v1 - v0
+    du = u1 - u0
+    L = math.sqrt(dv * dv + du * du)
+    if L <= stop_short:
+        return True
+    theta = math.atan2(-dv, du)
+    d, h = cast_ray(occ, v0, u0, theta, L - stop_short)
+    return not h
