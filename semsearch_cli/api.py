@@ -1,0 +1,115 @@
+"""The commands as Python functions; the CLI only parses, calls these and prints."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .errors import ScenarioError
+from .experiment import Loaded, expand, file_stem, read_runs, run_batch
+
+
+@dataclass
+class RunOutput:
+    out: Path
+    runs: pd.DataFrame
+    summary: pd.DataFrame
+
+
+def default_out(loaded: Loaded, out: str | Path | None) -> Path:
+    if out:
+        return Path(out)
+    if loaded.sc.experiment.out:
+        return (loaded.path.parent / loaded.sc.experiment.out).resolve()
+    return Path("results") / loaded.sc.name
+
+
+def default_workers() -> int:
+    return max(1, min(4, os.cpu_count() or 1))
+
+
+def run(scenario: str | Path, seeds: int | None = None, workers: int | None = None, goals=None,
+        planners=None, out: str | Path | None = None, progress=None, plots: bool = True) -> RunOutput:
+    """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/."""
+    loaded = Loaded.load(Path(scenario))
+    if goals:
+        known = {str(g) for g in loaded.sc.goals}
+        for g in goals:
+            if str(g) not in known:
+                raise ScenarioError("<command line>", "--goal", f"goal {g} is not among the scenario's goals {loaded.sc.goals}")
+    specs = expand(loaded, seeds, goals, planners)
+    if not specs:
+        raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
+    out_dir = default_out(loaded, out)
+    runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress)
+    wanted = {s.key for s in specs}
+    mine = runs[[(str(p), str(g), int(s)) in wanted for p, g, s in zip(runs["planner"], runs["goal"], runs["seed"])]]
+    summary = write_summary(runs, out_dir)
+    if plots:
+        write_path_plots(loaded, mine, out_dir)
+    return RunOutput(out_dir, runs, summary)
+
+
+def write_summary(runs: pd.DataFrame, out_dir: Path) -> pd.DataFrame:
+    from .report.tables import summarise
+
+    summary = summarise(runs)
+    tmp = out_dir / ".summary.csv.tmp"
+    summary.to_csv(tmp, index=False)
+    os.replace(tmp, out_dir / "summary.csv")
+    return summary
+
+
+def write_path_plots(loaded: Loaded, runs: pd.DataFrame, out_dir: Path) -> list[Path]:
+    """One PNG per goal x planner variant: the median run's path over the map."""
+    from .report.plots import plot_path
+    from .report.tables import median_run
+
+    if runs.empty:
+        return []
+    plots = out_dir / "plots"
+    plots.mkdir(parents=True, exist_ok=True)
+    written = []
+    for _, row in median_run(runs).iterrows():
+        goal = _goal_value(loaded, row["goal"])
+        f = out_dir / "paths" / f"{file_stem(row['planner'], goal, int(row['seed']))}.npz"
+        if not f.is_file():
+            continue
+        data = np.load(f)
+        title = (f"{loaded.sc.name}: goal {goal}, {row['planner']}, median run (seed {int(row['seed'])}): "
+                 f"{row['distance_m']:.1f} m, {row['outcome']}, shortest {row['shortest_m']:.1f} m")
+        png = plots / f"{file_stem(row['planner'], goal, None)}.png"
+        plot_path(loaded.world, data["path"], data["read_signs"], goal, title, png)
+        written.append(png)
+    return written
+
+
+def _goal_value(loaded: Loaded, g):
+    for x in loaded.sc.goals:
+        if str(x) == str(g):
+            return x
+    return g
+
+
+def validate(scenario: str | Path) -> dict:
+    """Every check of the loader, plus counts and each goal's shortest path (no simulation)."""
+    loaded = Loaded.load(Path(scenario))
+    w = loaded.world
+    from .planners import expand_variants
+
+    variants = expand_variants(loaded.sc.planners, str(loaded.path))
+    readable = 0
+    for i in range(len(w.signs)):
+        if w.readable_mask(i).any():
+            readable += 1
+    return {"name": loaded.sc.name, "signs": len(w.signs), "readable_signs": readable,
+            "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
+            "planners": [v.label for v in variants], "shortest_m": {str(k): round(v, 2) for k, v in loaded.shortest.items()}}
+
+
+def read_results(folder: str | Path) -> pd.DataFrame:
+    return read_runs(Path(folder) / "runs.csv")

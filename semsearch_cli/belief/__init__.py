@@ -1,0 +1,3 @@
+from .belief import Belief, Candidates
+
+__all__ = ["Belief", "Candidates"]

@@ -1,0 +1,257 @@
+"""The robot's belief, built from sensing only (SPEC 3): HIMM occupancy, visited region and its
+density classes, skeleton, clearance, door reads, frontier candidates.
+
+Per-step updates touch only a window around the robot; the derived maps (clearance, skeleton) are
+refreshed at re-plan time inside the bounding box of what changed since the last refresh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from skimage.morphology import skeletonize
+
+from ..config import BeliefSpec
+from ..geometry import GridFrame
+from ..gridalg import branch_walk, dijkstra, local_reach
+
+CLEARANCE_CAP_M = 1.0
+SKELETON_MARGIN_M = 4.0
+BRANCH_DEPTH = 10
+MIN_BRANCH_CELLS = 3
+
+
+@dataclass
+class Candidates:
+    """Frontier candidates C (SPEC 4): one skeleton cell per branch leaving the visited region.
+
+    rows, cols : (k,) int64 cells; theta : (k,) float64, radians, the branch direction theta_f
+    pointing out of the visited region; seg_rows, seg_cols : (k,) int64, a visited cell the
+    candidate touches (its segment S(c) is the segment of that cell).
+    """
+
+    rows: np.ndarray
+    cols: np.ndarray
+    theta: np.ndarray
+    seg_rows: np.ndarray
+    seg_cols: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.rows.shape[0])
+
+
+@dataclass
+class DoorReads:
+    """Every sign read, kept so door lists can be rebuilt when segments change (SPEC 3).
+
+    ``agg`` maps (sign index, robot cell flat index) -> [count, sum x, sum y]; ``total`` counts
+    reads per sign; ``headings`` is the robot heading (radians) at each read, in order.
+    """
+
+    agg: dict = field(default_factory=dict)
+    total: dict = field(default_factory=dict)
+    headings: list = field(default_factory=list)
+
+    def add(self, sign: int, cell: int, x: float, y: float, heading: float) -> bool:
+        """Record one read; True when the sign reaches ``min_reads`` with this read is decided by the caller."""
+        a = self.agg.get((sign, cell))
+        if a is None:
+            self.agg[(sign, cell)] = [1, x, y]
+        else:
+            a[0] += 1
+            a[1] += x
+            a[2] += y
+        self.total[sign] = self.total.get(sign, 0) + 1
+        self.headings.append(heading)
+        return True
+
+
+class Belief:
+    """What the robot knows. Arrays are (H, W) and share the world's :class:`GridFrame`.
+
+    Attributes
+    ----------
+    cv : uint8, HIMM certainty; seen : bool; free : bool (seen and below the occupied threshold);
+    visited : bool; seg_class : int16 (density class of visited cells, -1 elsewhere, Eq. 4.4);
+    clearance : float32 m (to the nearest cell that is not known free, capped);
+    skeleton : bool.
+    """
+
+    def __init__(self, frame: GridFrame, spec: BeliefSpec, robot_radius: float):
+        H, W = frame.height, frame.width
+        self.frame, self.spec = frame, spec
+        self.cv = np.zeros((H, W), np.uint8)
+        self.seen = np.zeros((H, W), bool)
+        self.free = np.zeros((H, W), bool)
+        self.visited = np.zeros((H, W), bool)
+        self.seg_class = np.full((H, W), -1, np.int16)
+        self.clearance = np.zeros((H, W), np.float32)
+        self.skeleton = np.zeros((H, W), bool)
+        self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
+        self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
+        self.reads = DoorReads()
+        self.vbox = [H, -1, W, -1]
+        self._seg_labels = None
+
+    # ---- per-step updates -------------------------------------------------------------
+    def refresh_free(self, bbox: np.ndarray) -> None:
+        """Re-derive ``free`` inside a scan's bounding box and grow the dirty box."""
+        r0, r1, c0, c1 = int(bbox[0]), int(bbox[1]) + 1, int(bbox[2]), int(bbox[3]) + 1
+        if r1 <= r0:
+            return
+        self.free[r0:r1, c0:c1] = self.seen[r0:r1, c0:c1] & (self.cv[r0:r1, c0:c1] < self.spec.occupied_threshold)
+        d = self.dirty
+        d[0], d[1], d[2], d[3] = min(d[0], r0), max(d[1], r1 - 1), min(d[2], c0), max(d[3], c1 - 1)
+
+    def visit(self, r: int, c: int) -> None:
+        """Mark the visited kernel around the robot and give it the local density class.
+
+        Density (Eqs. 4.1-4.4): the free area (m^2) 4-connected to the robot inside a Manhattan
+        kernel of ``density_radius``, divided by ``density_delta`` and floored.
+        """
+        res = self.frame.res
+        dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res, True)
+        cls = int(np.floor(dr.shape[0] * res * res / self.spec.density_delta))
+        vr, vc = local_reach(self.free, r, c, self.spec.visited_radius / res, False)
+        if vr.size == 0:
+            return
+        self.visited[vr, vc] = True
+        self.seg_class[vr, vc] = cls
+        b = self.vbox
+        b[0], b[1] = min(b[0], int(vr.min())), max(b[1], int(vr.max()))
+        b[2], b[3] = min(b[2], int(vc.min())), max(b[3], int(vc.max()))
+        self._seg_labels = None
+
+    # ---- derived maps, refreshed at re-plan time ---------------------------------------
+    def refresh_derived(self) -> None:
+        """Recompute clearance and skeleton inside the dirty box (plus margins)."""
+        d = self.dirty
+        if d[1] < d[0]:
+            return
+        H, W = self.free.shape
+        res = self.frame.res
+        cap = int(np.ceil(CLEARANCE_CAP_M / res))
+        m = int(np.ceil(SKELETON_MARGIN_M / res))
+        # clearance: write dirty+cap, compute on dirty+2cap
+        w0, w1, w2, w3 = max(0, d[0] - cap), min(H, d[1] + cap + 1), max(0, d[2] - cap), min(W, d[3] + cap + 1)
+        c0, c1, c2, c3 = max(0, d[0] - 2 * cap), min(H, d[1] + 2 * cap + 1), max(0, d[2] - 2 * cap), min(W, d[3] + 2 * cap + 1)
+        sub = np.pad(self.free[c0:c1, c2:c3], 1).astype(np.uint8)
+        dist = cv2.distanceTransform(sub, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+        np.minimum(dist * np.float32(res), np.float32(CLEARANCE_CAP_M), out=dist)
+        self.clearance[w0:w1, w2:w3] = dist[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
+        # skeleton: write dirty+m/2, compute on dirty+m
+        h = m // 2
+        w0, w1, w2, w3 = max(0, d[0] - h), min(H, d[1] + h + 1), max(0, d[2] - h), min(W, d[3] + h + 1)
+        c0, c1, c2, c3 = max(0, d[0] - m), min(H, d[1] + m + 1), max(0, d[2] - m), min(W, d[3] + m + 1)
+        sk = skeletonize(self.free[c0:c1, c2:c3])
+        self.skeleton[w0:w1, w2:w3] = sk[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
+        d[:] = (H, -1, W, -1)
+
+    @property
+    def passable(self) -> np.ndarray:
+        """(H, W) bool: known free cells where the robot disk fits."""
+        return self.clearance >= self.min_clear
+
+    def path_cost(self) -> np.ndarray:
+        """(H, W) float32 per-cell cost multiplier: 1 on the skeleton, more elsewhere and near walls.
+
+        Shortest paths under this cost run along the skeleton where it connects (so their length
+        counts skeleton cells, as the closeness factor of Eq. 16 does) and cut across open space
+        or skeleton gaps only when that is much shorter.
+        """
+        cost = 1.5 + 2.0 * (1.0 - self.clearance / np.float32(CLEARANCE_CAP_M))
+        cost[self.skeleton] = 1.0
+        return cost.astype(np.float32)
+
+    # ---- frontier candidates -----------------------------------------------------------
+    def candidates(self) -> Candidates:
+        """Candidates C: per 8-connected group of skeleton cells on the frontier (known free, not
+        visited, touching a visited cell), the one farthest from walls; groups whose branch does not
+        lead on (fewer than 3 unvisited skeleton cells) are dropped. Where the skeleton crosses no
+        frontier at all, each frontier group gives its widest cell instead, so a search never stops
+        while free space remains unvisited."""
+        H, W = self.free.shape
+        b = self.vbox
+        if b[1] < b[0]:
+            return _empty()
+        r0, r1, c0, c1 = max(0, b[0] - 2), min(H, b[1] + 3), max(0, b[2] - 2), min(W, b[3] + 3)
+        vis = self.visited[r0:r1, c0:c1]
+        grown = cv2.dilate(vis.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        front = grown & ~vis & self.free[r0:r1, c0:c1] & (self.clearance[r0:r1, c0:c1] >= self.min_clear)
+        out = self._groups(front & self.skeleton[r0:r1, c0:c1], r0, c0, need_branch=True)
+        if len(out) == 0:
+            out = self._groups(front, r0, c0, need_branch=False)
+        return out
+
+    def _groups(self, mask, r0, c0, need_branch):
+        n, lab = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8)
+        if n <= 1:
+            return _empty()
+        rr, cc = np.nonzero(lab)
+        ll = lab[rr, cc]
+        clear = self.clearance[rr + r0, cc + c0]
+        order = np.lexsort((-clear, ll))  # per label, widest first
+        first = np.r_[0, np.nonzero(np.diff(ll[order]))[0] + 1]
+        pick = order[first]
+        rows, cols = rr[pick] + r0, cc[pick] + c0
+        keep, theta, sr, sc = [], [], [], []
+        for k in range(rows.shape[0]):
+            r, c = int(rows[k]), int(cols[k])
+            dr, dc, cnt = branch_walk(self.skeleton if need_branch else self.free, self.visited, r, c, BRANCH_DEPTH)
+            if need_branch and cnt < MIN_BRANCH_CELLS:
+                continue
+            vr, vc = self._visited_neighbour(r, c)
+            if cnt == 0:  # point away from the visited neighbour
+                dr, dc = r - vr, c - vc
+            keep.append(k)
+            theta.append(np.arctan2(-dr, dc))
+            sr.append(vr)
+            sc.append(vc)
+        keep = np.array(keep, np.int64)
+        return Candidates(rows[keep], cols[keep], np.array(theta, float), np.array(sr, np.int64), np.array(sc, np.int64))
+
+    def _visited_neighbour(self, r, c):
+        H, W = self.visited.shape
+        for rad in (1, 2, 3):
+            rs, cs = slice(max(0, r - rad), r + rad + 1), slice(max(0, c - rad), c + rad + 1)
+            vr, vc = np.nonzero(self.visited[rs, cs])
+            if vr.size:
+                k = int(np.argmin((vr + rs.start - r) ** 2 + (vc + cs.start - c) ** 2))
+                return int(vr[k] + rs.start), int(vc[k] + cs.start)
+        return r, c
+
+    # ---- distances and segments ----------------------------------------------------------
+    def geodesic(self, r: int, c: int, targets: np.ndarray, n_stop: int):
+        """Dijkstra from the robot cell under :meth:`path_cost`; returns (cost, length, parent)."""
+        passable = self.passable
+        if not passable[r, c]:  # robot squeezed near a wall: let it leave
+            passable = passable.copy()
+            rr, cc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
+            passable[rr, cc] = True
+        return dijkstra(passable, self.path_cost(), np.array([r]), np.array([c]), targets, n_stop, np.inf)
+
+    def segment_labels(self) -> np.ndarray:
+        """(H, W) int32: visited segments (connected cells of one density class), 0 elsewhere."""
+        if self._seg_labels is not None:
+            return self._seg_labels
+        out = np.zeros(self.visited.shape, np.int32)
+        b = self.vbox
+        if b[1] >= b[0]:
+            sl = (slice(b[0], b[1] + 1), slice(b[2], b[3] + 1))
+            cls = self.seg_class[sl]
+            sub = out[sl]
+            nxt = 1
+            for k in np.unique(cls[cls >= 0]):
+                n, lab = cv2.connectedComponents((cls == k).astype(np.uint8), connectivity=8)
+                m = lab > 0
+                sub[m] = lab[m] + (nxt - 1)
+                nxt += n - 1
+        self._seg_labels = out
+        return out
+
+
+def _empty() -> Candidates:
+    z = np.zeros(0, np.int64)
+    return Candidates(z, z.copy(), np.zeros(0), z.copy(), z.copy())

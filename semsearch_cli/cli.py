@@ -1,0 +1,130 @@
+"""The ``semsearch`` command line (typer): parse, call :mod:`semsearch_cli.api`, print."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+from rich.table import Table
+
+from . import __version__
+from .errors import ScenarioError
+
+app = typer.Typer(add_completion=False, no_args_is_help=True,
+                  help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
+import_app = typer.Typer(no_args_is_help=True, help="Convert maps from other tools into scenarios.")
+app.add_typer(import_app, name="import")
+out = Console() if sys.stdout.isatty() else Console(width=200)
+err = Console(stderr=True) if sys.stderr.isatty() else Console(stderr=True, width=200)
+
+
+def _fail(exc: ScenarioError) -> None:
+    err.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+    raise typer.Exit(2)
+
+
+def _split(values: Optional[List[str]]) -> Optional[list]:
+    if not values:
+        return None
+    items = [v.strip() for s in values for v in s.split(",") if v.strip()]
+    return [int(v) if v.lstrip("-").isdigit() else v for v in items]
+
+
+@app.command()
+def run(
+    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and planner variant (default: the scenario's experiment.seeds)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
+    goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate)."),
+    planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
+    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
+):
+    """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
+    runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
+    from . import api
+
+    try:
+        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                      TimeRemainingColumn(), console=err, transient=False, disable=not err.is_terminal) as prog:
+            task = None
+
+            def tick(row):
+                nonlocal task
+                if task is None:
+                    task = prog.add_task("runs", total=None)
+                prog.advance(task)
+                prog.update(task, description=f"{row['planner']} goal {row['goal']} seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m")
+
+            res = api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick)
+    except ScenarioError as exc:
+        _fail(exc)
+    _print_summary(res.summary)
+    out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  plots: {res.out / 'plots'}")
+
+
+def _print_summary(summary):
+    t = Table(title="distance travelled (m) per goal and planner")
+    for col in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]:
+        t.add_column(col, justify="right" if col not in ("planner",) else "left")
+    for _, r in summary.iterrows():
+        t.add_row(*[str(r[c]) for c in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]])
+    out.print(t)
+
+
+@app.command()
+def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
+    """Check a scenario without simulating: every loader check, sign counts, shortest paths."""
+    from . import api
+
+    try:
+        info = api.validate(scenario)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"{scenario}: ok")
+    for k, v in info.items():
+        out.print(f"  {k}: {v}")
+
+
+@import_app.command("mobilesim")
+def import_mobilesim(
+    map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),
+    doors_file: Path = typer.Argument(..., help=".doors file: x y number facing (m, degrees)."),
+    out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
+    resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
+    start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
+    goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
+    density_delta: float = typer.Option(2.5, "--density-delta", help="m^2, segmentation delta (Eq. 4.4)."),
+):
+    """Convert a MobileSim map and door file into a scenario that runs as it is."""
+    from .world.mobilesim import import_mobilesim as imp
+
+    try:
+        xy = None
+        if start:
+            try:
+                xs, ys = start.split(",")
+                xy = (float(xs), float(ys))
+            except ValueError:
+                raise ScenarioError("<command line>", "--start", f"expected X,Y in metres, got {start!r}") from None
+        path = imp(map_file, doors_file, out_dir, resolution, xy, _split([goals]) if goals else None, density_delta)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+
+
+@app.command()
+def version():
+    """Print the semsearch version."""
+    out.print(__version__)
+
+
+def main() -> None:
+    try:
+        app()
+    except KeyboardInterrupt:
+        err.print("interrupted: finished runs are kept in runs.csv; run the same command again to resume")
+        sys.exit(130)

@@ -1,0 +1,171 @@
+"""Expand a scenario into runs, run them in parallel processes, append rows, resume (SPEC 9).
+
+Each finished run is appended to ``runs.csv`` at once (and its path to ``paths/``), so an
+interrupted batch keeps every finished run; a rerun skips the (planner, goal, seed) rows already
+there. Rows do not depend on the number of workers: a run's randomness comes only from its own
+seed (:func:`semsearch_cli.episode.run_seed`).
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from .config import Scenario, load_scenario
+from .episode import Episode
+from .metrics import COLUMNS, run_row
+from .planners import Variant, expand_variants
+from .world.scenario import World, build_world, check_goals_reachable
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    goal: object
+    variant: Variant
+    seed: int
+
+    @property
+    def key(self) -> tuple:
+        return (self.variant.label, str(self.goal), int(self.seed))
+
+    @property
+    def stem(self) -> str:
+        return file_stem(self.variant.label, self.goal, self.seed)
+
+
+def file_stem(label: str, goal, seed=None) -> str:
+    """File-name stem of a run (or, without seed, of a goal x variant)."""
+    safe = label.replace("[", "_").replace("]", "").replace("=", "").replace(",", "_")
+    return f"{safe}__goal{goal}" + (f"__seed{seed}" if seed is not None else "")
+
+
+@dataclass
+class Loaded:
+    """A scenario with its world and the shortest path of each goal, built once per process."""
+
+    path: Path
+    sc: Scenario
+    world: World
+    shortest: dict
+
+    @classmethod
+    def load(cls, path: Path, check: bool = True) -> "Loaded":
+        sc = load_scenario(path)
+        world = build_world(sc, path.parent, str(path))
+        shortest = check_goals_reachable(world, sc.goals, str(path))
+        return cls(path, sc, world, shortest)
+
+
+_CACHE: dict = {}
+
+
+def _worker_init(path: str) -> None:
+    _CACHE["loaded"] = Loaded.load(Path(path))
+
+
+def execute(loaded: Loaded, spec: RunSpec, trace: bool = False):
+    """Run one spec; returns (row, result)."""
+    res = Episode(loaded.world, loaded.sc, spec.variant, spec.goal, spec.seed, trace=trace).run()
+    row = run_row(loaded.sc.name, spec.variant, spec.goal, spec.seed, res, loaded.shortest[spec.goal], loaded.sc.navigation.navigator)
+    return row, res
+
+
+def _worker_run(spec: RunSpec, paths_dir: str):
+    row, res = execute(_CACHE["loaded"], spec)
+    _save_path(Path(paths_dir), spec, res)
+    return row
+
+
+def _save_path(paths_dir: Path, spec: RunSpec, res) -> None:
+    paths_dir.mkdir(parents=True, exist_ok=True)
+    tmp = paths_dir / f".{spec.stem}.tmp.npz"
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, path=res.path, read_signs=np.asarray(res.read_signs, np.int64))
+    os.replace(tmp, paths_dir / f"{spec.stem}.npz")
+
+
+def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> list[RunSpec]:
+    """goals x planner variants x seeds, in that nesting order."""
+    sc = loaded.sc
+    variants = expand_variants(sc.planners, str(loaded.path))
+    if planners:
+        variants = [v for v in variants if v.name in planners or v.label in planners]
+    gl = [g for g in sc.goals if goals is None or str(g) in {str(x) for x in goals}]
+    n = seeds or sc.experiment.seeds
+    return [RunSpec(g, v, s) for g in gl for v in variants for s in range(n)]
+
+
+def read_runs(path: Path) -> pd.DataFrame:
+    """runs.csv as a DataFrame (empty with the columns when absent); a torn last line is dropped."""
+    if not path.is_file() or path.stat().st_size == 0:
+        return pd.DataFrame(columns=COLUMNS)
+    df = pd.read_csv(path, on_bad_lines="skip")
+    return df.dropna(subset=["wall_s"])
+
+
+class RowWriter:
+    """Appends rows to runs.csv, flushing each to disk as it arrives."""
+
+    def __init__(self, path: Path):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        new = not path.is_file() or path.stat().st_size == 0
+        if not new:  # repair a file cut mid-line by an interruption
+            with open(path, "rb+") as fh:
+                fh.seek(-1, os.SEEK_END)
+                if fh.read(1) != b"\n":
+                    fh.write(b"\n")
+        self.fh = open(path, "a", newline="")
+        self.w = csv.DictWriter(self.fh, fieldnames=COLUMNS)
+        if new:
+            self.w.writeheader()
+            self.fh.flush()
+
+    def write(self, row: dict) -> None:
+        self.w.writerow(row)
+        self.fh.flush()
+        os.fsync(self.fh.fileno())
+
+    def close(self) -> None:
+        self.fh.close()
+
+
+def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
+              progress: Callable[[dict], None] | None = None) -> pd.DataFrame:
+    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards."""
+    runs_csv = out / "runs.csv"
+    done = read_runs(runs_csv)
+    have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
+    todo = [s for s in specs if s.key not in have]
+    writer = RowWriter(runs_csv)
+    paths_dir = out / "paths"
+    try:
+        if workers <= 1 or len(todo) <= 1:
+            for spec in todo:
+                row, res = execute(loaded, spec)
+                _save_path(paths_dir, spec, res)
+                writer.write(row)
+                if progress:
+                    progress(row)
+        else:
+            with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(str(loaded.path),)) as pool:
+                futs = [pool.submit(_worker_run, spec, str(paths_dir)) for spec in todo]
+                try:
+                    for f in as_completed(futs):
+                        row = f.result()
+                        writer.write(row)
+                        if progress:
+                            progress(row)
+                except BaseException:
+                    for f in futs:
+                        f.cancel()
+                    raise
+    finally:
+        writer.close()
+    return read_runs(runs_csv)

@@ -1,0 +1,3 @@
+from .navigators import NAVIGATORS, GeodesicNavigator, HarmonicNavigator
+
+__all__ = ["NAVIGATORS", "GeodesicNavigator", "HarmonicNavigator"]

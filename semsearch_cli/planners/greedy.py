@@ -1,0 +1,23 @@
+"""Greedy: the nearest candidate along the skeleton (thesis 4.4.2; phi = phi_c)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Decision, Planner, register_planner
+
+
+@register_planner("greedy")
+class Greedy(Planner):
+    def choose(self, ctx, cands):
+        if len(cands) == 0:
+            return None
+        target = np.zeros(ctx.belief.free.shape, bool)
+        target[cands.rows, cands.cols] = True
+        _, length, _ = ctx.belief.geodesic(ctx.row, ctx.col, target, 1)
+        d = length[cands.rows, cands.cols]
+        if not np.isfinite(d).any():
+            return None
+        best = np.flatnonzero(d == d.min())
+        k = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+        return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k])})
