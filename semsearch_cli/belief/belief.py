@@ -14,7 +14,7 @@ import numpy as np
 from skimage.morphology import skeletonize
 
 from ..config import BeliefSpec
-from ..geometry import GridFrame
+from ..geometry import GridFrame, wrap_angle
 from ..gridalg import branch_walk, dijkstra, local_reach
 
 CLEARANCE_CAP_M = 1.0
@@ -112,9 +112,9 @@ class Belief:
         kernel of ``density_radius``, divided by ``density_delta`` and floored.
         """
         res = self.frame.res
-        dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res, True)
+        dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res + 1e-6, True)
         cls = int(np.floor(dr.shape[0] * res * res / self.spec.density_delta))
-        vr, vc = local_reach(self.free, r, c, self.spec.visited_radius / res, False)
+        vr, vc = local_reach(self.free, r, c, self.spec.visited_radius / res + 1e-6, False)
         if vr.size == 0:
             return
         self.visited[vr, vc] = True
@@ -126,7 +126,13 @@ class Belief:
 
     # ---- derived maps, refreshed at re-plan time ---------------------------------------
     def refresh_derived(self) -> None:
-        """Recompute clearance and skeleton inside the dirty box (plus margins)."""
+        """Recompute clearance and skeleton inside the dirty box (plus margins).
+
+        Clearance is exact (it is capped at ``CLEARANCE_CAP_M``). Thinning is not strictly local,
+        so the windowed skeleton equals the global one wherever free regions are narrower than
+        about ``SKELETON_MARGIN_M`` (corridors); in wide open areas it may differ near the window
+        seam, which only moves candidate cells within those areas.
+        """
         d = self.dirty
         if d[1] < d[0]:
             return
@@ -210,7 +216,7 @@ class Belief:
             sr.append(vr)
             sc.append(vc)
         keep = np.array(keep, np.int64)
-        return Candidates(rows[keep], cols[keep], np.array(theta, float), np.array(sr, np.int64), np.array(sc, np.int64))
+        return Candidates(rows[keep], cols[keep], wrap_angle(np.array(theta, float)), np.array(sr, np.int64), np.array(sc, np.int64))
 
     def _visited_neighbour(self, r, c):
         H, W = self.visited.shape

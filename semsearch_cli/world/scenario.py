@@ -56,10 +56,10 @@ def _as_label(v):
     return int(s) if s.lstrip("-").isdigit() else s
 
 
-def read_doors(path: Path, field: str = "doors") -> list[DoorSpec]:
+def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> list[DoorSpec]:
     """Door signs from a CSV (columns number,x,y,facing) or YAML list file."""
     if not path.is_file():
-        raise ScenarioError(str(path), field, "door file not found")
+        raise ScenarioError(owner or str(path), field, f"door file {path} not found")
     rows: list[dict]
     if path.suffix.lower() in (".yaml", ".yml"):
         rows = yaml.safe_load(path.read_text()) or []
@@ -79,13 +79,13 @@ def read_doors(path: Path, field: str = "doors") -> list[DoorSpec]:
     return out
 
 
-def load_map(path: Path, field: str = "map.image") -> np.ndarray:
+def load_map(path: Path, field: str = "map.image", owner: str | None = None) -> np.ndarray:
     """Gray image (H, W) uint8 of a map file."""
     if not path.is_file():
-        raise ScenarioError(str(path), field, "map image not found")
+        raise ScenarioError(owner or str(path), field, f"map image {path} not found")
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
-        raise ScenarioError(str(path), field, "not a readable image (expected a PNG: dark = wall, light = free)")
+        raise ScenarioError(owner or str(path), field, f"{path} is not a readable image (expected a PNG: dark = wall, light = free)")
     return img
 
 
@@ -200,12 +200,12 @@ class World:
 
 def build_world(sc: Scenario, base: Path, file: str) -> World:
     """Build and check the world of a scenario (paths relative to ``base``)."""
-    img = load_map(base / sc.map.image)
+    img = load_map(base / sc.map.image, owner=file)
     free = img >= FREE_FROM
     H, W = free.shape
     frame = GridFrame(sc.map.resolution, sc.map.origin[0], sc.map.origin[1], H, W)
 
-    doors = read_doors(base / sc.doors) if isinstance(sc.doors, str) else list(sc.doors)
+    doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
     dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file
     if not doors:
         raise ScenarioError(dfile, "doors", "no door signs given")

@@ -1,0 +1,29 @@
+from pathlib import Path
+
+import matplotlib
+import pytest
+
+matplotlib.use("Agg")
+
+SHARED = Path(__file__).resolve().parents[2] / "shared"
+REF = SHARED / "reference_maps"
+
+
+@pytest.fixture(scope="session")
+def demo_dir(tmp_path_factory):
+    from semsearch_cli.world.demo import write_demo
+
+    d = tmp_path_factory.mktemp("demo")
+    write_demo(d)
+    return d
+
+
+@pytest.fixture(scope="session")
+def demo_loaded(demo_dir):
+    from semsearch_cli.experiment import Loaded
+
+    return Loaded.load(demo_dir / "scenario.yaml")
+
+
+def needs_reference():
+    return pytest.mark.skipif(not REF.is_dir(), reason=f"the authors' reference maps are not at {REF} (../shared absent)")

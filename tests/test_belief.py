@@ -1,0 +1,104 @@
+import numpy as np
+
+from semsearch_cli.belief import Belief
+from semsearch_cli.config import BeliefSpec
+from semsearch_cli.geometry import GridFrame
+from semsearch_cli.gridalg import dijkstra, local_reach
+
+
+def make_belief(free):
+    H, W = free.shape
+    b = Belief(GridFrame(0.1, 0.0, 0.0, H, W), BeliefSpec(), robot_radius=0.05)
+    b.seen[:] = True
+    b.cv[~free] = 10
+    b.refresh_free(np.array([0, H - 1, 0, W - 1]))
+    b.refresh_derived()
+    return b
+
+
+def test_skeleton_of_corridor_is_its_centre_line():
+    free = np.zeros((7, 12), bool)
+    free[2:5, 1:11] = True  # a 3-cell corridor
+    b = make_belief(free)
+    expected = np.zeros_like(free)
+    expected[3, 1:9] = True  # scikit-image's thinning keeps the centre row and bends at one end
+    expected[2, 9] = True
+    assert (b.skeleton == expected).all()
+
+
+def test_windowed_skeleton_refresh_matches_global():
+    # a corridor grid (corridors 20 cells wide, well under the 4 m refresh margin)
+    free = np.zeros((120, 160), bool)
+    for k in range(10, 110, 40):
+        free[k : k + 20, 10:150] = True
+    for k in range(10, 150, 45):
+        free[10:110, k : k + 20] = True
+    b = make_belief(free)
+    from skimage.morphology import skeletonize
+
+    # an obstacle appears in one corridor: only a window around it is recomputed
+    b.cv[55:58, 80:83] = 10
+    b.refresh_free(np.array([55, 57, 80, 82]))
+    b.refresh_derived()
+    full = skeletonize(b.free)
+    assert (b.skeleton[40:80, 60:100] == full[40:80, 60:100]).all()
+
+
+def test_local_reach_does_not_leak_through_diagonal_wall():
+    free = np.ones((6, 6), bool)
+    for k in range(6):
+        free[k, 5 - k] = False  # an 8-connected diagonal wall
+    rr, cc = local_reach(free, 0, 0, 10.0, False)
+    assert len(rr) == 15  # the upper-left triangle only
+    assert (rr + cc < 5).all()
+
+
+def test_dijkstra_lengths_and_no_corner_cutting():
+    p = np.ones((3, 3), bool)
+    p[0, 1] = False
+    p[1, 0] = False
+    t = np.zeros_like(p)
+    t[2, 2] = True
+    dist, length, _ = dijkstra(p, np.ones((1, 1), np.float32), np.array([0]), np.array([0]), t, 0, np.inf)
+    assert np.isinf(dist[1, 1])  # (0,0) -> (1,1) would cut two blocked corners
+    p[1, 0] = True
+    dist, length, _ = dijkstra(p, np.ones((1, 1), np.float32), np.array([0]), np.array([0]), t, 0, np.inf)
+    assert length[2, 2] == 1 + 2 ** 0.5 + 1 or abs(length[2, 2] - (2 + 2 ** 0.5)) < 1e-12
+
+
+def plus_belief():
+    """A plus-shaped junction of 5-cell-wide corridors, visited in the middle."""
+    free = np.zeros((61, 61), bool)
+    free[28:33, 2:59] = True
+    free[2:59, 28:33] = True
+    b = make_belief(free)
+    b.visit(30, 30)  # visited radius 1.2 m = 12 cells: rows/cols 18..42 on the arms
+    return b
+
+
+def test_frontier_candidates_and_theta_f_on_a_junction():
+    b = plus_belief()
+    c = b.candidates()
+    assert len(c) == 4
+    got = sorted((int(r), int(cc), round(float(np.degrees(t)))) for r, cc, t in zip(c.rows, c.cols, c.theta))
+    # one candidate per branch, on the centre line, just outside the visited disk, pointing out
+    assert got == [(17, 30, 90), (30, 17, -180), (30, 43, 0), (43, 30, -90)]  # theta in [-180, 180)
+    # each touches a visited cell
+    assert b.visited[c.seg_rows, c.seg_cols].all()
+
+
+def test_candidates_drop_explored_dead_end():
+    b = plus_belief()
+    for r in range(30, 60):
+        b.visit(r, 30)  # walk down the south branch to its end
+    c = b.candidates()
+    dirs = sorted(round(float(np.degrees(t))) for t in c.theta)
+    assert dirs == [-180, 0, 90]
+
+
+def test_density_class_of_corridor_and_junction():
+    b = plus_belief()
+    # Manhattan kernel r = 2.4 m (24 cells) at the junction: 5 x (24+24+1) cells in each arm, minus overlap
+    assert b.seg_class[30, 30] == int(np.floor((2 * 5 * 49 - 25) * 0.01 / 2.5))
+    lab = b.segment_labels()
+    assert lab[30, 30] > 0 and lab[0, 0] == 0

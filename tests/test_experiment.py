@@ -1,0 +1,92 @@
+"""End-to-end runs on the demo building (a small map of our own)."""
+
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from semsearch_cli import api
+from semsearch_cli.cli import app
+from semsearch_cli.episode import Episode
+from semsearch_cli.experiment import expand, run_batch
+from semsearch_cli.planners import PLANNERS, Variant, expand_variants
+from semsearch_cli.config import PlannerSpec
+
+
+@pytest.mark.parametrize("name", sorted(PLANNERS))
+def test_every_planner_finds_the_goal_on_the_demo(demo_loaded, name):
+    L = demo_loaded
+    for goal in L.sc.goals:
+        res = Episode(L.world, L.sc, Variant(name, ()), goal, seed=0).run()
+        assert res.outcome == "found"
+        assert res.distance_m >= L.shortest[goal] - 0.5  # never better than the ground-truth optimum
+        assert res.decisions >= 1
+        assert res.path.shape == (res.steps + 1, 2)
+
+
+def test_same_seed_same_run(demo_loaded):
+    L = demo_loaded
+    a = Episode(L.world, L.sc, Variant("greedy", ()), 452, seed=1).run()
+    b = Episode(L.world, L.sc, Variant("greedy", ()), 452, seed=1).run()
+    assert (a.outcome, a.distance_m, a.steps, a.decisions) == (b.outcome, b.distance_m, b.steps, b.decisions)
+    assert (a.path == b.path).all()
+
+
+def test_seeds_change_start_heading_and_runs(demo_loaded):
+    L = demo_loaded
+    d = {Episode(L.world, L.sc, Variant("greedy", ()), 452, seed=s).run().distance_m for s in range(4)}
+    assert len(d) > 1
+
+
+KEY = ["planner", "goal", "seed"]
+
+
+def _rows(df):
+    return df.drop(columns=["wall_s"]).sort_values(KEY).reset_index(drop=True)
+
+
+def test_rows_do_not_depend_on_worker_count(demo_loaded, tmp_path):
+    specs = expand(demo_loaded, seeds=2)
+    one = run_batch(demo_loaded, specs, tmp_path / "w1", workers=1)
+    two = run_batch(demo_loaded, specs, tmp_path / "w2", workers=2)
+    assert len(one) == len(specs) == 8
+    pd.testing.assert_frame_equal(_rows(one), _rows(two))
+
+
+def test_interrupted_batch_resumes(demo_loaded, tmp_path):
+    out = tmp_path / "r"
+    specs = expand(demo_loaded, seeds=2)
+    run_batch(demo_loaded, specs[:3], out)
+    with open(out / "runs.csv", "a") as fh:
+        fh.write("demo,greedy,{},304,1,fou")  # a row torn by an interruption
+    seen = []
+    runs = run_batch(demo_loaded, specs, out, progress=seen.append)
+    assert len(seen) == len(specs) - 3  # only the missing runs were run
+    assert len(runs) == len(specs)
+    assert sorted(map(tuple, runs[KEY].astype(str).values)) == sorted((s.variant.label, str(s.goal), str(s.seed)) for s in specs)
+
+
+def test_run_command_writes_rows_summary_and_plots(demo_dir, tmp_path):
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "2", "--goal", "304", "--workers", "1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    runs = pd.read_csv(out / "runs.csv")
+    for col in ["scenario", "planner", "params", "goal", "seed", "outcome", "success", "distance_m", "shortest_m",
+                "ratio", "spl", "steps", "decisions", "wall_s"]:
+        assert col in runs.columns
+    assert len(runs) == 4 and set(runs["planner"]) == {"greedy", "bvp"}
+    assert ((runs["ratio"] - runs["distance_m"] / runs["shortest_m"]).abs() < 1e-3).all()
+    s = pd.read_csv(out / "summary.csv")
+    g = runs[runs.planner == "greedy"]["distance_m"]
+    row = s[s.planner == "greedy"].iloc[0]
+    assert row["n"] == 2 and row["mean"] == pytest.approx(g.mean(), abs=1e-3) and row["std"] == pytest.approx(g.std(), abs=1e-3)
+    assert sorted(p.name for p in (out / "plots").iterdir()) == ["bvp__goal304.png", "greedy__goal304.png"]
+
+
+def test_list_valued_parameters_expand_into_variants():
+    vs = expand_variants([PlannerSpec(name="bvp", window=[5.0, 10.0]), PlannerSpec(name="greedy")])
+    assert [v.label for v in vs] == ["bvp[window=5.0]", "bvp[window=10.0]", "greedy"]
+
+
+def test_api_run_filters_planner(demo_dir, tmp_path):
+    res = api.run(demo_dir / "scenario.yaml", seeds=1, workers=1, goals=[452], planners=["bvp"], out=tmp_path / "o", plots=False)
+    assert list(res.runs["planner"]) == ["bvp"]
