@@ -79,28 +79,17 @@ def local_reach(free, r0, c0, radius, manhattan):
 
 
 @njit(cache=True)
-def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
+def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, length, parent, touched, closed, gen):
     """Multi-source Dijkstra on an 8-connected grid with per-cell cost multipliers.
 
     Moving into cell q costs ``step * cost[q]`` with step 1 or sqrt(2); ``cost`` of shape (1, 1)
-    means a uniform cost of 1. The search stops once ``n_stop`` cells with ``target`` set are
-    settled (0: never) or the cost exceeds ``max_cost``.
-
-    Returns
-    -------
-    dist : (H, W) float64
-        Cost-to-come (inf where not reached).
-    length : (H, W) float64
-        Geometric length (cells) of the cheapest path.
-    parent : (H, W) int64
-        Flat index of the predecessor (-1 for sources and unreached cells).
+    means a uniform cost of 1. Cells with ``tmark == gen`` are targets; the search stops once
+    ``n_stop`` of them are settled (0: never) or the cost exceeds ``max_cost``. The state arrays
+    are reused across searches: a value is valid only where its stamp (``touched`` / ``closed``)
+    equals ``gen``, so a search costs what it explores, not the grid size.
     """
     H, W = passable.shape
     uniform = cost.shape[0] == 1
-    dist = np.full((H, W), np.inf)
-    length = np.full((H, W), np.inf)
-    parent = np.full((H, W), -1, np.int64)
-    done = np.zeros((H, W), np.bool_)
     heap = [(0.0, np.int64(0))]
     heap.pop()
     for i in range(src_r.shape[0]):
@@ -109,25 +98,27 @@ def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
         if 0 <= r < H and 0 <= c < W and passable[r, c]:
             dist[r, c] = 0.0
             length[r, c] = 0.0
+            parent[r, c] = -1
+            touched[r, c] = gen
             heapq.heappush(heap, (0.0, np.int64(r * W + c)))
     settled_targets = 0
     while len(heap) > 0:
         d, idx = heapq.heappop(heap)
         r = idx // W
         c = idx - r * W
-        if done[r, c]:
+        if closed[r, c] == gen:
             continue
-        done[r, c] = True
         if d > max_cost:
             break
-        if target[r, c]:
+        closed[r, c] = gen
+        if tmark[r, c] == gen:
             settled_targets += 1
             if n_stop > 0 and settled_targets >= n_stop:
                 break
         for k in range(8):
             nr = r + _DR8[k]
             nc = c + _DC8[k]
-            if nr < 0 or nr >= H or nc < 0 or nc >= W or done[nr, nc] or not passable[nr, nc]:
+            if nr < 0 or nr >= H or nc < 0 or nc >= W or closed[nr, nc] == gen or not passable[nr, nc]:
                 continue
             if k >= 4:
                 if not passable[r, nc] or not passable[nr, c]:
@@ -136,12 +127,68 @@ def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
             else:
                 step = 1.0
             nd = d + (step if uniform else step * cost[nr, nc])
-            if nd < dist[nr, nc]:
+            if touched[nr, nc] != gen or nd < dist[nr, nc]:
+                touched[nr, nc] = gen
                 dist[nr, nc] = nd
                 length[nr, nc] = length[r, c] + step
                 parent[nr, nc] = idx
                 heapq.heappush(heap, (nd, np.int64(nr * W + nc)))
-    return dist, length, parent
+    return settled_targets
+
+
+class GridSearch:
+    """Reusable Dijkstra state for one grid shape (see :func:`_dijkstra`).
+
+    After :meth:`run`, :meth:`lengths` and :meth:`path` read the settled cells of that search.
+    """
+
+    def __init__(self, shape):
+        self.dist = np.zeros(shape)
+        self.length_ = np.zeros(shape)
+        self.parent = np.full(shape, -1, np.int64)
+        self.touched = np.zeros(shape, np.int32)
+        self.closed = np.zeros(shape, np.int32)
+        self.tmark = np.zeros(shape, np.int32)
+        self.gen = 0
+        self.source = None
+
+    def run(self, passable, cost, src_r, src_c, t_rows, t_cols, n_stop=0, max_cost=np.inf) -> int:
+        """Search from the source cells; returns the number of targets settled."""
+        self.gen += 1
+        self.tmark[t_rows, t_cols] = self.gen
+        src_r = np.atleast_1d(np.asarray(src_r, np.int64))
+        src_c = np.atleast_1d(np.asarray(src_c, np.int64))
+        self.source = (tuple(src_r), tuple(src_c))
+        return _dijkstra(passable, cost, src_r, src_c, self.tmark, n_stop, max_cost, self.dist, self.length_,
+                         self.parent, self.touched, self.closed, self.gen)
+
+    def settled(self, rows, cols) -> np.ndarray:
+        return self.closed[rows, cols] == self.gen
+
+    def lengths(self, rows, cols) -> np.ndarray:
+        """Path length (cells) to each given cell, inf where it was not settled."""
+        return np.where(self.settled(rows, cols), self.length_[rows, cols], np.inf)
+
+    def costs(self, rows, cols) -> np.ndarray:
+        return np.where(self.settled(rows, cols), self.dist[rows, cols], np.inf)
+
+    def path(self, r, c):
+        """Cells (rows, cols) from the source to (r, c), or None if (r, c) was not settled."""
+        if self.closed[r, c] != self.gen:
+            return None
+        return backtrack(self.parent, r, c)
+
+
+def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
+    """One-off search returning full arrays (cost, length, parent); inf / -1 where not settled.
+
+    ``target`` is an (H, W) bool mask. For repeated searches on one grid use :class:`GridSearch`.
+    """
+    gs = GridSearch(passable.shape)
+    tr, tc = np.nonzero(target)
+    gs.run(passable, cost, src_r, src_c, tr, tc, n_stop, max_cost)
+    done = gs.closed == gs.gen
+    return np.where(done, gs.dist, np.inf), np.where(done, gs.length_, np.inf), np.where(done, gs.parent, -1)
 
 
 @njit(cache=True)

@@ -15,7 +15,7 @@ from skimage.morphology import skeletonize
 
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
-from ..gridalg import branch_walk, dijkstra, local_reach
+from ..gridalg import GridSearch, branch_walk, local_reach
 
 CLEARANCE_CAP_M = 1.0
 SKELETON_MARGIN_M = 4.0
@@ -89,6 +89,11 @@ class Belief:
         self.seg_class = np.full((H, W), -1, np.int16)
         self.clearance = np.zeros((H, W), np.float32)
         self.skeleton = np.zeros((H, W), bool)
+        self.passable = np.zeros((H, W), bool)
+        self.cost = np.ones((H, W), np.float32)
+        self.search_state = GridSearch((H, W))
+        self.version = 0  # bumped whenever passable/cost change
+        self._search_key = None
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
@@ -152,24 +157,22 @@ class Belief:
         w0, w1, w2, w3 = max(0, d[0] - h), min(H, d[1] + h + 1), max(0, d[2] - h), min(W, d[3] + h + 1)
         c0, c1, c2, c3 = max(0, d[0] - m), min(H, d[1] + m + 1), max(0, d[2] - m), min(W, d[3] + m + 1)
         sk = skeletonize(self.free[c0:c1, c2:c3])
-        self.skeleton[w0:w1, w2:w3] = sk[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
+        win = (slice(w0, w1), slice(w2, w3))
+        self.skeleton[win] = sk[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
+        # passable and cost over the skeleton's write window (it contains the clearance's)
+        clear = self.clearance[win]
+        self.passable[win] = clear >= self.min_clear
+        cost = np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * clear
+        cost[self.skeleton[win]] = 1.0
+        self.cost[win] = cost
+        self.version += 1
         d[:] = (H, -1, W, -1)
 
-    @property
-    def passable(self) -> np.ndarray:
-        """(H, W) bool: known free cells where the robot disk fits."""
-        return self.clearance >= self.min_clear
-
-    def path_cost(self) -> np.ndarray:
-        """(H, W) float32 per-cell cost multiplier: 1 on the skeleton, more elsewhere and near walls.
-
-        Shortest paths under this cost run along the skeleton where it connects (so their length
-        counts skeleton cells, as the closeness factor of Eq. 16 does) and cut across open space
-        or skeleton gaps only when that is much shorter.
-        """
-        cost = 1.5 + 2.0 * (1.0 - self.clearance / np.float32(CLEARANCE_CAP_M))
-        cost[self.skeleton] = 1.0
-        return cost.astype(np.float32)
+    # passable : (H, W) bool, known free cells where the robot disk fits.
+    # cost : (H, W) float32 per-cell cost multiplier, 1 on the skeleton and 1.5 (open space) to
+    # 3.5 (against a wall) elsewhere. Shortest paths under this cost run along the skeleton where
+    # it connects (so their length counts skeleton cells, as the closeness factor of Eq. 16 does)
+    # and cut across open space or skeleton gaps only where that is much shorter.
 
     # ---- frontier candidates -----------------------------------------------------------
     def candidates(self) -> Candidates:
@@ -229,14 +232,26 @@ class Belief:
         return r, c
 
     # ---- distances and segments ----------------------------------------------------------
-    def geodesic(self, r: int, c: int, targets: np.ndarray, n_stop: int):
-        """Dijkstra from the robot cell under :meth:`path_cost`; returns (cost, length, parent)."""
+    def search(self, r: int, c: int, t_rows, t_cols, n_stop: int) -> GridSearch:
+        """Dijkstra from the robot cell (r, c) under ``cost``; the returned state answers
+        ``lengths`` (cells) and ``path`` for the settled cells. Stops after ``n_stop`` targets."""
         passable = self.passable
         if not passable[r, c]:  # robot squeezed near a wall: let it leave
             passable = passable.copy()
             rr, cc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
             passable[rr, cc] = True
-        return dijkstra(passable, self.path_cost(), np.array([r]), np.array([c]), targets, n_stop, np.inf)
+        gs = self.search_state
+        gs.run(passable, self.cost, r, c, np.asarray(t_rows, np.int64), np.asarray(t_cols, np.int64), n_stop)
+        self._search_key = (r, c, self.version)
+        return gs
+
+    def path(self, r: int, c: int, tr: int, tc: int):
+        """Cheapest path (rows, cols) from (r, c) to (tr, tc), reusing the last search when it
+        started here on the current maps and reached the target; None when unreachable."""
+        gs = self.search_state
+        if self._search_key != (r, c, self.version) or not gs.settled(tr, tc):
+            self.search(r, c, [tr], [tc], 1)
+        return gs.path(tr, tc)
 
     def segment_labels(self) -> np.ndarray:
         """(H, W) int32: visited segments (connected cells of one density class), 0 elsewhere."""

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..gridalg import backtrack
 from .harmonic import ascend, harmonic_field
 
 HARMONIC_MARGIN_M = 5.0
@@ -20,12 +19,7 @@ class GeodesicNavigator:
 
     def plan(self, belief, r: int, c: int, tr: int, tc: int):
         """Cells (rows, cols) from (r, c) to (tr, tc), or None when unreachable."""
-        target = np.zeros(belief.free.shape, bool)
-        target[tr, tc] = True
-        cost, _, parent = belief.geodesic(r, c, target, 1)
-        if not np.isfinite(cost[tr, tc]):
-            return None
-        return backtrack(parent, tr, tc)
+        return belief.path(r, c, tr, tc)
 
 
 class HarmonicNavigator:

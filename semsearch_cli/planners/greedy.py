@@ -12,10 +12,8 @@ class Greedy(Planner):
     def choose(self, ctx, cands):
         if len(cands) == 0:
             return None
-        target = np.zeros(ctx.belief.free.shape, bool)
-        target[cands.rows, cands.cols] = True
-        _, length, _ = ctx.belief.geodesic(ctx.row, ctx.col, target, 1)
-        d = length[cands.rows, cands.cols]
+        gs = ctx.belief.search(ctx.row, ctx.col, cands.rows, cands.cols, 1)
+        d = gs.lengths(cands.rows, cands.cols)
         if not np.isfinite(d).any():
             return None
         best = np.flatnonzero(d == d.min())
