@@ -127,7 +127,7 @@ class Episode:
                     keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
                     if keep.all():
                         break
-                    cands = type(cands)(cands.rows[keep], cands.cols[keep], cands.theta[keep], cands.seg_rows[keep], cands.seg_cols[keep])
+                    cands = cands.take(np.flatnonzero(keep))
                 if path_r is None:
                     outcome = "stuck"
                     break

@@ -41,6 +41,12 @@ class Candidates:
     def __len__(self) -> int:
         return int(self.rows.shape[0])
 
+    def take(self, idx) -> "Candidates":
+        return Candidates(self.rows[idx], self.cols[idx], self.theta[idx], self.seg_rows[idx], self.seg_cols[idx])
+
+    def concat(self, other: "Candidates") -> "Candidates":
+        return Candidates(*(np.concatenate([getattr(self, f), getattr(other, f)]) for f in ("rows", "cols", "theta", "seg_rows", "seg_cols")))
+
 
 @dataclass
 class DoorReads:
@@ -98,6 +104,8 @@ class Belief:
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
         self.vbox = [H, -1, W, -1]
+        self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
+        self._cands = None
         self._seg_labels = None
 
     # ---- per-step updates -------------------------------------------------------------
@@ -107,8 +115,7 @@ class Belief:
         if r1 <= r0:
             return
         self.free[r0:r1, c0:c1] = self.seen[r0:r1, c0:c1] & (self.cv[r0:r1, c0:c1] < self.spec.occupied_threshold)
-        d = self.dirty
-        d[0], d[1], d[2], d[3] = min(d[0], r0), max(d[1], r1 - 1), min(d[2], c0), max(d[3], c1 - 1)
+        _grow(self.dirty, (r0, r1 - 1, c0, c1 - 1))
 
     def visit(self, r: int, c: int) -> None:
         """Mark the visited kernel around the robot and give it the local density class.
@@ -124,9 +131,9 @@ class Belief:
             return
         self.visited[vr, vc] = True
         self.seg_class[vr, vc] = cls
-        b = self.vbox
-        b[0], b[1] = min(b[0], int(vr.min())), max(b[1], int(vr.max()))
-        b[2], b[3] = min(b[2], int(vc.min())), max(b[3], int(vc.max()))
+        box = (int(vr.min()), int(vr.max()), int(vc.min()), int(vc.max()))
+        _grow(self.vbox, box)
+        _grow(self.cdirty, box)
         self._seg_labels = None
 
     # ---- derived maps, refreshed at re-plan time ---------------------------------------
@@ -165,6 +172,7 @@ class Belief:
         cost = np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * clear
         cost[self.skeleton[win]] = 1.0
         self.cost[win] = cost
+        _grow(self.cdirty, (w0, w1 - 1, w2, w3 - 1))
         self.version += 1
         d[:] = (H, -1, W, -1)
 
@@ -177,22 +185,47 @@ class Belief:
     # ---- frontier candidates -----------------------------------------------------------
     def candidates(self) -> Candidates:
         """Candidates C: per 8-connected group of skeleton cells on the frontier (known free, not
-        visited, touching a visited cell), the one farthest from walls; groups whose branch does not
-        lead on (fewer than 3 unvisited skeleton cells) are dropped. Where the skeleton crosses no
-        frontier at all, each frontier group gives its widest cell instead, so a search never stops
-        while free space remains unvisited."""
+        visited, touching a visited cell, where the robot fits), the one farthest from walls;
+        groups whose branch does not lead on (fewer than 3 unvisited skeleton cells) are dropped.
+        Where the skeleton crosses no frontier at all, each frontier group gives its widest cell
+        instead, so a search never stops while free space remains unvisited.
+
+        Incremental: only a window around what changed since the last call (visited kernels,
+        refreshed maps) is recomputed; candidates elsewhere cannot have changed and are kept.
+        """
         H, W = self.free.shape
-        b = self.vbox
+        b, d = self.vbox, self.cdirty
         if b[1] < b[0]:
             return _empty()
-        r0, r1, c0, c1 = max(0, b[0] - 2), min(H, b[1] + 3), max(0, b[2] - 2), min(W, b[3] + 3)
+        if self._cands is not None and d[1] < d[0]:
+            out = self._cands
+        else:
+            m = BRANCH_DEPTH + 3
+            if self._cands is None:
+                r0, r1, c0, c1 = max(0, b[0] - 2), min(H, b[1] + 3), max(0, b[2] - 2), min(W, b[3] + 3)
+            else:
+                r0, r1 = max(0, b[0] - 2, d[0] - m), min(H, b[1] + 3, d[1] + m + 1)
+                c0, c1 = max(0, b[2] - 2, d[2] - m), min(W, b[3] + 3, d[3] + m + 1)
+            new = self._groups(self._front(r0, r1, c0, c1) & self.skeleton[r0:r1, c0:c1], r0, c0, need_branch=True)
+            if self._cands is not None:
+                old = self._cands
+                out_w = ~((old.rows >= r0) & (old.rows < r1) & (old.cols >= c0) & (old.cols < c1))
+                kept = old.take(np.flatnonzero(out_w))
+                if len(kept) and len(new):  # a group straddling the window border: keep one
+                    near = (np.abs(new.rows[:, None] - kept.rows[None]) <= 2) & (np.abs(new.cols[:, None] - kept.cols[None]) <= 2)
+                    new = new.take(np.flatnonzero(~near.any(axis=1)))
+                new = kept.concat(new)
+            self._cands = out = new
+            d[:] = (H, -1, W, -1)
+        if len(out) == 0:
+            r0, r1, c0, c1 = max(0, b[0] - 2), min(H, b[1] + 3), max(0, b[2] - 2), min(W, b[3] + 3)
+            out = self._groups(self._front(r0, r1, c0, c1), r0, c0, need_branch=False)
+        return out
+
+    def _front(self, r0, r1, c0, c1) -> np.ndarray:
         vis = self.visited[r0:r1, c0:c1]
         grown = cv2.dilate(vis.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-        front = grown & ~vis & self.free[r0:r1, c0:c1] & (self.clearance[r0:r1, c0:c1] >= self.min_clear)
-        out = self._groups(front & self.skeleton[r0:r1, c0:c1], r0, c0, need_branch=True)
-        if len(out) == 0:
-            out = self._groups(front, r0, c0, need_branch=False)
-        return out
+        return grown & ~vis & self.passable[r0:r1, c0:c1]
 
     def _groups(self, mask, r0, c0, need_branch):
         n, lab = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8)
@@ -271,6 +304,12 @@ class Belief:
                 nxt += n - 1
         self._seg_labels = out
         return out
+
+
+def _grow(box, other) -> None:
+    """Grow bounding box ``box`` = [rmin, rmax, cmin, cmax] (in place) to contain ``other``."""
+    box[0], box[1] = min(box[0], other[0]), max(box[1], other[1])
+    box[2], box[3] = min(box[2], other[2]), max(box[3], other[3])
 
 
 def _empty() -> Candidates:

@@ -1,8 +1,13 @@
 """Navigators (SPEC 5): from the robot cell to a chosen target cell, a path of cells.
 
 ``geodesic`` (default): the cheapest path under the belief's skeleton-following cost.
-``harmonic``: gradient ascent of the harmonic attraction toward the target, solved in a window
-around robot and target; falls back to the geodesic path where the field is numerically flat.
+``harmonic``: gradient ascent of the harmonic attraction (the thesis' BVP) solved in a window around
+the robot. The attraction decays exponentially along corridors (by about exp(-pi d / w) over a
+distance d in a corridor of width w), so beyond ~20 m in a 2 m corridor it falls below double
+precision; like the seeds' local BVP, the navigator therefore aims at the target when it is within
+``LOOKAHEAD_M`` along the geodesic path, and otherwise at the point of that path ``LOOKAHEAD_M``
+ahead (the robot re-plans long before it gets there). Where the ascent still stalls it follows the
+geodesic path and counts a fallback.
 """
 
 from __future__ import annotations
@@ -11,7 +16,8 @@ import numpy as np
 
 from .harmonic import ascend, harmonic_field
 
-HARMONIC_MARGIN_M = 5.0
+HARMONIC_MARGIN_M = 3.0
+LOOKAHEAD_M = 8.0
 
 
 class GeodesicNavigator:
@@ -26,10 +32,17 @@ class HarmonicNavigator:
     name = "harmonic"
 
     def __init__(self):
-        self.fallback = GeodesicNavigator()
         self.fallbacks = 0
 
     def plan(self, belief, r: int, c: int, tr: int, tc: int):
+        geo = belief.path(r, c, tr, tc)
+        if geo is None:
+            return None
+        gr, gc = geo
+        along = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(gr), np.diff(gc)))]) * belief.frame.res
+        k = int(np.searchsorted(along, LOOKAHEAD_M))
+        if k < len(gr):
+            tr, tc = int(gr[k]), int(gc[k])
         H, W = belief.free.shape
         m = int(HARMONIC_MARGIN_M / belief.frame.res)
         r0, r1 = max(0, min(r, tr) - m), min(H, max(r, tr) + m + 1)
@@ -42,7 +55,7 @@ class HarmonicNavigator:
         rows, cols, ok = ascend(u, r - r0, c - c0, 4 * (r1 - r0 + c1 - c0))
         if not ok:
             self.fallbacks += 1
-            return self.fallback.plan(belief, r, c, tr, tc)
+            return geo
         return rows + r0, cols + c0
 
 

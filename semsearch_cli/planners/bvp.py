@@ -1,8 +1,11 @@
 """BVP exploration (Prestes et al. 2002; draft paper Section IV-B): frontier exploration by the
 harmonic potential with every frontier cell attracting.
 
-The attraction is solved in a square window around the robot (``window`` m half-size); the robot
-climbs it to whichever frontier the field leads to. Where the window holds no frontier or the field
+The attraction is solved in a square window around the robot (``window`` m half-size), on cells
+``coarsen`` times the map's (a coarse cell is passable when all its fine cells are, and attracts
+when any of them is a frontier cell), which keeps each solve to a few milliseconds; the robot
+climbs the field to whichever frontier it leads to, and the target is the frontier cell in that
+coarse cell nearest to the robot. Where the window holds no frontier or the field
 is numerically flat at the robot (frontiers far away), the nearest candidate along the skeleton is
 taken instead, as greedy would.
 """
@@ -21,6 +24,7 @@ from .greedy import Greedy
 class BVPParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
     window: float = Field(15.0, gt=1.0, description="m, half-size of the square solved around the robot")
+    coarsen: int = Field(2, ge=1, le=8, description="cells of the map per cell of the potential's grid")
 
 
 @register_planner("bvp")
@@ -40,12 +44,30 @@ class BVP(Planner):
         passable[ctx.row - r0, ctx.col - c0] = True
         front = grown & ~vis & passable
         if front.any():
-            u = harmonic_field(passable, front)
-            if u[ctx.row - r0, ctx.col - c0] >= FLAT:
-                rows, cols, ok = ascend(u, ctx.row - r0, ctx.col - c0, 8 * m)
+            k = self.params.coarsen
+            pc, fc = _pool(passable, k, np.all), _pool(front, k, np.any)
+            pc |= fc
+            rr, rc = (ctx.row - r0) // k, (ctx.col - c0) // k
+            pc[rr, rc] = True
+            u = harmonic_field(pc, fc)
+            if u[rr, rc] >= FLAT:
+                rows, cols, ok = ascend(u, rr, rc, 8 * m)
                 if ok:
-                    return Decision(int(rows[-1] + r0), int(cols[-1] + c0), {"u_robot": float(u[ctx.row - r0, ctx.col - c0])})
+                    br, bc = int(rows[-1]) * k, int(cols[-1]) * k
+                    fr, fcol = np.nonzero(front[br : br + k, bc : bc + k])
+                    j = int(np.argmin((fr + br - (ctx.row - r0)) ** 2 + (fcol + bc - (ctx.col - c0)) ** 2))
+                    return Decision(int(fr[j] + br + r0), int(fcol[j] + bc + c0), {"u_robot": float(u[rr, rc])})
         d = Greedy(self.params).choose(ctx, cands)
         if d is not None:
             d.info["fallback"] = "nearest"
         return d
+
+
+def _pool(a: np.ndarray, k: int, how) -> np.ndarray:
+    """Pool a bool grid by k x k blocks (padding with False) using ``how`` (np.all or np.any)."""
+    if k == 1:
+        return a.copy()
+    h, w = a.shape
+    p = np.zeros((-(-h // k) * k, -(-w // k) * k), bool)
+    p[:h, :w] = a
+    return how(p.reshape(p.shape[0] // k, k, p.shape[1] // k, k), axis=(1, 3))

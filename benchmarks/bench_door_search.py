@@ -1,0 +1,173 @@
+"""Door-search benchmark on the authors' Hotel map (read from ../shared, never copied).
+
+Measures (medians of repeated runs, with ratios against baselines timed in the same process):
+  1. one greedy run, Hotel goal 148, seed 0: wall time and seconds per 300 m travelled; the
+     baseline is the sensing-only loop (laser + HIMM + door cameras + visited kernel) over the
+     same poses, i.e. the floor any planner pays;
+  2. the whole Hotel table (4 goals x greedy and bvp x 10 seeds) with 2 workers;
+  3. navigators: path lengths of the geodesic and the harmonic navigator between random pairs of
+     cells on the fully known Hotel map, and greedy runs with either navigator.
+
+Usage: python benchmarks/bench_door_search.py [--repeat 5] [--skip-table] [--out FILE.md]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from semsearch_cli.belief import Belief
+from semsearch_cli.episode import Episode
+from semsearch_cli.experiment import Loaded, expand, run_batch
+from semsearch_cli.navigation import GeodesicNavigator, HarmonicNavigator
+from semsearch_cli.planners import Variant
+from semsearch_cli.sensors.devices import DoorCamera, Laser
+from semsearch_cli.sensors.raycast import himm_update
+from semsearch_cli.world.mobilesim import import_mobilesim
+
+REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
+
+
+def sensing_only(L: Loaded, path: np.ndarray) -> float:
+    """Seconds to sense and update the belief at each pose of ``path`` (no planning, no motion)."""
+    sc, w = L.sc, L.world
+    b = Belief(w.frame, sc.belief, sc.robot.radius)
+    laser, cam = Laser(w, sc.laser), DoorCamera(w, sc.door_camera)
+    rng = np.random.default_rng(0)
+    bbox = np.empty(4, np.int64)
+    t0 = time.perf_counter()
+    prev = path[0]
+    for x, y in path[1:]:
+        heading = float(np.arctan2(y - prev[1], x - prev[0])) if (x, y) != tuple(prev) else 0.0
+        prev = (x, y)
+        v, u = w.frame.to_cell(x, y)
+        th, d, h = laser.scan(float(v), float(u), heading, rng)
+        bbox[:] = (10**9, -1, 10**9, -1)
+        himm_update(b.cv, b.seen, float(v), float(u), th, d, h, 3, 1, 15, bbox)
+        b.refresh_free(bbox)
+        cam.read(float(x), float(y), heading, rng)
+        b.visit(int(np.floor(v)), int(np.floor(u)))
+    return time.perf_counter() - t0
+
+
+def known_belief(L: Loaded) -> Belief:
+    w = L.world
+    b = Belief(w.frame, L.sc.belief, L.sc.robot.radius)
+    b.seen[:] = True
+    b.cv[w.occ] = 15
+    b.refresh_free(np.array([0, w.frame.height - 1, 0, w.frame.width - 1]))
+    b.refresh_derived()
+    return b
+
+
+def drive(nav, b: Belief, r: int, c: int, tr: int, tc: int, replan_cells: float) -> float | None:
+    """Length (cells) a robot travels from (r, c) to (tr, tc), re-planning every ``replan_cells``."""
+    total = 0.0
+    for _ in range(10_000):
+        if (r, c) == (tr, tc):
+            return total
+        p = nav.plan(b, r, c, tr, tc)
+        if p is None or len(p[0]) < 2:
+            return None
+        rows, cols = p
+        seg = np.hypot(np.diff(rows), np.diff(cols))
+        k = max(1, int(np.searchsorted(np.cumsum(seg), replan_cells)) + 1)
+        k = min(k, len(rows) - 1)
+        total += float(seg[:k].sum())
+        r, c = int(rows[k]), int(cols[k])
+    return None
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--pairs", type=int, default=40)
+    ap.add_argument("--skip-table", action="store_true")
+    ap.add_argument("--out", type=Path)
+    a = ap.parse_args()
+    if not REF.is_dir():
+        print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
+        return 0
+    lines = []
+
+    def say(s=""):
+        print(s, flush=True)
+        lines.append(s)
+
+    tmp = Path(tempfile.mkdtemp(prefix="semsearch-bench-"))
+    p = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5, "hotel-reference")
+    L = Loaded.load(p)
+    say(f"# semsearch door-search benchmark ({time.strftime('%Y-%m-%d %H:%M')}, {sys.platform}, python {sys.version.split()[0]})")
+    say()
+    # 1. one greedy run
+    Episode(L.world, L.sc, Variant("greedy", ()), 148, 0).run()  # warm-up (numba cache, imports)
+    walls, base = [], []
+    for _ in range(a.repeat):
+        res = Episode(L.world, L.sc, Variant("greedy", ()), 148, 0).run()
+        walls.append(res.wall_s)
+        base.append(sensing_only(L, res.path.astype(float)))
+    med, bmed = statistics.median(walls), statistics.median(base)
+    say(f"## 1. greedy, Hotel goal 148, seed 0 ({a.repeat} repeats)")
+    say(f"distance {res.distance_m:.1f} m, {res.steps} steps, {res.decisions} decisions, outcome {res.outcome}")
+    say(f"median wall {med:.3f} s (min {min(walls):.3f}, max {max(walls):.3f}) = {med / res.distance_m * 300:.2f} s per 300 m (target <= 1.5)")
+    say(f"sensing-only baseline over the same poses: median {bmed:.3f} s; run / baseline = {med / bmed:.2f}")
+    say()
+    # 2. navigators
+    b = known_belief(L)
+    rng = np.random.default_rng(7)
+    rr, cc = np.nonzero(L.world.reach & b.passable)
+    geo, har = GeodesicNavigator(), HarmonicNavigator()
+    rel, tg, th = [], [], []
+    while len(rel) < a.pairs:
+        i, j = rng.integers(len(rr), size=2)
+        d = np.hypot(rr[i] - rr[j], cc[i] - cc[j]) * L.world.frame.res
+        if not 5.0 <= d <= 30.0:
+            continue
+        args = (b, int(rr[i]), int(cc[i]), int(rr[j]), int(cc[j]), L.sc.navigation.replan_every / L.world.frame.res)
+        t0 = time.perf_counter()
+        lg = drive(geo, *args)
+        t1 = time.perf_counter()
+        lh = drive(har, *args)
+        t2 = time.perf_counter()
+        if lg is None or lh is None:
+            continue
+        rel.append(lh / lg - 1.0)
+        tg.append(t1 - t0)
+        th.append(t2 - t1)
+    rel = np.array(rel)
+    say(f"## 2. navigators on the fully known Hotel map ({a.pairs} random pairs 5-30 m apart, re-planning every {L.sc.navigation.replan_every} m)")
+    say(f"harmonic path length vs geodesic: mean {rel.mean() * 100:+.1f}%, median {np.median(rel) * 100:+.1f}%, "
+        f"range {rel.min() * 100:+.1f}% .. {rel.max() * 100:+.1f}%; harmonic fell back to geodesic {har.fallbacks} times")
+    say(f"time to drive one pair: geodesic median {statistics.median(tg) * 1000:.0f} ms, harmonic median {statistics.median(th) * 1000:.0f} ms")
+    from semsearch_cli.config import NavigationSpec
+
+    sc_h = L.sc.model_copy(update={"navigation": NavigationSpec(navigator="harmonic")})
+    dg, dh = [], []
+    for s in range(3):
+        dg.append(Episode(L.world, L.sc, Variant("greedy", ()), 148, s).run().distance_m)
+        dh.append(Episode(L.world, sc_h, Variant("greedy", ()), 148, s).run().distance_m)
+    say("greedy runs, goal 148, seeds 0-2: geodesic " + ", ".join(f"{d:.1f}" for d in dg)
+        + " m; harmonic " + ", ".join(f"{d:.1f}" for d in dh) + " m")
+    say()
+    # 3. the whole table
+    if not a.skip_table:
+        specs = expand(L, 10)
+        t0 = time.perf_counter()
+        runs = run_batch(L, specs, tmp / "table", workers=2)
+        wall = time.perf_counter() - t0
+        say(f"## 3. whole Hotel table: 4 goals x greedy, bvp x 10 seeds = {len(specs)} runs, 2 workers")
+        say(f"wall {wall:.1f} s; sum of run times {runs['wall_s'].sum():.1f} s; travelled {runs['distance_m'].sum() / 1000:.1f} km")
+        say(runs.groupby("planner")["wall_s"].describe().round(2).to_string())
+    if a.out:
+        a.out.write_text("\n".join(lines) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
