@@ -96,8 +96,7 @@ class Episode:
                 read_signs.add(i)
                 if i == self.goal_idx and label == self.goal:
                     found = True
-                belief.reads.add(label, r * W + c, x, y, heading)
-                if belief.reads.total[label] == min_reads:
+                if belief.reads.add(label, r * W + c, x, y, heading) == min_reads:
                     event = True
             # 2. belief
             belief.visit(r, c)

@@ -102,3 +102,23 @@ def test_density_class_of_corridor_and_junction():
     assert b.seg_class[30, 30] == int(np.floor((2 * 5 * 49 - 25) * 0.01 / 2.5))
     lab = b.segment_labels()
     assert lab[30, 30] > 0 and lab[0, 0] == 0
+
+
+def test_door_lists_count_min_reads_and_follow_segments():
+    b = plus_belief()
+    W = b.free.shape[1]
+    b.visit(30, 55)  # far down the east arm: a corridor segment, class lower than the junction's
+    junction, east = 30 * W + 30, 30 * W + 55
+    for _ in range(3):
+        b.reads.add(101, junction, 3.0, 3.0, 0.0)
+    b.reads.add(102, junction, 3.0, 3.0, 0.0)  # read twice only: below min_reads = 3
+    b.reads.add(102, junction, 3.0, 3.0, 0.0)
+    b.reads.add(103, east, 4.4, 3.0, 0.0)
+    b.reads.add(103, east, 4.6, 3.0, 0.0)
+    b.reads.add(103, junction, 3.0, 3.0, 0.0)
+    lists = b.door_lists()
+    seg = b.segment_labels()
+    sj, se = int(seg[30, 30]), int(seg[30, 55])
+    assert sj != se
+    assert lists[sj] == {101: (3, 3.0, 3.0), 103: (1, 3.0, 3.0)}
+    assert lists[se] == {103: (2, 4.5, 3.0)}

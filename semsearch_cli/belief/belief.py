@@ -52,26 +52,28 @@ class Candidates:
 class DoorReads:
     """Every sign read, kept so door lists can be rebuilt when segments change (SPEC 3).
 
-    ``agg`` maps (sign index, robot cell flat index) -> [count, sum x, sum y]; ``total`` counts
-    reads per sign; ``headings`` is the robot heading (radians) at each read, in order.
+    ``agg`` maps (label as read, robot cell flat index) -> [count, sum x, sum y]; ``total`` counts
+    reads per label; ``headings`` is the robot heading (radians) at each read, in order.
     """
 
     agg: dict = field(default_factory=dict)
     total: dict = field(default_factory=dict)
     headings: list = field(default_factory=list)
 
-    def add(self, sign: int, cell: int, x: float, y: float, heading: float) -> bool:
-        """Record one read; True when the sign reaches ``min_reads`` with this read is decided by the caller."""
-        a = self.agg.get((sign, cell))
+    def add(self, label, cell: int, x: float, y: float, heading: float) -> int:
+        """Record one read of ``label`` from robot cell ``cell`` at robot pose (x, y, heading);
+        returns the label's total read count."""
+        a = self.agg.get((label, cell))
         if a is None:
-            self.agg[(sign, cell)] = [1, x, y]
+            self.agg[(label, cell)] = [1, x, y]
         else:
             a[0] += 1
             a[1] += x
             a[2] += y
-        self.total[sign] = self.total.get(sign, 0) + 1
+        n = self.total.get(label, 0) + 1
+        self.total[label] = n
         self.headings.append(heading)
-        return True
+        return n
 
 
 class Belief:
@@ -285,6 +287,27 @@ class Belief:
         if self._search_key != (r, c, self.version) or not gs.settled(tr, tc):
             self.search(r, c, [tr], [tc], 1)
         return gs.path(tr, tc)
+
+    def door_lists(self) -> dict:
+        """Door list of each visited segment (thesis 4.2.3, SPEC 3), rebuilt from every read.
+
+        Returns ``{segment: {label: (count, x, y)}}``: the signs read at least ``min_reads`` times
+        in all, attached to the segment of the robot's cell at each read, with the number of reads
+        made from that segment and the mean robot position (m) at them, which lies on the
+        corridor's axis.
+        """
+        labels = self.segment_labels().ravel()
+        counted = {lab for lab, n in self.reads.total.items() if n >= self.spec.min_reads}
+        acc: dict = {}
+        for (label, cell), (n, sx, sy) in self.reads.agg.items():
+            seg = int(labels[cell])
+            if label not in counted or seg == 0:
+                continue
+            e = acc.setdefault(seg, {}).setdefault(label, [0, 0.0, 0.0])
+            e[0] += n
+            e[1] += sx
+            e[2] += sy
+        return {seg: {lab: (n, sx / n, sy / n) for lab, (n, sx, sy) in d.items()} for seg, d in acc.items()}
 
     def segment_labels(self) -> np.ndarray:
         """(H, W) int32: visited segments (connected cells of one density class), 0 elsewhere."""
