@@ -5,7 +5,10 @@ The attraction is solved in a square window around the robot (``window`` m half-
 ``coarsen`` times the map's (a coarse cell is passable when all its fine cells are, and attracts
 when any of them is a frontier cell), which keeps each solve to a few milliseconds; the robot
 climbs the field to whichever frontier it leads to, and the target is the frontier cell in that
-coarse cell nearest to the robot. Where the window holds no frontier or the field
+coarse cell nearest to the robot. The robot keeps that target until it is reached or stops being a
+frontier cell (visited, or no longer passable): re-solving every metre and switching between the
+field and the nearest-candidate fallback can otherwise trap it in a back-and-forth between two
+poses where the field is near the limit of double precision. Where the window holds no frontier or the field
 is numerically flat at the robot (frontiers far away), the nearest candidate along the skeleton is
 taken instead, as greedy would.
 """
@@ -31,9 +34,23 @@ class BVPParams(BaseModel):
 class BVP(Planner):
     Params = BVPParams
 
+    def __init__(self, params):
+        super().__init__(params)
+        self.target: tuple[int, int] | None = None
+
     def choose(self, ctx, cands):
         if len(cands) == 0:
             return None
+        b = ctx.belief
+        if self.target is not None:
+            tr, tc = self.target
+            if (tr, tc) != (ctx.row, ctx.col) and b.passable[tr, tc] and not b.visited[tr, tc]:
+                return Decision(tr, tc, {"kept": True})
+        d = self._choose(ctx, cands)
+        self.target = None if d is None else (d.row, d.col)
+        return d
+
+    def _choose(self, ctx, cands):
         b = ctx.belief
         H, W = b.free.shape
         m = int(self.params.window / b.frame.res)
