@@ -266,3 +266,36 @@ def branch_walk(skel, visited, r0, c0, depth):
     if n == 0:
         return 0.0, 0.0, 0
     return sr / n, sc / n, n
+
+
+@njit(cache=True)
+def segment_flood(seg_class, visited, r0, c0, stamp, gen, queue):
+    """Mark with ``gen`` in ``stamp`` the segment of (r0, c0): the visited cells 8-connected to it
+    through cells of the same density class (thesis 4.2.2). Returns the number of cells marked.
+
+    ``queue`` is scratch space of at least H * W int64 entries.
+    """
+    H, W = seg_class.shape
+    if not visited[r0, c0] or stamp[r0, c0] == gen:
+        return 0
+    k = seg_class[r0, c0]
+    stamp[r0, c0] = gen
+    queue[0] = r0 * W + c0
+    head = 0
+    tail = 1
+    while head < tail:
+        idx = queue[head]
+        head += 1
+        r = idx // W
+        c = idx - r * W
+        for j in range(8):
+            nr = r + _DR8[j]
+            nc = c + _DC8[j]
+            if nr < 0 or nr >= H or nc < 0 or nc >= W:
+                continue
+            if stamp[nr, nc] == gen or not visited[nr, nc] or seg_class[nr, nc] != k:
+                continue
+            stamp[nr, nc] = gen
+            queue[tail] = nr * W + nc
+            tail += 1
+    return tail

@@ -122,3 +122,7 @@ def test_door_lists_count_min_reads_and_follow_segments():
     assert sj != se
     assert lists[sj] == {101: (3, 3.0, 3.0), 103: (1, 3.0, 3.0)}
     assert lists[se] == {103: (2, 4.5, 3.0)}
+    # the planners' flood-fill view agrees, and cells of one segment share its lists
+    seg_i, seg_lists = b.segment_door_lists(np.array([30, 30, 30, 0]), np.array([30, 55, 50, 0]))
+    assert seg_i.tolist() == [0, 1, 1, -1]
+    assert seg_lists == [lists[sj], lists[se]]

@@ -7,7 +7,7 @@ refreshed at re-plan time inside the bounding box of what changed since the last
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -15,7 +15,7 @@ from skimage.morphology import skeletonize
 
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
-from ..gridalg import GridSearch, branch_walk, local_reach
+from ..gridalg import GridSearch, branch_walk, local_reach, segment_flood
 
 CLEARANCE_CAP_M = 1.0
 SKELETON_MARGIN_M = 4.0
@@ -48,32 +48,66 @@ class Candidates:
         return Candidates(*(np.concatenate([getattr(self, f), getattr(other, f)]) for f in ("rows", "cols", "theta", "seg_rows", "seg_cols")))
 
 
-@dataclass
 class DoorReads:
     """Every sign read, kept so door lists can be rebuilt when segments change (SPEC 3).
 
-    ``agg`` maps (label as read, robot cell flat index) -> [count, sum x, sum y]; ``total`` counts
-    reads per label; ``headings`` is the robot heading (radians) at each read, in order.
+    Reads are aggregated per (label, robot cell): ``cell``, ``label`` (index into ``labels``),
+    ``count``, ``sx``, ``sy`` (sums of robot x, y in m) are arrays of the first ``n`` rows.
+    ``total`` counts reads per label; ``headings`` is the robot heading (radians) at each read.
     """
 
-    agg: dict = field(default_factory=dict)
-    total: dict = field(default_factory=dict)
-    headings: list = field(default_factory=list)
+    def __init__(self):
+        self.labels: list = []  # label values in order of first read
+        self._label_id: dict = {}
+        self._row: dict = {}
+        self.n = 0
+        self.cell = np.zeros(256, np.int64)
+        self.label = np.zeros(256, np.int64)
+        self.count = np.zeros(256, np.int64)
+        self.sx = np.zeros(256)
+        self.sy = np.zeros(256)
+        self.total: dict = {}
+        self.headings: list = []
 
     def add(self, label, cell: int, x: float, y: float, heading: float) -> int:
         """Record one read of ``label`` from robot cell ``cell`` at robot pose (x, y, heading);
         returns the label's total read count."""
-        a = self.agg.get((label, cell))
-        if a is None:
-            self.agg[(label, cell)] = [1, x, y]
-        else:
-            a[0] += 1
-            a[1] += x
-            a[2] += y
+        row = self._row.get((label, cell))
+        if row is None:
+            lid = self._label_id.get(label)
+            if lid is None:
+                lid = self._label_id[label] = len(self.labels)
+                self.labels.append(label)
+            if self.n == self.cell.shape[0]:
+                for f in ("cell", "label", "count", "sx", "sy"):
+                    a = getattr(self, f)
+                    setattr(self, f, np.concatenate([a, np.zeros_like(a)]))
+            row = self._row[(label, cell)] = self.n
+            self.cell[row], self.label[row] = cell, lid
+            self.n += 1
+        self.count[row] += 1
+        self.sx[row] += x
+        self.sy[row] += y
         n = self.total.get(label, 0) + 1
         self.total[label] = n
         self.headings.append(heading)
         return n
+
+    def lists(self, rows: np.ndarray, min_reads: int) -> dict:
+        """``{label: (count, x, y)}`` over the given aggregate rows, for labels read at least
+        ``min_reads`` times in all; x, y the mean robot position (m) at those reads."""
+        out = {}
+        if rows.size == 0:
+            return out
+        lid = self.label[rows]
+        cnt = np.bincount(lid, self.count[rows])
+        sx = np.bincount(lid, self.sx[rows])
+        sy = np.bincount(lid, self.sy[rows])
+        for i in np.flatnonzero(cnt):
+            lab = self.labels[i]
+            if self.total[lab] >= min_reads:
+                out[lab] = (int(cnt[i]), sx[i] / cnt[i], sy[i] / cnt[i])
+        return out
 
 
 class Belief:
@@ -105,6 +139,9 @@ class Belief:
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
+        self._seg_stamp = np.zeros((H, W), np.int64)
+        self._seg_gen = 0
+        self._queue = np.empty(H * W, np.int64)
         self.vbox = [H, -1, W, -1]
         self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
         self._cands = None
@@ -120,10 +157,15 @@ class Belief:
         _grow(self.dirty, (r0, r1 - 1, c0, c1 - 1))
 
     def visit(self, r: int, c: int) -> None:
-        """Mark the visited kernel around the robot and give it the local density class.
+        """Mark the visited kernel around the robot and give its newly visited cells the local
+        density class.
 
         Density (Eqs. 4.1-4.4): the free area (m^2) 4-connected to the robot inside a Manhattan
-        kernel of ``density_radius``, divided by ``density_delta`` and floored.
+        kernel of ``density_radius``, divided by ``density_delta`` and floored. A cell keeps the
+        class of its first visit: overwriting the classes around the robot at every step makes
+        segments change under it as it passes a junction, moving signs between segments and, at
+        alpha = 1, sending the robot back and forth between two candidates for ever (seen on Hotel
+        goal 148).
         """
         res = self.frame.res
         dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res + 1e-6, True)
@@ -131,8 +173,9 @@ class Belief:
         vr, vc = local_reach(self.free, r, c, self.spec.visited_radius / res + 1e-6, False)
         if vr.size == 0:
             return
+        new = ~self.visited[vr, vc]
         self.visited[vr, vc] = True
-        self.seg_class[vr, vc] = cls
+        self.seg_class[vr[new], vc[new]] = cls
         box = (int(vr.min()), int(vr.max()), int(vc.min()), int(vc.max()))
         _grow(self.vbox, box)
         _grow(self.cdirty, box)
@@ -296,18 +339,42 @@ class Belief:
         made from that segment and the mean robot position (m) at them, which lies on the
         corridor's axis.
         """
-        labels = self.segment_labels().ravel()
-        counted = {lab for lab, n in self.reads.total.items() if n >= self.spec.min_reads}
-        acc: dict = {}
-        for (label, cell), (n, sx, sy) in self.reads.agg.items():
-            seg = int(labels[cell])
-            if label not in counted or seg == 0:
+        rd = self.reads
+        seg = self.segment_labels().ravel()[rd.cell[: rd.n]]
+        out = {}
+        for s in np.unique(seg[seg > 0]):
+            lists = rd.lists(np.flatnonzero(seg == s), self.spec.min_reads)
+            if lists:
+                out[int(s)] = lists
+        return out
+
+    def segment_door_lists(self, rows: np.ndarray, cols: np.ndarray, min_reads: int | None = None):
+        """Door lists of the segments of the given visited cells, without labelling the map.
+
+        Each segment is flood-filled once (cost: its size), so this is what planners use at
+        re-plan time. Returns (``seg`` (k,) int64 segment index per cell, -1 when the cell is not
+        visited; ``lists``, one ``{label: (count, x, y)}`` per segment index), as
+        :meth:`door_lists`.
+        """
+        min_reads = self.spec.min_reads if min_reads is None else min_reads
+        rd = self.reads
+        read_cells = rd.cell[: rd.n]
+        base = self._seg_gen
+        seg = np.full(len(rows), -1, np.int64)
+        lists = []
+        for i, (r, c) in enumerate(zip(rows, cols)):
+            st = int(self._seg_stamp[r, c])
+            if st > base:
+                seg[i] = st - base - 1
                 continue
-            e = acc.setdefault(seg, {}).setdefault(label, [0, 0.0, 0.0])
-            e[0] += n
-            e[1] += sx
-            e[2] += sy
-        return {seg: {lab: (n, sx / n, sy / n) for lab, (n, sx, sy) in d.items()} for seg, d in acc.items()}
+            if not self.visited[r, c]:
+                continue
+            self._seg_gen += 1
+            segment_flood(self.seg_class, self.visited, int(r), int(c), self._seg_stamp, self._seg_gen, self._queue)
+            seg[i] = len(lists)
+            inside = self._seg_stamp.ravel()[read_cells] == self._seg_gen
+            lists.append(rd.lists(np.flatnonzero(inside), min_reads))
+        return seg, lists
 
     def segment_labels(self) -> np.ndarray:
         """(H, W) int32: visited segments (connected cells of one density class), 0 elsewhere."""

@@ -1,6 +1,6 @@
 """Planners: importing this package registers the built-in ones."""
 
-from . import bvp, greedy  # noqa: F401  (registration side effect)
+from . import bvp, greedy, nsos  # noqa: F401  (registration side effect)
 from .base import PLANNERS, Decision, PlanContext, Planner, Variant, expand_variants, register_planner
 
 __all__ = ["PLANNERS", "Decision", "PlanContext", "Planner", "Variant", "expand_variants", "register_planner"]

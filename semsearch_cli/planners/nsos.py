@@ -1,0 +1,193 @@
+"""NSOS semantic planner (thesis 4.3; paper Section 4; SPEC 4) and the ``geometric`` planner.
+
+For each frontier candidate c (segment S(c), branch direction theta_f(c)):
+
+- growing direction (Eqs. 4.9-4.11): ``phi_g = (zeta * gamma + 1) / 2`` with
+  ``zeta = (n_smaller - n_bigger) / max(n_smaller + n_bigger, w_g)`` over the numbered signs of S
+  (Eq. 4.9 as written: +1 when all signs are smaller than the goal, so the goal lies in the
+  increasing direction) and ``gamma = 1 - 2 |wrap(theta_f - theta_inc)| / pi``, where theta_inc is
+  the direction of the sum of the unit vectors from sign l to sign l' over all pairs l < l'
+  (positions: the mean robot position at the sign's reads); gamma = 0 with fewer than two distinct
+  numbers (or when the vectors cancel);
+- parity (Eq. 4.12): ``phi_p = 0.5 + 0.5 (n_same - n_diff) / max(n_same + n_diff, w_p)``;
+- door orientation (Eq. 4.13): ``phi_o = H_d[theta_f]``, H_d the normalised histogram of the
+  robot's heading modulo 180 degrees at its last ``lambda_d`` sign reads, ``door_bins`` bins
+  centred on 0, 45, 90, 135 degrees (for 4 bins);
+- robot orientation (Eq. 4.14): ``phi_r = H_r[theta_f]``, H_r the normalised histogram of the
+  robot's heading over its last ``lambda_r`` poses, ``robot_bins`` bins over 360 degrees centred
+  on 0, 20, 40, ... degrees (for 18 bins; the seeds do not say where the bins start, so both
+  histograms are centred alike);
+- closeness (paper Eq. 16): ``phi_c = 1 - (1 - D_min / D(c))^4``, D the path length along the
+  skeleton (see :meth:`semsearch_cli.belief.Belief.search`).
+
+``SF = phi_g phi_p`` (Eq. 4.5), ``GF = ((phi_o + phi_r) phi_c + phi_c) / 3`` (Eq. 4.6),
+``phi = alpha SF + (1 - alpha) GF`` (Eq. 4.7); the robot goes to argmax phi (Eq. 4.8). Ties go to
+the nearest candidate, then to the run's generator: at alpha = 1, before any sign counts, every
+candidate scores 0.25, and a random pick at each re-plan would send the robot back and forth. Text labels (e.g. "B12") are ignored by the number-based factors.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from ..geometry import wrap_angle
+from .base import Decision, Planner, register_planner
+
+
+# ---- the five factors, as pure functions ------------------------------------------------------
+def increasing_direction(numbers: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> float | None:
+    """theta_inc (radians): direction of the sum of unit vectors from each sign to every larger
+    one; None with fewer than two distinct numbers or when the vectors cancel."""
+    numbers = np.asarray(numbers)
+    if np.unique(numbers).size < 2:
+        return None
+    i, j = np.nonzero(numbers[:, None] < numbers[None, :])
+    dx, dy = xs[j] - xs[i], ys[j] - ys[i]
+    n = np.hypot(dx, dy)
+    ok = n > 1e-9
+    sx, sy = (dx[ok] / n[ok]).sum(), (dy[ok] / n[ok]).sum()
+    if math.hypot(sx, sy) < 1e-9:
+        return None
+    return math.atan2(sy, sx)
+
+
+def growing_direction(numbers, xs, ys, goal: int, theta_f: float, w_g: float) -> tuple[float, float, float]:
+    """(phi_g, zeta, gamma) of Eqs. 4.9-4.11 for one candidate."""
+    numbers = np.asarray(numbers)
+    smaller = int((numbers < goal).sum())
+    bigger = int((numbers > goal).sum())
+    zeta = (smaller - bigger) / max(smaller + bigger, w_g)
+    th = increasing_direction(numbers, np.asarray(xs, float), np.asarray(ys, float))
+    gamma = 0.0 if th is None else 1.0 - 2.0 * abs(float(wrap_angle(theta_f - th))) / math.pi
+    return (zeta * gamma + 1.0) / 2.0, zeta, gamma
+
+
+def parity(numbers, goal: int, w_p: float) -> float:
+    """phi_p of Eq. 4.12."""
+    numbers = np.asarray(numbers)
+    same = int((numbers % 2 == goal % 2).sum())
+    diff = numbers.size - same
+    return 0.5 + 0.5 * (same - diff) / max(same + diff, w_p)
+
+
+def heading_histogram(headings, bins: int, fold: bool) -> np.ndarray:
+    """Normalised histogram of headings (radians): ``bins`` bins centred on multiples of
+    180/bins degrees over [0, 180) when ``fold`` (headings modulo 180), else of 360/bins over
+    [0, 360). All zeros when there are no headings."""
+    h = np.asarray(headings, float)
+    if h.size == 0:
+        return np.zeros(bins)
+    idx = _bin(h, bins, fold)
+    return np.bincount(idx, minlength=bins) / h.size
+
+
+def histogram_lookup(hist: np.ndarray, theta, fold: bool):
+    """H[theta]: the value of the bin holding ``theta`` (radians)."""
+    return hist[_bin(np.asarray(theta, float), hist.shape[0], fold)]
+
+
+def _bin(theta, bins, fold):
+    span = math.pi if fold else 2.0 * math.pi
+    return np.floor(np.mod(theta, span) / (span / bins) + 0.5).astype(np.int64) % bins
+
+
+def closeness(D: np.ndarray) -> np.ndarray:
+    """phi_c of paper Eq. 16 from skeleton distances D (cells, >= 0); inf D gives 0."""
+    D = np.maximum(np.asarray(D, float), 1.0)
+    return 1.0 - (1.0 - D.min() / D) ** 4
+
+
+# ---- the planner ------------------------------------------------------------------------------
+class NSOSParams(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    alpha: float = Field(0.9, ge=0.0, le=1.0, description="weight of the semantic factor, Eq. 4.7")
+    w_g: float = Field(8.0, gt=0.0, description="signs needed for full growing-direction confidence, Eq. 4.9")
+    w_p: float = Field(8.0, gt=0.0, description="signs needed for full parity confidence, Eq. 4.12")
+    door_bins: int = Field(4, ge=1, description="bins of H_d over 180 degrees")
+    robot_bins: int = Field(18, ge=1, description="bins of H_r over 360 degrees")
+    lambda_d: int = Field(6000, ge=1, description="sign reads kept for H_d")
+    lambda_r: int = Field(600000, ge=1, description="poses kept for H_r")
+    min_reads: int | None = Field(None, ge=1, description="reads before a sign counts (default: belief.min_reads)")
+
+
+@register_planner("nsos")
+class NSOS(Planner):
+    Params = NSOSParams
+    replan_on_signs = True
+    use_semantics = True
+
+    def choose(self, ctx, cands):
+        k = len(cands)
+        if k == 0:
+            return None
+        p, b = self.params, ctx.belief
+        alpha = p.alpha if self.use_semantics else 0.0
+        gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, k)
+        D = gs.lengths(cands.rows, cands.cols)
+        reach = np.isfinite(D)
+        if not reach.any():
+            return None
+        phi_c = np.zeros(k)
+        phi_c[reach] = closeness(D[reach])
+        h_d = heading_histogram(b.reads.headings[-p.lambda_d :], p.door_bins, fold=True)
+        h_r = heading_histogram(ctx.headings[-p.lambda_r :], p.robot_bins, fold=False)
+        phi_o = histogram_lookup(h_d, cands.theta, fold=True)
+        phi_r = histogram_lookup(h_r, cands.theta, fold=False)
+        GF = ((phi_o + phi_r) * phi_c + phi_c) / 3.0
+        phi_g = np.full(k, 0.5)
+        phi_p = np.full(k, 0.5)
+        zeta = np.zeros(k)
+        gamma = np.zeros(k)
+        seg = np.full(k, -1)
+        goal = ctx.goal if isinstance(ctx.goal, (int, np.integer)) else None
+        if alpha > 0 and goal is not None:
+            seg, lists = b.segment_door_lists(cands.seg_rows, cands.seg_cols, p.min_reads)
+            numeric = []
+            for lst in lists:
+                items = [(lab, x, y) for lab, (_, x, y) in lst.items() if isinstance(lab, (int, np.integer))]
+                numeric.append((np.array([i[0] for i in items], np.int64), np.array([i[1] for i in items]), np.array([i[2] for i in items])))
+            for i in range(k):
+                if seg[i] < 0:
+                    continue
+                nums, xs, ys = numeric[seg[i]]
+                phi_g[i], zeta[i], gamma[i] = growing_direction(nums, xs, ys, goal, cands.theta[i], p.w_g)
+                phi_p[i] = parity(nums, goal, p.w_p)
+        SF = phi_g * phi_p
+        phi = alpha * SF + (1.0 - alpha) * GF
+        phi[~reach] = -np.inf
+        best = np.flatnonzero(phi >= phi.max() - 1e-12)
+        if best.size > 1:  # ties (common at alpha = 1 before any sign counts): nearest, then random
+            best = best[D[best] <= D[best].min() + 1e-9]
+        j = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+        info = {"chosen": j, "candidates": [
+            {"x": round(float(x), 2), "y": round(float(y), 2), "theta_f_deg": round(float(np.degrees(t)), 1),
+             "segment": int(seg[i]), "D_m": round(float(D[i]) * b.frame.res, 2) if reach[i] else None,
+             "phi_g": round(float(phi_g[i]), 4), "zeta": round(float(zeta[i]), 4), "gamma": round(float(gamma[i]), 4),
+             "phi_p": round(float(phi_p[i]), 4), "phi_o": round(float(phi_o[i]), 4), "phi_r": round(float(phi_r[i]), 4),
+             "phi_c": round(float(phi_c[i]), 4), "SF": round(float(SF[i]), 4), "GF": round(float(GF[i]), 4),
+             "phi": round(float(phi[i]), 4) if reach[i] else None}
+            for i, (x, y, t) in enumerate(zip(*b.frame.to_world(cands.rows, cands.cols), cands.theta))]}
+        return Decision(int(cands.rows[j]), int(cands.cols[j]), info)
+
+
+class GeometricParams(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    door_bins: int = Field(4, ge=1)
+    robot_bins: int = Field(18, ge=1)
+    lambda_d: int = Field(6000, ge=1)
+    lambda_r: int = Field(600000, ge=1)
+
+
+@register_planner("geometric")
+class Geometric(NSOS):
+    """Eq. 4.6 alone: NSOS with alpha = 0, keeping the two orientation factors."""
+
+    Params = GeometricParams
+    replan_on_signs = False
+    use_semantics = False
+
+    def __init__(self, params):
+        super().__init__(NSOSParams(alpha=0.0, **params.model_dump()))
