@@ -33,9 +33,16 @@ def default_workers() -> int:
 
 
 def run(scenario: str | Path, seeds: int | None = None, workers: int | None = None, goals=None,
-        planners=None, out: str | Path | None = None, progress=None, plots: bool = True) -> RunOutput:
-    """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/."""
+        planners=None, out: str | Path | None = None, progress=None, plots: bool = True,
+        trace: bool = False, planner_specs=None) -> RunOutput:
+    """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/.
+
+    ``planner_specs`` (a list of :class:`~semsearch_cli.config.PlannerSpec`) replaces the
+    scenario's planners; ``trace`` writes each run's decisions to traces/<run>.jsonl.
+    """
     loaded = Loaded.load(Path(scenario))
+    if planner_specs is not None:
+        loaded.sc = loaded.sc.model_copy(update={"planners": planner_specs})
     if goals:
         known = {str(g) for g in loaded.sc.goals}
         for g in goals:
@@ -45,13 +52,32 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
     out_dir = default_out(loaded, out)
-    runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress)
+    runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress, trace)
     wanted = {s.key for s in specs}
     mine = runs[[(str(p), str(g), int(s)) in wanted for p, g, s in zip(runs["planner"], runs["goal"], runs["seed"])]]
     summary = write_summary(runs, out_dir)
     if plots:
         write_path_plots(loaded, mine, out_dir)
     return RunOutput(out_dir, runs, summary)
+
+
+def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
+                goals=None, out: str | Path | None = None, progress=None, trace: bool = False) -> RunOutput:
+    """nsos at each alpha with greedy beside it: the rows and summary of :func:`run`, plus
+    ``plots/alpha_sweep.png``. Other nsos parameters come from the scenario's first nsos entry."""
+    from .config import PlannerSpec, load_scenario
+
+    sc = load_scenario(scenario)
+    base = next((p.params() for p in sc.planners if p.name == "nsos"), {})
+    base.pop("alpha", None)
+    specs = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[float(a) for a in alphas], **base)]
+    res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs)
+    from .planners import expand_variants
+    from .report.plots import plot_alpha_sweep
+
+    labels = {v.label for v in expand_variants(specs, str(scenario))}
+    plot_alpha_sweep(res.runs[res.runs["planner"].isin(labels)], res.out / "plots" / "alpha_sweep.png")
+    return res
 
 
 def write_summary(runs: pd.DataFrame, out_dir: Path) -> pd.DataFrame:

@@ -8,6 +8,7 @@ from typing import List, Optional
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
@@ -42,11 +43,41 @@ def run(
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate)."),
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
     out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
+    trace: bool = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl."),
 ):
     """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
     from . import api
 
+    _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick, trace=trace))
+
+
+@app.command("sweep-alpha")
+def sweep_alpha(
+    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    alphas: str = typer.Option("0,0.5,0.8,0.9,1.0", "--alphas", help="Comma-separated alpha values for nsos."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and variant (default: the scenario's)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
+    goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
+    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
+    trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
+):
+    """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
+    plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
+    from . import api
+
+    try:
+        values = [float(a) for a in alphas.split(",") if a.strip()]
+    except ValueError:
+        _fail(ScenarioError("<command line>", "--alphas", f"expected comma-separated numbers, got {alphas!r}"))
+    if not values or any(not 0.0 <= a <= 1.0 for a in values):
+        _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
+    res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal), out_dir, progress=tick, trace=trace))
+    out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
+
+
+def _batch(call):
+    """Run a batch with a progress bar, print its summary; bad input exits with status 2."""
     try:
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       TimeRemainingColumn(), console=err, transient=False, disable=not err.is_terminal) as prog:
@@ -59,11 +90,12 @@ def run(
                 prog.advance(task)
                 prog.update(task, description=f"{row['planner']} goal {row['goal']} seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m")
 
-            res = api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick)
+            res = call(tick)
     except ScenarioError as exc:
         _fail(exc)
     _print_summary(res.summary)
     out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  plots: {res.out / 'plots'}")
+    return res
 
 
 def _print_summary(summary):
@@ -71,7 +103,7 @@ def _print_summary(summary):
     for col in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]:
         t.add_column(col, justify="right" if col not in ("planner",) else "left")
     for _, r in summary.iterrows():
-        t.add_row(*[str(r[c]) for c in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]])
+        t.add_row(*[escape(str(r[c])) for c in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]])
     out.print(t)
 
 

@@ -116,9 +116,10 @@ class Episode:
                         break
                     decisions += 1
                     if self.keep_trace:
-                        trace.append({"step": steps, "distance_m": round(distance, 3), "x": round(x, 3), "y": round(y, 3),
-                                      "heading_deg": round(float(np.degrees(heading)), 1), "target": fr.to_world(dec.row, dec.col),
-                                      "candidates": len(cands), **dec.info})
+                        tx, ty = fr.to_world(dec.row, dec.col)
+                        trace.append({"step": steps, "distance_m": round(distance, 3), "x": round(float(x), 3), "y": round(float(y), 3),
+                                      "heading_deg": round(float(np.degrees(heading)), 1),
+                                      "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(cands), **dec.info})
                     p = navigator.plan(belief, r, c, dec.row, dec.col)
                     if p is not None and len(p[0]) >= 2:
                         path_r, path_c = p

@@ -9,6 +9,7 @@ seed (:func:`semsearch_cli.episode.run_seed`).
 from __future__ import annotations
 
 import csv
+import json
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -77,18 +78,29 @@ def execute(loaded: Loaded, spec: RunSpec, trace: bool = False):
     return row, res
 
 
-def _worker_run(spec: RunSpec, paths_dir: str):
-    row, res = execute(_CACHE["loaded"], spec)
-    _save_path(Path(paths_dir), spec, res)
+def _worker_run(spec: RunSpec, out: str, trace: bool):
+    row, res = execute(_CACHE["loaded"], spec, trace)
+    save_run_files(Path(out), spec, res)
     return row
 
 
-def _save_path(paths_dir: Path, spec: RunSpec, res) -> None:
-    paths_dir.mkdir(parents=True, exist_ok=True)
-    tmp = paths_dir / f".{spec.stem}.tmp.npz"
+def save_run_files(out: Path, spec: RunSpec, res) -> None:
+    """``paths/<stem>.npz`` (path, signs read) and, for traced runs, ``traces/<stem>.jsonl``
+    (one JSON object per decision); each written atomically."""
+    paths = out / "paths"
+    paths.mkdir(parents=True, exist_ok=True)
+    tmp = paths / f".{spec.stem}.tmp.npz"
     with open(tmp, "wb") as fh:
         np.savez_compressed(fh, path=res.path, read_signs=np.asarray(res.read_signs, np.int64))
-    os.replace(tmp, paths_dir / f"{spec.stem}.npz")
+    os.replace(tmp, paths / f"{spec.stem}.npz")
+    if res.trace:
+        traces = out / "traces"
+        traces.mkdir(parents=True, exist_ok=True)
+        tmp = traces / f".{spec.stem}.tmp.jsonl"
+        with open(tmp, "w") as fh:
+            for d in res.trace:
+                fh.write(json.dumps(d) + "\n")
+        os.replace(tmp, traces / f"{spec.stem}.jsonl")
 
 
 def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> list[RunSpec]:
@@ -137,25 +149,25 @@ class RowWriter:
 
 
 def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
-              progress: Callable[[dict], None] | None = None) -> pd.DataFrame:
-    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards."""
+              progress: Callable[[dict], None] | None = None, trace: bool = False) -> pd.DataFrame:
+    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
+    With ``trace``, each run it runs also writes its decision trace to ``out/traces/``."""
     runs_csv = out / "runs.csv"
     done = read_runs(runs_csv)
     have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
     todo = [s for s in specs if s.key not in have]
     writer = RowWriter(runs_csv)
-    paths_dir = out / "paths"
     try:
         if workers <= 1 or len(todo) <= 1:
             for spec in todo:
-                row, res = execute(loaded, spec)
-                _save_path(paths_dir, spec, res)
+                row, res = execute(loaded, spec, trace)
+                save_run_files(out, spec, res)
                 writer.write(row)
                 if progress:
                     progress(row)
         else:
             with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(str(loaded.path),)) as pool:
-                futs = [pool.submit(_worker_run, spec, str(paths_dir)) for spec in todo]
+                futs = [pool.submit(_worker_run, spec, str(out), trace) for spec in todo]
                 try:
                     for f in as_completed(futs):
                         row = f.result()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -36,6 +37,34 @@ def plot_path(world, path: np.ndarray, read_signs, goal, title: str, out: Path) 
     ax.set_ylabel("y (m)")
     ax.set_title(title)
     ax.legend(loc="upper right", fontsize=7, framealpha=0.8)
+    fig.tight_layout()
+    tmp = out.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, out)
+
+
+def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy") -> None:
+    """Mean ratio to the shortest path (+- std across seeds) against alpha, one panel per goal;
+    the baseline planner (greedy) as a dashed line with its spread shaded."""
+    nsos = runs[runs["planner"].str.startswith("nsos")].copy()
+    nsos["alpha"] = nsos["params"].map(lambda p: json.loads(p).get("alpha", 0.9))
+    goals = sorted(runs["goal"].unique(), key=str)
+    fig, axes = plt.subplots(1, len(goals), figsize=(4.2 * len(goals), 3.6), squeeze=False, sharey=False)
+    for ax, g in zip(axes[0], goals):
+        d = nsos[nsos["goal"] == g].groupby("alpha")["ratio"].agg(["mean", "std", "count"]).reset_index()
+        ax.errorbar(d["alpha"], d["mean"], yerr=d["std"].fillna(0), fmt="o-", capsize=3, c="tab:blue", label="nsos")
+        base = runs[(runs["planner"] == baseline) & (runs["goal"] == g)]["ratio"]
+        if len(base):
+            m, s = base.mean(), (base.std() if len(base) > 1 else 0.0)
+            ax.axhline(m, ls="--", c="tab:orange", label=baseline)
+            ax.axhspan(m - s, m + s, color="tab:orange", alpha=0.15)
+        ax.axhline(1.0, c="gray", lw=0.8)
+        ax.set_title(f"goal {g}")
+        ax.set_xlabel("alpha (weight of the semantic factor)")
+        ax.set_ylabel("distance / shortest path")
+        ax.legend(fontsize=7)
+    fig.suptitle("alpha sweep: mean ratio to the shortest path, +- std over seeds")
     fig.tight_layout()
     tmp = out.with_suffix(".tmp.png")
     fig.savefig(tmp, dpi=110)

@@ -1,0 +1,119 @@
+"""NSOS factors against values computed by hand (thesis 4.3, paper Eq. 16, SPEC 4)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from semsearch_cli.cli import app
+from semsearch_cli.planners.nsos import (
+    closeness,
+    growing_direction,
+    heading_histogram,
+    histogram_lookup,
+    increasing_direction,
+    parity,
+)
+
+D2R = math.pi / 180
+
+
+def test_signs_all_smaller_favour_the_increasing_direction():
+    nums, xs, ys = np.array([1, 2, 3]), np.array([0.0, 2.0, 4.0]), np.zeros(3)  # increasing toward +x
+    phi, zeta, gamma = growing_direction(nums, xs, ys, goal=10, theta_f=0.0, w_g=8)
+    assert zeta == 3 / 8  # w_g caps the confidence while fewer than 8 signs are known
+    assert gamma == 1.0
+    assert phi == (3 / 8 + 1) / 2
+    phi_back, _, gamma_back = growing_direction(nums, xs, ys, goal=10, theta_f=math.pi, w_g=8)
+    assert gamma_back == -1.0 and phi_back == (1 - 3 / 8) / 2
+    # with enough signs the confidence is full: zeta = 1
+    nums9 = np.arange(1, 10)
+    phi9, zeta9, _ = growing_direction(nums9, nums9 * 2.0, np.zeros(9), goal=50, theta_f=0.0, w_g=8)
+    assert zeta9 == 1.0 and phi9 == 1.0
+    # all bigger: the goal lies the other way
+    phi_big, zeta_big, _ = growing_direction(nums, xs, ys, goal=0, theta_f=math.pi, w_g=2)
+    assert zeta_big == -1.0 and phi_big == 1.0
+
+
+def test_gamma_is_minus_one_across_the_pi_seam():
+    # signs 5 -> 7 increase toward 179 degrees
+    xs, ys = np.array([0.0, math.cos(179 * D2R)]), np.array([0.0, math.sin(179 * D2R)])
+    assert increasing_direction(np.array([5, 7]), xs, ys) == pytest.approx(179 * D2R)
+    # a candidate pointing at -1 degrees is opposite (the difference wraps to 180 degrees)
+    _, _, gamma = growing_direction(np.array([5, 7]), xs, ys, goal=9, theta_f=-1 * D2R, w_g=8)
+    assert gamma == pytest.approx(-1.0)
+    # one pointing at -179 degrees is 2 degrees away, across the seam
+    _, _, gamma_same = growing_direction(np.array([5, 7]), xs, ys, goal=9, theta_f=-179 * D2R, w_g=8)
+    assert gamma_same == pytest.approx(1.0 - 2 * 2 / 180)
+
+
+def test_fewer_than_two_numbers_gives_one_half():
+    assert growing_direction(np.array([4]), np.array([0.0]), np.array([0.0]), 9, 0.3, 8)[0] == 0.5
+    assert growing_direction(np.array([4, 4]), np.array([0.0, 1.0]), np.zeros(2), 9, 0.3, 8)[0] == 0.5
+    assert growing_direction(np.array([], np.int64), np.array([]), np.array([]), 9, 0.3, 8)[0] == 0.5
+
+
+def test_unit_vectors_per_pair():
+    # 1 -> 2 points +x (length 10), 1 -> 3 and 2 -> 3 point +y (short): unit vectors, not lengths
+    xs, ys = np.array([0.0, 10.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    th = increasing_direction(np.array([1, 2, 3]), xs, ys)
+    v = np.array([1.0, 0.0]) + np.array([0.0, 1.0]) + np.array([-10.0, 1.0]) / math.hypot(10, 1)
+    assert th == pytest.approx(math.atan2(v[1], v[0]))
+
+
+def test_parity():
+    assert parity(np.array([1, 2]), 4, 8) == 0.5  # mixed parity
+    assert parity(np.array([2, 4, 6]), 8, 8) == 0.5 + 0.5 * 3 / 8  # capped by w_p
+    assert parity(np.array([1, 3, 5, 7, 9, 11, 13, 15]), 8, 8) == 0.0
+    assert parity(np.array([], np.int64), 8, 8) == 0.5
+
+
+def test_door_histogram_folds_modulo_180():
+    h = heading_histogram(np.radians([0.0, 180.0, 90.0, -90.0, 44.0, 46.0]), 4, fold=True)
+    # bins centred on 0, 45, 90, 135: {0, 180} -> 0; {90, -90} -> 90; 44, 46 -> 45
+    assert h.tolist() == [2 / 6, 2 / 6, 2 / 6, 0.0]
+    assert histogram_lookup(h, math.pi, fold=True) == 2 / 6  # theta_f = 180 reads bin 0
+    assert histogram_lookup(h, -3 * math.pi / 4, fold=True) == 2 / 6  # -135 = 45 mod 180
+    assert heading_histogram([], 4, fold=True).tolist() == [0.0] * 4
+
+
+def test_robot_histogram_keeps_direction():
+    h = heading_histogram(np.radians([0.0, 0.0, 0.0, 180.0]), 18, fold=False)
+    assert h[0] == 0.75 and h[9] == 0.25 and h.sum() == pytest.approx(1.0)
+    assert histogram_lookup(h, math.radians(9.0), fold=False) == 0.75  # bin centred on 0 spans +-10
+    assert histogram_lookup(h, math.radians(-170.0), fold=False) == 0.0  # 190 -> bin 10 (200)
+    assert histogram_lookup(h, math.radians(-171.0), fold=False) == 0.25
+
+
+def test_closeness_eq16():
+    phi = closeness(np.array([10.0, 20.0, 40.0]))
+    assert phi.tolist() == [1.0, 1 - 0.5**4, 1 - 0.75**4]
+
+
+def test_trace_and_sweep_alpha(demo_dir, tmp_path):
+    out = tmp_path / "sweep"
+    res = CliRunner().invoke(app, ["sweep-alpha", str(demo_dir / "scenario.yaml"), "--alphas", "0.8,1.0", "--seeds", "1",
+                                   "--goal", "452", "--workers", "1", "--out", str(out), "--trace"])
+    assert res.exit_code == 0, res.output
+    import pandas as pd
+
+    runs = pd.read_csv(out / "runs.csv")
+    assert sorted(runs["planner"]) == ["greedy", "nsos[alpha=0.8]", "nsos[alpha=1.0]"]
+    assert (out / "plots" / "alpha_sweep.png").is_file()
+    lines = (out / "traces" / "nsos_alpha0.8__goal452__seed0.jsonl").read_text().splitlines()
+    assert len(lines) == runs[runs.planner == "nsos[alpha=0.8]"]["decisions"].iloc[0]
+    d = json.loads(lines[-1])
+    for key in ("step", "x", "y", "heading_deg", "chosen", "candidates"):
+        assert key in d
+    c = d["candidates"][d["chosen"]]
+    for key in ("phi_g", "phi_p", "phi_o", "phi_r", "phi_c", "SF", "GF", "phi"):
+        assert 0.0 <= c[key] <= 1.0
+    assert c["phi"] == max(x["phi"] for x in d["candidates"] if x["phi"] is not None)
+    assert c["phi"] == pytest.approx(0.8 * c["SF"] + 0.2 * c["GF"], abs=2e-4)
+
+
+def test_bad_alphas(demo_dir):
+    res = CliRunner().invoke(app, ["sweep-alpha", str(demo_dir / "scenario.yaml"), "--alphas", "0.5,2"])
+    assert res.exit_code == 2 and "--alphas" in res.output
