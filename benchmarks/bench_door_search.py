@@ -1,14 +1,15 @@
 """Door-search benchmark on the authors' Hotel map (read from ../shared, never copied).
 
 Measures (medians of repeated runs, with ratios against baselines timed in the same process):
-  1. one greedy run, Hotel goal 148, seed 0: wall time and seconds per 300 m travelled; the
-     baseline is the sensing-only loop (laser + HIMM + door cameras + visited kernel) over the
-     same poses, i.e. the floor any planner pays;
-  2. the whole Hotel table (4 goals x greedy and bvp x 10 seeds) with 2 workers;
+  1. one run each of greedy and nsos (alpha 0.9), Hotel goal 148, seed 0: wall time and seconds
+     per 300 m travelled; the baseline is the sensing-only loop (laser + HIMM + door cameras +
+     visited kernel) over the same poses, i.e. the floor any planner pays;
+  2. whole Hotel tables with 2 workers: 4 goals x greedy and bvp x 10 seeds, and 4 goals x
+     greedy and nsos at alpha 0.8, 0.9, 1.0 x 10 seeds;
   3. navigators: path lengths of the geodesic and the harmonic navigator between random pairs of
      cells on the fully known Hotel map, and greedy runs with either navigator.
 
-Usage: python benchmarks/bench_door_search.py [--repeat 5] [--skip-table] [--out FILE.md]
+Usage: python benchmarks/bench_door_search.py [--repeat 5] [--tables bvp,nsos] [--out FILE.md]
 """
 
 from __future__ import annotations
@@ -88,7 +89,7 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--pairs", type=int, default=40)
-    ap.add_argument("--skip-table", action="store_true")
+    ap.add_argument("--tables", default="bvp,nsos", help="which whole tables to time: bvp, nsos, both or none")
     ap.add_argument("--out", type=Path)
     a = ap.parse_args()
     if not REF.is_dir():
@@ -105,19 +106,20 @@ def main() -> int:
     L = Loaded.load(p)
     say(f"# semsearch door-search benchmark ({time.strftime('%Y-%m-%d %H:%M')}, {sys.platform}, python {sys.version.split()[0]})")
     say()
-    # 1. one greedy run
-    Episode(L.world, L.sc, Variant("greedy", ()), 148, 0).run()  # warm-up (numba cache, imports)
-    walls, base = [], []
-    for _ in range(a.repeat):
-        res = Episode(L.world, L.sc, Variant("greedy", ()), 148, 0).run()
-        walls.append(res.wall_s)
-        base.append(sensing_only(L, res.path.astype(float)))
-    med, bmed = statistics.median(walls), statistics.median(base)
-    say(f"## 1. greedy, Hotel goal 148, seed 0 ({a.repeat} repeats)")
-    say(f"distance {res.distance_m:.1f} m, {res.steps} steps, {res.decisions} decisions, outcome {res.outcome}")
-    say(f"median wall {med:.3f} s (min {min(walls):.3f}, max {max(walls):.3f}) = {med / res.distance_m * 300:.2f} s per 300 m (target <= 1.5)")
-    say(f"sensing-only baseline over the same poses: median {bmed:.3f} s; run / baseline = {med / bmed:.2f}")
-    say()
+    # 1. one run per planner
+    for variant in (Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),))):
+        Episode(L.world, L.sc, variant, 148, 0).run()  # warm-up (numba cache, imports)
+        walls, base = [], []
+        for _ in range(a.repeat):
+            res = Episode(L.world, L.sc, variant, 148, 0).run()
+            walls.append(res.wall_s)
+            base.append(sensing_only(L, res.path.astype(float)))
+        med, bmed = statistics.median(walls), statistics.median(base)
+        say(f"## 1. {variant.label}, Hotel goal 148, seed 0 ({a.repeat} repeats)")
+        say(f"distance {res.distance_m:.1f} m, {res.steps} steps, {res.decisions} decisions, outcome {res.outcome}")
+        say(f"median wall {med:.3f} s (min {min(walls):.3f}, max {max(walls):.3f}) = {med / res.distance_m * 300:.2f} s per 300 m (target <= 1.5)")
+        say(f"sensing-only baseline over the same poses: median {bmed:.3f} s; run / baseline = {med / bmed:.2f}")
+        say()
     # 2. navigators
     b = known_belief(L)
     rng = np.random.default_rng(7)
@@ -155,15 +157,23 @@ def main() -> int:
     say("greedy runs, goal 148, seeds 0-2: geodesic " + ", ".join(f"{d:.1f}" for d in dg)
         + " m; harmonic " + ", ".join(f"{d:.1f}" for d in dh) + " m")
     say()
-    # 3. the whole table
-    if not a.skip_table:
+    # 3. whole tables
+    from semsearch_cli.config import PlannerSpec
+
+    tables = {"bvp": [PlannerSpec(name="greedy"), PlannerSpec(name="bvp")],
+              "nsos": [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[0.8, 0.9, 1.0])]}
+    for key in [t for t in a.tables.split(",") if t in tables]:
+        L.sc = L.sc.model_copy(update={"planners": tables[key]})
         specs = expand(L, 10)
         t0 = time.perf_counter()
-        runs = run_batch(L, specs, tmp / "table", workers=2)
+        runs = run_batch(L, specs, tmp / f"table-{key}", workers=2)
         wall = time.perf_counter() - t0
-        say(f"## 3. whole Hotel table: 4 goals x greedy, bvp x 10 seeds = {len(specs)} runs, 2 workers")
-        say(f"wall {wall:.1f} s; sum of run times {runs['wall_s'].sum():.1f} s; travelled {runs['distance_m'].sum() / 1000:.1f} km")
+        labels = sorted(runs["planner"].unique())
+        say(f"## 3. whole Hotel table: 4 goals x {', '.join(labels)} x 10 seeds = {len(specs)} runs, 2 workers")
+        say(f"wall {wall:.1f} s; sum of run times {runs['wall_s'].sum():.1f} s; travelled {runs['distance_m'].sum() / 1000:.1f} km; "
+            f"{runs['wall_s'].sum() / runs['distance_m'].sum() * 300:.2f} s per 300 m over all runs")
         say(runs.groupby("planner")["wall_s"].describe().round(2).to_string())
+        say()
     if a.out:
         a.out.write_text("\n".join(lines) + "\n")
     return 0
