@@ -114,8 +114,9 @@ class Episode:
                     dec = planner.choose(ctx, cands)
                     if dec is None:
                         break
-                    decisions += 1
-                    if self.keep_trace:
+                    kept = dec.info.get("kept", False)
+                    decisions += not kept
+                    if self.keep_trace and not kept:
                         tx, ty = fr.to_world(dec.row, dec.col)
                         trace.append({"step": steps, "distance_m": round(distance, 3), "x": round(float(x), 3), "y": round(float(y), 3),
                                       "heading_deg": round(float(np.degrees(heading)), 1),

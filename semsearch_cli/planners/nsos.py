@@ -115,14 +115,38 @@ class NSOSParams(BaseModel):
 
 @register_planner("nsos")
 class NSOS(Planner):
+    """The semantic planner. It keeps its last choice while only the robot's own position has
+    changed since it was made (the chosen candidate is still there, no new candidate appeared and
+    no sign reached ``min_reads``): closeness is relative to the nearest candidate, so otherwise a
+    robot travelling toward a far candidate past a near, unpromising one sees every other
+    candidate's closeness shrink, turns back, and repeats for ever (seen on Inverse goal 124)."""
+
     Params = NSOSParams
     replan_on_signs = True
     use_semantics = True
+
+    def __init__(self, params):
+        super().__init__(params)
+        self._last = None  # (target cell, candidate cells, counted signs) of the last decision
 
     def choose(self, ctx, cands):
         k = len(cands)
         if k == 0:
             return None
+        b = ctx.belief
+        cells = set(zip(cands.rows.tolist(), cands.cols.tolist()))
+        min_reads = self.params.min_reads or b.spec.min_reads
+        counted = sum(1 for n in b.reads.total.values() if n >= min_reads)
+        if self._last is not None:
+            target, old_cells, old_counted = self._last
+            if target in cells and cells <= old_cells and counted == old_counted:
+                return Decision(target[0], target[1], {"kept": True})
+        d = self._decide(ctx, cands)
+        self._last = None if d is None else ((d.row, d.col), cells, counted)
+        return d
+
+    def _decide(self, ctx, cands):
+        k = len(cands)
         p, b = self.params, ctx.belief
         alpha = p.alpha if self.use_semantics else 0.0
         gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, k)
