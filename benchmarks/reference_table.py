@@ -3,7 +3,7 @@ into the repository) and print, per goal and planner, mean +- std and the ratio 
 path beside the thesis' Tables 4.2-4.4 and 4.6-4.8.
 
 Usage: python benchmarks/reference_table.py [--seeds 10] [--workers 2] [--planners greedy,nsos]
-           [--alphas 0.8,0.9,1.0] [--out results/reference] [--md FILE]
+           [--alphas 0.8,0.9,1.0] [--heading random|DEG] [--out results/reference] [--md FILE]
 Rows go to OUT/<map>/runs.csv (resumable), like `semsearch run`.
 """
 
@@ -24,6 +24,7 @@ from semsearch_cli.experiment import Loaded, expand, run_batch  # noqa: E402
 from semsearch_cli.planners import expand_variants  # noqa: E402
 from semsearch_cli.report.tables import summarise  # noqa: E402
 from semsearch_cli.world.mobilesim import import_mobilesim  # noqa: E402
+from semsearch_cli.world.scenario import build_world  # noqa: E402
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 
@@ -44,6 +45,7 @@ def main() -> int:
     ap.add_argument("--alphas", default="0.8,0.9,1.0")
     ap.add_argument("--out", type=Path, default=Path("results/reference"))
     ap.add_argument("--md", type=Path)
+    ap.add_argument("--heading", default="random", help="start heading in degrees, or random (the importer's default)")
     a = ap.parse_args()
     if not REF.is_dir():
         print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
@@ -58,7 +60,9 @@ def main() -> int:
         goals = list(GREEDY[name])
         p = import_mobilesim(REF / f"{stem}.map", REF / f"{stem}.doors", tmp / stem, 0.1, start, goals, delta, f"{name.lower()}-reference")
         L = Loaded.load(p)
-        L.sc = L.sc.model_copy(update={"planners": specs})
+        start = L.sc.start.model_copy(update={"heading": a.heading if a.heading == "random" else float(a.heading)})
+        L.sc = L.sc.model_copy(update={"planners": specs, "start": start})
+        L.world = build_world(L.sc, p.parent, str(p))
         todo = expand(L, a.seeds)
         t0 = time.perf_counter()
         runs = run_batch(L, todo, a.out / name.lower(), a.workers)

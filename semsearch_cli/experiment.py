@@ -64,11 +64,11 @@ class Loaded:
         return cls(path, sc, world, shortest)
 
 
-_CACHE: dict = {}
+_CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process once
 
 
-def _worker_init(path: str) -> None:
-    _CACHE["loaded"] = Loaded.load(Path(path))
+def _worker_init(loaded: Loaded) -> None:
+    _CACHE["loaded"] = loaded
 
 
 def execute(loaded: Loaded, spec: RunSpec, trace: bool = False):
@@ -166,7 +166,7 @@ def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
                 if progress:
                     progress(row)
         else:
-            with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(str(loaded.path),)) as pool:
+            with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(loaded,)) as pool:
                 futs = [pool.submit(_worker_run, spec, str(out), trace) for spec in todo]
                 try:
                     for f in as_completed(futs):
