@@ -117,3 +117,53 @@ def test_trace_and_sweep_alpha(demo_dir, tmp_path):
 def test_bad_alphas(demo_dir):
     res = CliRunner().invoke(app, ["sweep-alpha", str(demo_dir / "scenario.yaml"), "--alphas", "0.5,2"])
     assert res.exit_code == 2 and "--alphas" in res.output
+
+
+def _junction_context(goal=7):
+    from semsearch_cli.planners import PlanContext
+
+    from .test_belief import make_belief
+
+    free = np.zeros((61, 121), bool)
+    free[28:33, 2:119] = True  # a long east-west corridor
+    free[2:59, 28:33] = True  # crossed by a north-south one
+    b = make_belief(free)
+    W = free.shape[1]
+    b.visit(30, 30)
+    b.visit(30, 45)  # the robot went east and came back to the junction
+    # signs 1, 3, 5 read in the east arm, rising eastward: the goal 7 lies further east
+    for k, lab in enumerate((1, 3, 5)):
+        for _ in range(3):
+            b.reads.add(lab, 30 * W + 40 + 4 * k, (40 + 4 * k) * 0.1, 3.0, 0.0)
+    cands = b.candidates()
+    ctx = PlanContext(b, 30, 30, 3.05, 3.05, 0.0, goal, np.random.default_rng(0), [0.0] * 10)
+    return b, cands, ctx
+
+
+def test_nsos_on_a_junction_follows_the_signs_and_keeps_its_choice():
+    from semsearch_cli.planners import Variant
+
+    b, cands, ctx = _junction_context()
+    planner = Variant("nsos", (("alpha", 1.0),)).build()
+    d = planner.choose(ctx, cands)
+    chosen = d.info["candidates"][d.info["chosen"]]
+    assert chosen["theta_f_deg"] == 0.0  # east, where the numbers rise toward 7
+    assert chosen["zeta"] == 3 / 8 and chosen["gamma"] == 1.0 and chosen["phi_p"] == 0.5 + 0.5 * 3 / 8
+    # the robot moves; nothing else changes: the choice is kept without re-deciding
+    ctx.row, ctx.col = 30, 31
+    again = planner.choose(ctx, cands)
+    assert (again.row, again.col) == (d.row, d.col) and again.info == {"kept": True}
+    # a sign reaching min_reads is new information: decide again
+    for _ in range(3):
+        b.reads.add(9, 30 * b.free.shape[1] + 50, 5.0, 3.0, 0.0)
+    assert "kept" not in planner.choose(ctx, cands).info
+
+
+def test_geometric_is_eq_4_6_alone():
+    from semsearch_cli.planners import Variant
+
+    _, cands, ctx = _junction_context()
+    d = Variant("geometric", ()).build().choose(ctx, cands)
+    for c in d.info["candidates"]:
+        assert c["phi"] == pytest.approx(c["GF"], abs=1e-4)
+        assert c["GF"] == pytest.approx(((c["phi_o"] + c["phi_r"]) * c["phi_c"] + c["phi_c"]) / 3, abs=2e-4)
