@@ -140,7 +140,7 @@ def _junction_context(goal=7):
     return b, cands, ctx
 
 
-def test_nsos_on_a_junction_follows_the_signs_and_keeps_its_choice():
+def test_nsos_on_a_junction_follows_the_signs():
     from semsearch_cli.planners import Variant
 
     b, cands, ctx = _junction_context()
@@ -149,14 +149,30 @@ def test_nsos_on_a_junction_follows_the_signs_and_keeps_its_choice():
     chosen = d.info["candidates"][d.info["chosen"]]
     assert chosen["theta_f_deg"] == 0.0  # east, where the numbers rise toward 7
     assert chosen["zeta"] == 3 / 8 and chosen["gamma"] == 1.0 and chosen["phi_p"] == 0.5 + 0.5 * 3 / 8
-    # the robot moves; nothing else changes: the choice is kept without re-deciding
+    # the robot moves a cell; the same target is chosen again
     ctx.row, ctx.col = 30, 31
     again = planner.choose(ctx, cands)
-    assert (again.row, again.col) == (d.row, d.col) and again.info == {"kept": True}
-    # a sign reaching min_reads is new information: decide again
+    assert (again.row, again.col) == (d.row, d.col)
+
+
+def test_hysteresis_keeps_a_near_best_target_until_signs_change():
+    from semsearch_cli.planners import Variant
+
+    b, cands, ctx = _junction_context()
+    north = int(np.flatnonzero(np.degrees(cands.theta).round() == 90)[0])
+    east = int(np.flatnonzero(np.degrees(cands.theta).round() == 0)[0])
+    wide = Variant("nsos", (("alpha", 1.0), ("hysteresis", 0.2))).build()
+    wide._last = ((int(cands.rows[north]), int(cands.cols[north])), 3)  # last choice: north, 3 signs counted
+    d = wide.choose(ctx, cands)  # north scores 0.3438, east 0.4727: within 0.2, kept
+    assert d.info["chosen"] == north
+    narrow = Variant("nsos", (("alpha", 1.0), ("hysteresis", 0.01))).build()
+    narrow._last = wide._last
+    assert narrow.choose(ctx, cands).info["chosen"] == east
+    # a sign reaching min_reads is new evidence: choose afresh even within the hysteresis
     for _ in range(3):
         b.reads.add(9, 30 * b.free.shape[1] + 50, 5.0, 3.0, 0.0)
-    assert "kept" not in planner.choose(ctx, cands).info
+    wide._last = ((int(cands.rows[north]), int(cands.cols[north])), 3)
+    assert wide.choose(ctx, cands).info["chosen"] == east
 
 
 def test_geometric_is_eq_4_6_alone():

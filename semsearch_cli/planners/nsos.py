@@ -111,15 +111,21 @@ class NSOSParams(BaseModel):
     lambda_d: int = Field(6000, ge=1, description="sign reads kept for H_d")
     lambda_r: int = Field(600000, ge=1, description="poses kept for H_r")
     min_reads: int | None = Field(None, ge=1, description="reads before a sign counts (default: belief.min_reads)")
+    hysteresis: float = Field(0.01, ge=0.0, description="keep the last target while its phi is within this of the best")
 
 
 @register_planner("nsos")
 class NSOS(Planner):
-    """The semantic planner. It keeps its last choice while only the robot's own position has
-    changed since it was made (the chosen candidate is still there, no new candidate appeared and
-    no sign reached ``min_reads``): closeness is relative to the nearest candidate, so otherwise a
-    robot travelling toward a far candidate past a near, unpromising one sees every other
-    candidate's closeness shrink, turns back, and repeats for ever (seen on Inverse goal 124)."""
+    """The semantic planner, with hysteresis between re-plans.
+
+    Closeness is relative to the nearest candidate, so as the robot moves every candidate's phi
+    drifts; with the argmax taken afresh at each re-plan, a robot travelling toward a far
+    candidate past a near, unpromising one sees the other candidates' closeness shrink, turns
+    back, and repeats for ever (seen on Inverse goal 124: 2000 m between two poses 1.1 m apart).
+    So the planner keeps its last target while it is still a candidate and its phi is within
+    ``hysteresis`` of the best; it chooses afresh whenever a sign reaches ``min_reads`` (new
+    semantic evidence) or the target is gone. ``hysteresis = 0`` is the plain argmax of Eq. 4.8.
+    """
 
     Params = NSOSParams
     replan_on_signs = True
@@ -127,25 +133,23 @@ class NSOS(Planner):
 
     def __init__(self, params):
         super().__init__(params)
-        self._last = None  # (target cell, candidate cells, counted signs) of the last decision
+        self._last = None  # (target cell, counted signs) of the last decision
 
     def choose(self, ctx, cands):
-        k = len(cands)
-        if k == 0:
+        if len(cands) == 0:
             return None
         b = ctx.belief
-        cells = set(zip(cands.rows.tolist(), cands.cols.tolist()))
         min_reads = self.params.min_reads or b.spec.min_reads
         counted = sum(1 for n in b.reads.total.values() if n >= min_reads)
-        if self._last is not None:
-            target, old_cells, old_counted = self._last
-            if target in cells and cells <= old_cells and counted == old_counted:
-                return Decision(target[0], target[1], {"kept": True})
-        d = self._decide(ctx, cands)
-        self._last = None if d is None else ((d.row, d.col), cells, counted)
+        keep = None
+        if self._last is not None and self._last[1] == counted and self.params.hysteresis > 0:
+            hit = np.flatnonzero((cands.rows == self._last[0][0]) & (cands.cols == self._last[0][1]))
+            keep = int(hit[0]) if hit.size else None
+        d = self._decide(ctx, cands, keep)
+        self._last = None if d is None else ((d.row, d.col), counted)
         return d
 
-    def _decide(self, ctx, cands):
+    def _decide(self, ctx, cands, keep: int | None = None):
         k = len(cands)
         p, b = self.params, ctx.belief
         alpha = p.alpha if self.use_semantics else 0.0
@@ -182,10 +186,13 @@ class NSOS(Planner):
         SF = phi_g * phi_p
         phi = alpha * SF + (1.0 - alpha) * GF
         phi[~reach] = -np.inf
-        best = np.flatnonzero(phi >= phi.max() - 1e-12)
-        if best.size > 1:  # ties (common at alpha = 1 before any sign counts): nearest, then random
-            best = best[D[best] <= D[best].min() + 1e-9]
-        j = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+        if keep is not None and phi[keep] >= phi.max() - p.hysteresis:
+            j = keep
+        else:
+            best = np.flatnonzero(phi >= phi.max() - 1e-12)
+            if best.size > 1:  # ties (common at alpha = 1 before any sign counts): nearest, then random
+                best = best[D[best] <= D[best].min() + 1e-9]
+            j = int(best[0] if best.size == 1 else ctx.rng.choice(best))
         info = {"chosen": j, "candidates": [
             {"x": round(float(x), 2), "y": round(float(y), 2), "theta_f_deg": round(float(np.degrees(t)), 1),
              "segment": int(seg[i]), "D_m": round(float(D[i]) * b.frame.res, 2) if reach[i] else None,
@@ -203,6 +210,7 @@ class GeometricParams(BaseModel):
     robot_bins: int = Field(18, ge=1)
     lambda_d: int = Field(6000, ge=1)
     lambda_r: int = Field(600000, ge=1)
+    hysteresis: float = Field(0.01, ge=0.0)
 
 
 @register_planner("geometric")
