@@ -183,3 +183,14 @@ def test_geometric_is_eq_4_6_alone():
     for c in d.info["candidates"]:
         assert c["phi"] == pytest.approx(c["GF"], abs=1e-4)
         assert c["GF"] == pytest.approx(((c["phi_o"] + c["phi_r"]) * c["phi_c"] + c["phi_c"]) / 3, abs=2e-4)
+
+
+def test_rolling_histogram_matches_the_plain_one():
+    from semsearch_cli.planners.nsos import RollingHistogram
+
+    rng = np.random.default_rng(1)
+    items: list = []
+    rh = RollingHistogram(18, False, window=50)
+    for _ in range(12):
+        items.extend(rng.uniform(-math.pi, math.pi, int(rng.integers(0, 30))).tolist())
+        assert np.allclose(rh.update(items), heading_histogram(items[-50:], 18, fold=False))

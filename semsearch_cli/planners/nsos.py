@@ -94,6 +94,27 @@ def _bin(theta, bins, fold):
     return np.floor(np.mod(theta, span) / (span / bins) + 0.5).astype(np.int64) % bins
 
 
+class RollingHistogram:
+    """:func:`heading_histogram` of the last ``window`` items of a growing list, kept up to date
+    by consuming only the items appended since the last call (O(new items), not O(history))."""
+
+    def __init__(self, bins: int, fold: bool, window: int):
+        self.bins, self.fold, self.window = bins, fold, window
+        self.counts = np.zeros(bins, np.int64)
+        self.seen = 0  # items of the list consumed so far
+
+    def update(self, items: list) -> np.ndarray:
+        n = len(items)
+        if n > self.seen:
+            self.counts += np.bincount(_bin(np.asarray(items[self.seen :], float), self.bins, self.fold), minlength=self.bins)
+            lo_old, lo_new = max(0, self.seen - self.window), max(0, n - self.window)
+            if lo_new > lo_old:  # items that left the window
+                self.counts -= np.bincount(_bin(np.asarray(items[lo_old:lo_new], float), self.bins, self.fold), minlength=self.bins)
+            self.seen = n
+        total = min(n, self.window)
+        return self.counts / total if total else np.zeros(self.bins)
+
+
 def closeness(D: np.ndarray) -> np.ndarray:
     """phi_c of paper Eq. 16 from skeleton distances D (cells, >= 0); inf D gives 0."""
     D = np.maximum(np.asarray(D, float), 1.0)
@@ -134,6 +155,8 @@ class NSOS(Planner):
     def __init__(self, params):
         super().__init__(params)
         self._last = None  # (target cell, counted signs) of the last decision
+        self._h_d = RollingHistogram(self.params.door_bins, True, self.params.lambda_d)
+        self._h_r = RollingHistogram(self.params.robot_bins, False, self.params.lambda_r)
 
     def choose(self, ctx, cands):
         if len(cands) == 0:
@@ -160,8 +183,8 @@ class NSOS(Planner):
             return None
         phi_c = np.zeros(k)
         phi_c[reach] = closeness(D[reach])
-        h_d = heading_histogram(b.reads.headings[-p.lambda_d :], p.door_bins, fold=True)
-        h_r = heading_histogram(ctx.headings[-p.lambda_r :], p.robot_bins, fold=False)
+        h_d = self._h_d.update(b.reads.headings)
+        h_r = self._h_r.update(ctx.headings)
         phi_o = histogram_lookup(h_d, cands.theta, fold=True)
         phi_r = histogram_lookup(h_r, cands.theta, fold=False)
         GF = ((phi_o + phi_r) * phi_c + phi_c) / 3.0
