@@ -18,6 +18,7 @@ from ..geometry import GridFrame, wrap_angle
 from ..gridalg import GridSearch, branch_walk, local_reach, segment_flood
 
 CLEARANCE_CAP_M = 1.0
+CONNECT_M = 1.5
 SKELETON_MARGIN_M = 4.0
 BRANCH_DEPTH = 10
 MIN_BRANCH_CELLS = 3
@@ -132,6 +133,7 @@ class Belief:
         self.clearance = np.zeros((H, W), np.float32)
         self.skeleton = np.zeros((H, W), bool)
         self.passable = np.zeros((H, W), bool)
+        self.skel_band = np.zeros((H, W), bool)
         self.cost = np.ones((H, W), np.float32)
         self.search_state = GridSearch((H, W))
         self.version = 0  # bumped whenever passable/cost change
@@ -217,6 +219,11 @@ class Belief:
         cost = np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * clear
         cost[self.skeleton[win]] = 1.0
         self.cost[win] = cost
+        # the skeleton band: the skeleton grown by one cell (so that its diagonal steps are
+        # allowed moves), where the robot fits
+        g0, g1, g2, g3 = max(0, w0 - 1), min(H, w1 + 1), max(0, w2 - 1), min(W, w3 + 1)
+        band = cv2.dilate(self.skeleton[g0:g1, g2:g3].astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        self.skel_band[win] = band[w0 - g0 : w1 - g0, w2 - g2 : w3 - g2] & self.passable[win]
         _grow(self.cdirty, (w0, w1 - 1, w2, w3 - 1))
         self.version += 1
         d[:] = (H, -1, W, -1)
@@ -311,16 +318,35 @@ class Belief:
 
     # ---- distances and segments ----------------------------------------------------------
     def search(self, r: int, c: int, t_rows, t_cols, n_stop: int) -> GridSearch:
-        """Dijkstra from the robot cell (r, c) under ``cost``; the returned state answers
-        ``lengths`` (cells) and ``path`` for the settled cells. Stops after ``n_stop`` targets."""
+        """Dijkstra from the robot cell (r, c) to target cells along the skeleton; the returned
+        state answers ``lengths`` (cells) and ``path`` for the settled cells. Stops after
+        ``n_stop`` targets (0: all).
+
+        The search runs on the skeleton band (the skeleton grown by one cell, where the robot
+        fits), joined to the robot and to each target by the cells within ``CONNECT_M`` of them;
+        on it the cheapest path runs on the skeleton itself (the thesis counts only Voronoi
+        cells for D). Targets it cannot reach that way (a gap in the windowed skeleton) are
+        searched for again over every cell where the robot fits, under ``cost``.
+        """
+        t_rows = np.asarray(t_rows, np.int64)
+        t_cols = np.asarray(t_cols, np.int64)
+        need = n_stop if n_stop > 0 else len(t_rows)
+        rad = CONNECT_M / self.frame.res
+        mask = self.skel_band.copy()
+        for tr, tc in zip(t_rows.tolist(), t_cols.tolist()):
+            pr, pc = local_reach(self.passable, tr, tc, rad, False)
+            mask[pr, pc] = True
         passable = self.passable
         if not passable[r, c]:  # robot squeezed near a wall: let it leave
             passable = passable.copy()
-            rr, cc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
-            passable[rr, cc] = True
+            pr, pc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
+            passable[pr, pc] = True
+        pr, pc = local_reach(passable, r, c, rad, False)
+        mask[pr, pc] = True
         gs = self.search_state
-        gs.run(passable, self.cost, r, c, np.asarray(t_rows, np.int64), np.asarray(t_cols, np.int64), n_stop)
         self._search_key = (r, c, self.version)
+        if gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop) < need:
+            gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop)
         return gs
 
     def path(self, r: int, c: int, tr: int, tc: int):
