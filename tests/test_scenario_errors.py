@@ -3,8 +3,6 @@
 import shutil
 
 import cv2
-import numpy as np
-import pytest
 import yaml
 from typer.testing import CliRunner
 
