@@ -137,5 +137,20 @@ def validate(scenario: str | Path) -> dict:
             "planners": [v.label for v in variants], "shortest_m": {str(k): round(v, 2) for k, v in loaded.shortest.items()}}
 
 
+def show(scenario: str | Path, out: str | Path) -> Path:
+    """Draw a scenario (map, signs with numbers, start, goals) to a PNG without simulating."""
+    from .config import load_scenario
+    from .report.plots import plot_scenario
+    from .world.scenario import build_world
+
+    path = Path(scenario)
+    sc = load_scenario(path)
+    world = build_world(sc, path.parent, str(path))
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    plot_scenario(world, sc.goals, f"{sc.name}: {len(world.signs)} signs, goals {', '.join(map(str, sc.goals))}", out)
+    return out
+
+
 def read_results(folder: str | Path) -> pd.DataFrame:
     return read_runs(Path(folder) / "runs.csv")

@@ -121,6 +121,21 @@ def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
         out.print(f"  {k}: {v}")
 
 
+@app.command()
+def show(
+    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    out_file: Path = typer.Option(Path("map.png"), "--out", help="PNG to write."),
+):
+    """Draw a scenario: the map with every sign and its number, the start and the goals."""
+    from . import api
+
+    try:
+        path = api.show(scenario, out_file)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {path}")
+
+
 @import_app.command("mobilesim")
 def import_mobilesim(
     map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),

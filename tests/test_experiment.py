@@ -90,3 +90,12 @@ def test_list_valued_parameters_expand_into_variants():
 def test_api_run_filters_planner(demo_dir, tmp_path):
     res = api.run(demo_dir / "scenario.yaml", seeds=1, workers=1, goals=[452], planners=["bvp"], out=tmp_path / "o", plots=False)
     assert list(res.runs["planner"]) == ["bvp"]
+
+
+def test_show_draws_the_scenario(demo_dir, tmp_path):
+    import matplotlib.image
+
+    res = CliRunner().invoke(app, ["show", str(demo_dir / "scenario.yaml"), "--out", str(tmp_path / "m.png")])
+    assert res.exit_code == 0, res.output
+    img = matplotlib.image.imread(tmp_path / "m.png")
+    assert img.shape[0] > 300 and img.shape[1] > 600

@@ -70,3 +70,31 @@ def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy") -> None:
     fig.savefig(tmp, dpi=110)
     plt.close(fig)
     os.replace(tmp, out)
+
+
+def plot_scenario(world, goals, title: str, out: Path) -> None:
+    """The ground-truth map with every sign (dot, number, facing tick), the start and the goals."""
+    fr = world.frame
+    aspect = fr.height / fr.width
+    fig, ax = plt.subplots(figsize=(12, max(3.5, 12 * aspect)))
+    ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+    s = world.signs
+    ax.quiver(s.x, s.y, np.cos(s.facing), np.sin(s.facing), color="tab:blue", scale=40, width=0.002)
+    ax.scatter(s.x, s.y, s=8, c="tab:blue", label=f"signs ({len(s)})")
+    size = 6 if len(s) <= 60 else 4.5
+    for lab, x, y in zip(s.number, s.x, s.y):
+        ax.annotate(str(lab), (x, y), fontsize=size, color="navy", xytext=(2, 2), textcoords="offset points")
+    for g in goals:
+        i = s.index_of(g)
+        ax.plot(s.x[i], s.y[i], "*", c="tab:red", ms=14)
+        ax.annotate(f"goal {g}", (s.x[i], s.y[i]), fontsize=8, color="tab:red", xytext=(4, -10), textcoords="offset points")
+    ax.plot(*world.start_xy, "s", c="tab:green", ms=9, label="start")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title)
+    ax.legend(loc="upper right", fontsize=7, framealpha=0.8)
+    fig.tight_layout()
+    tmp = out.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=130)
+    plt.close(fig)
+    os.replace(tmp, out)
