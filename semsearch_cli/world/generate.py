@@ -1,0 +1,260 @@
+"""Generated numbered buildings: corridor layouts x door-numbering schemes (issue: scenario library).
+
+A building is a set of straight corridors (centre line and width) rasterised into a map where
+the corridors are free, their walls are one cell thick and everything else is "outside" (rooms
+are closed, as in the authors' maps: the robot searches the corridors and reads the signs on
+their walls). Along each corridor wall a door slot lies every ``spacing`` metres; slots where
+the wall is missing (a junction) or that are trimmed to reach a sign count keep their number as
+a gap, so numbering stays that of a real building.
+
+Layouts (``LAYOUTS``):
+  grid    corridors around room blocks, like the thesis' Normal map;
+  wings   a long main corridor with perpendicular wings and a loop, like its Hotel;
+  angled  corridors at 30 and 120 degrees off a main one, like its KTH floor;
+  single  one long corridor.
+
+Numbering schemes (``SCHEMES``):
+  odd-even-out  odd numbers on one wall, even on the other, rising with the distance from the
+                start along the corridors (the thesis' Normal);
+  odd-even-in   the same, falling with that distance (its Inverse);
+  floor         rising along each corridor, both walls in turn, floor digit first (201, 202, ...);
+  blocks        one hundred-block per corridor (101.., 201.., ...), rising along it, with gaps;
+  random        a random permutation: the control case where no planner can use the signs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+from ..errors import ScenarioError
+from ..geometry import GridFrame
+from ..gridalg import dijkstra
+from .mobilesim import OUTSIDE_GRAY
+
+LAYOUTS = ("grid", "wings", "angled", "single")
+SCHEMES = ("odd-even-out", "odd-even-in", "floor", "blocks", "random")
+
+
+@dataclass(frozen=True)
+class Corridor:
+    """A straight corridor: centre line from ``a`` to ``b`` (m) and its width (m)."""
+
+    a: tuple[float, float]
+    b: tuple[float, float]
+    width: float = 2.0
+
+
+@dataclass(frozen=True)
+class Plan:
+    corridors: tuple[Corridor, ...]
+    size: tuple[float, float]  # m (width, height)
+    start: tuple[float, float]  # m
+
+
+def layout(name: str, rng: np.random.Generator) -> Plan:
+    """The corridors of a layout; small random variations (lengths, wing positions) per seed."""
+    j = lambda s: float(rng.uniform(-s, s))  # noqa: E731  (jitter)
+    if name == "single":
+        L = 60.0 + j(8)
+        return Plan((Corridor((2.0, 5.0), (2.0 + L, 5.0)),), (L + 4.0, 10.0), (2.0 + L / 2, 5.0))
+    if name == "grid":
+        W, H = 50.0 + j(4), 29.0 + j(3)
+        ys = [1.5, 1.5 + (H - 1.5) / 3, 1.5 + 2 * (H - 1.5) / 3, H]
+        xs = [1.5, 1.5 + (W - 1.5) / 2, W]
+        cs = [Corridor((xs[0], y), (xs[-1], y)) for y in ys] + [Corridor((x, ys[0]), (x, ys[-1])) for x in xs]
+        return Plan(tuple(cs), (W + 2.5, H + 2.5), (xs[1], ys[-1] - 0.5))
+    if name == "wings":
+        main_y, L = 50.0, 112.0 + j(6)
+        wx = sorted([9.0, 46.0 + j(3), 83.0 + j(3), 9.0 + L])
+        cs = [Corridor((wx[0], main_y), (wx[-1], main_y))]
+        cs += [Corridor((x, main_y), (x, 6.0 + j(2))) for x in wx]
+        lx0, lx1 = 57.0 + j(2), 92.0 + j(2)
+        cs += [Corridor((lx0, main_y), (lx0, main_y + 11)), Corridor((lx1, main_y), (lx1, main_y + 11)),
+               Corridor((lx0, main_y + 11), (lx1, main_y + 11))]
+        cs += [Corridor((wx[1], main_y), (wx[1], main_y + 16))]  # the start stub
+        return Plan(tuple(cs), (wx[-1] + 10.0, main_y + 20.0), (wx[1], main_y + 14.0))
+    if name == "angled":
+        a0, a1 = (3.0, 8.0), (50.0 + j(3), 8.0)
+        cs = [Corridor(a0, a1)]
+        for x0, ang, length in ((14.0 + j(2), 30.0, 26.0), (34.0 + j(2), 120.0, 24.0)):
+            t = np.radians(ang + j(5))
+            cs.append(Corridor((x0, 8.0), (x0 + length * np.cos(t), 8.0 + length * np.sin(t))))
+        far = cs[1].b
+        t = np.radians(120.0 + j(5))
+        cs.append(Corridor(far, (far[0] + 14.0 * np.cos(t), far[1] + 14.0 * np.sin(t))))
+        xs = [p for c in cs for p in (c.a[0], c.b[0])]
+        ys = [p for c in cs for p in (c.a[1], c.b[1])]
+        shift = (3.0 - min(xs), 3.0 - min(ys))
+        cs = [Corridor((c.a[0] + shift[0], c.a[1] + shift[1]), (c.b[0] + shift[0], c.b[1] + shift[1]), c.width) for c in cs]
+        return Plan(tuple(cs), (max(xs) + shift[0] + 3.0, max(ys) + shift[1] + 3.0), (cs[0].a[0] + 1.5, cs[0].a[1]))
+    raise ScenarioError("<command line>", "--layout", f"unknown layout {name!r}; valid: {', '.join(LAYOUTS)}")
+
+
+def rasterise(plan: Plan, res: float) -> tuple[np.ndarray, GridFrame]:
+    """(H, W) uint8 image: corridors 255, their one-cell walls 0, outside gray."""
+    W, H = int(np.ceil(plan.size[0] / res)), int(np.ceil(plan.size[1] / res))
+    frame = GridFrame(res, 0.0, 0.0, H, W)
+    free = np.zeros((H, W), np.uint8)
+    for c in plan.corridors:
+        a, b = np.array(c.a), np.array(c.b)
+        u = (b - a) / np.linalg.norm(b - a)
+        n = np.array([-u[1], u[0]])
+        h = c.width / 2
+        # axis-aligned corridors are extended by half their width to fill the corners they meet;
+        # slanted ones start on the centre line of the corridor they branch from
+        ea = h if abs(u[0]) < 1e-9 or abs(u[1]) < 1e-9 else 0.0
+        pts = [a - u * ea + n * h, b + u * h + n * h, b + u * h - n * h, a - u * ea - n * h]
+        r, cc = frame.to_cell(np.array([p[0] for p in pts]), np.array([p[1] for p in pts]))
+        cv2.fillPoly(free, [np.stack([cc, r], axis=1).round().astype(np.int32)], 1)
+    free = free.astype(bool)
+    walls = cv2.dilate(free.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & ~free
+    img = np.full((H, W), OUTSIDE_GRAY, np.uint8)
+    img[free] = 255
+    img[walls] = 0
+    return img, frame
+
+
+@dataclass
+class Slot:
+    corridor: int
+    side: int  # +1: left of a -> b, -1: right
+    t: float  # m along the corridor
+    x: float  # m, on the wall face
+    y: float
+    facing: float  # degrees, into the corridor
+    ok: bool  # a wall is there (not a junction)
+
+
+def door_slots(plan: Plan, img: np.ndarray, frame: GridFrame, spacing: float) -> list[Slot]:
+    """Door slots every ``spacing`` m along both walls of each corridor."""
+    out = []
+    for k, c in enumerate(plan.corridors):
+        a, b = np.array(c.a), np.array(c.b)
+        L = float(np.linalg.norm(b - a))
+        u = (b - a) / L
+        n = np.array([-u[1], u[0]])
+        H, W = img.shape
+        for side in (1, -1):
+            for t in np.arange(spacing / 2, L - spacing / 4, spacing):
+                centre = a + u * t
+                # walk from the centre line toward this wall until the corridor ends
+                p, ok = centre, False
+                for step in np.arange(0.0, c.width / 2 + 4 * frame.res, frame.res / 2):
+                    q = centre + side * n * step
+                    r, cc = frame.to_index(*q)
+                    if not (0 <= r < H and 0 <= cc < W):
+                        break
+                    if img[r, cc] != 255:
+                        ok = bool(img[r, cc] == 0)  # a wall, not another corridor or outside
+                        break
+                    p = q
+                face = p + side * n * (frame.res / 2)
+                facing = float(np.degrees(np.arctan2(-side * n[1], -side * n[0])))
+                out.append(Slot(k, side, float(t), round(float(face[0]), 4), round(float(face[1]), 4), round(facing, 2), ok))
+    return out
+
+
+def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, frame: GridFrame,
+                 rng: np.random.Generator, floor: int = 2) -> list[int]:
+    """A door number for every slot (gaps included) under ``scheme``."""
+    if scheme in ("odd-even-out", "odd-even-in"):
+        free = img == 255
+        r, c = frame.to_index(*plan.start)
+        _, length, _ = dijkstra(free, np.ones((1, 1), np.float32), np.array([r]), np.array([c]), np.zeros_like(free), 0, np.inf)
+        d = []
+        for s in slots:
+            cor = plan.corridors[s.corridor]
+            a, b = np.array(cor.a), np.array(cor.b)
+            u = (b - a) / np.linalg.norm(b - a)
+            centre = a + u * s.t
+            ahead = centre + u * 1.0
+            rc0, rc1 = frame.to_index(*centre), frame.to_index(*ahead)
+            d0, d1 = length[rc0], length[rc1]
+            outward = 1 if (np.isfinite(d1) and np.isfinite(d0) and d1 >= d0) else -1
+            d.append((float(d0) if np.isfinite(d0) else 1e9, s.side * outward))
+        order = np.argsort([x[0] for x in d], kind="stable")
+        if scheme == "odd-even-in":
+            order = order[::-1]
+        nums = [0] * len(slots)
+        nxt = {1: 1, -1: 2}
+        for i in order:
+            side = d[i][1]
+            nums[i] = nxt[side]
+            nxt[side] += 2
+        return nums
+    if scheme == "floor":
+        nums, i = [], 0
+        order = sorted(range(len(slots)), key=lambda k: (slots[k].corridor, slots[k].t, -slots[k].side))
+        nums = [0] * len(slots)
+        for i, k in enumerate(order, start=1):
+            nums[k] = int(f"{floor}{i:02d}")
+        return nums
+    if scheme == "blocks":
+        nums = [0] * len(slots)
+        order = sorted(range(len(slots)), key=lambda k: (slots[k].corridor, slots[k].t, -slots[k].side))
+        count: dict = {}
+        for k in order:
+            cor = slots[k].corridor
+            count[cor] = count.get(cor, 0) + 1
+            nums[k] = 100 * (cor + 1) + count[cor]
+        return nums
+    if scheme == "random":
+        return [int(x) for x in rng.permutation(len(slots)) + 1]
+    raise ScenarioError("<command line>", "--numbering", f"unknown numbering scheme {scheme!r}; valid: {', '.join(SCHEMES)}")
+
+
+def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: float = 0.1,
+                      spacing: float = 2.5, signs: int | None = None, goals: list | None = None,
+                      name: str | None = None, density_delta: float = 2.5, planners: list | None = None) -> Path:
+    """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path.
+
+    ``signs`` trims the doors (not the numbers) at random to that count, keeping ``goals``.
+    """
+    rng = np.random.default_rng(seed)
+    plan = layout(layout_name, rng)
+    img, frame = rasterise(plan, res)
+    slots = door_slots(plan, img, frame, spacing)
+    nums = number_slots(slots, plan, scheme, img, frame, rng)
+    keep = [i for i, s in enumerate(slots) if s.ok]
+    goal_set = {int(g) for g in goals or []}
+    missing = goal_set - {nums[i] for i in keep}
+    if missing:
+        raise ScenarioError("<command line>", "--goals", f"no door of this building carries {sorted(missing)} "
+                            f"(numbers run {min(nums)}..{max(nums)} with gaps at junctions)")
+    if signs is not None:
+        if signs > len(keep):
+            raise ScenarioError("<command line>", "--signs", f"the building has room for {len(keep)} signs at {spacing} m spacing, fewer than {signs}")
+        spare = [i for i in keep if nums[i] not in goal_set]
+        drop = set(rng.choice(spare, size=len(keep) - signs, replace=False).tolist()) if len(keep) > signs else set()
+        keep = [i for i in keep if i not in drop]
+    free = img == 255
+    snapped = [(nums[i], slots[i].x, slots[i].y, slots[i].facing) for i in keep]
+    out.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(out / "map.png"), img)
+    with (out / "doors.csv").open("w") as fh:
+        fh.write("number,x,y,facing\n")
+        for lab, x, y, f in sorted(snapped):
+            fh.write(f"{lab},{x},{y},{f}\n")
+    if not goals:
+        from .mobilesim import _spread_goals
+
+        goals = _spread_goals(free, frame, snapped, plan.start)
+    scen = {
+        "name": name or f"{layout_name}-{scheme}-{seed}",
+        "map": {"image": "map.png", "resolution": res},
+        "start": {"x": round(plan.start[0], 3), "y": round(plan.start[1], 3), "heading": "random"},
+        "doors": "doors.csv",
+        "goals": [int(g) for g in goals],
+        "planners": planners or [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}],
+        "belief": {"density_delta": density_delta},
+        "experiment": {"seeds": 10, "base_seed": 0, "max_distance": 2000.0},
+    }
+    path = out / "scenario.yaml"
+    path.write_text(f"# generated by `semsearch generate building --layout {layout_name} --numbering {scheme} --seed {seed}`\n"
+                    + yaml.safe_dump(scen, sort_keys=False))
+    return path
