@@ -136,6 +136,32 @@ def show(
     out.print(f"wrote {path}")
 
 
+generate_app = typer.Typer(no_args_is_help=True, help="Generate numbered buildings of your own.")
+app.add_typer(generate_app, name="generate")
+
+
+@generate_app.command("building")
+def generate_building(
+    layout: str = typer.Option(..., "--layout", help="grid, wings, angled or single."),
+    numbering: str = typer.Option(..., "--numbering", help="odd-even-out, odd-even-in, floor, blocks or random."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the layout's variations (and of random numbering)."),
+    out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
+    spacing: float = typer.Option(2.5, "--spacing", min=0.5, help="m between door slots along a wall."),
+    signs: Optional[int] = typer.Option(None, "--signs", min=1, help="Keep exactly this many signs (doors trimmed at random, numbers kept)."),
+    goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
+    name: Optional[str] = typer.Option(None, "--name", help="Scenario name (default LAYOUT-NUMBERING-SEED)."),
+):
+    """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
+    from .world.generate import generate_building as gen
+
+    try:
+        path = gen(layout, numbering, seed, out_dir, spacing=spacing, signs=signs,
+                   goals=_split([goals]) if goals else None, name=name)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+
+
 @import_app.command("mobilesim")
 def import_mobilesim(
     map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),

@@ -1,0 +1,77 @@
+"""Generated buildings: every layout and scheme gives a valid scenario with the promised numbering."""
+
+import csv
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from semsearch_cli.cli import app
+from semsearch_cli.experiment import Loaded
+from semsearch_cli.world.generate import LAYOUTS, SCHEMES, generate_building
+
+
+def doors(path):
+    with open(path / "doors.csv") as fh:
+        return [(int(r["number"]), float(r["x"]), float(r["y"]), float(r["facing"])) for r in csv.DictReader(fh)]
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_every_layout_validates(layout, tmp_path):
+    p = generate_building(layout, "odd-even-out", 1, tmp_path, spacing=4.0)
+    L = Loaded.load(p)  # every loader check: start free, signs next to free space, goals reachable
+    assert len(L.world.signs) >= 10
+    assert all(np.isfinite(v) for v in L.shortest.values())
+    # every sign is readable from somewhere reachable
+    assert all(L.world.readable_mask(i).any() for i in range(len(L.world.signs)))
+
+
+def test_odd_even_out_on_a_single_corridor(tmp_path):
+    generate_building("single", "odd-even-out", 0, tmp_path)
+    d = doors(tmp_path)
+    start_x = 2.0 + (np.random.default_rng(0).uniform(-8, 8) + 60.0) / 2
+    for parity in (0, 1):
+        side = sorted((abs(x - start_x), n) for n, x, y, f in d if n % 2 == parity)
+        nums = [n for _, n in side]
+        assert nums == sorted(nums)  # rising away from the middle
+    ys_odd = {round(y, 1) for n, x, y, f in d if n % 2 == 1 and x > start_x}
+    ys_even = {round(y, 1) for n, x, y, f in d if n % 2 == 0 and x > start_x}
+    assert len(ys_odd) == 1 and len(ys_even) == 1 and ys_odd != ys_even  # one wall each, beyond the start
+
+
+def test_odd_even_in_reverses(tmp_path):
+    generate_building("single", "odd-even-out", 0, tmp_path / "a")
+    generate_building("single", "odd-even-in", 0, tmp_path / "b")
+    a = {(round(x, 2), round(y, 2)): n for n, x, y, f in doors(tmp_path / "a")}
+    b = {(round(x, 2), round(y, 2)): n for n, x, y, f in doors(tmp_path / "b")}
+    far = max(a, key=lambda k: a[k])
+    assert b[far] in (1, 2)  # the farthest door carries the smallest number
+
+
+def test_floor_blocks_and_random(tmp_path):
+    generate_building("grid", "floor", 0, tmp_path / "f")
+    assert all(str(n).startswith("2") for n, *_ in doors(tmp_path / "f"))
+    generate_building("grid", "blocks", 0, tmp_path / "b")
+    assert {n // 100 for n, *_ in doors(tmp_path / "b")} == set(range(1, 8))  # 7 corridors, one block each
+    generate_building("grid", "random", 0, tmp_path / "r")
+    d = doors(tmp_path / "r")
+    assert len({n for n, *_ in d}) == len(d)
+    y0 = min(y for _, _, y, _ in d)
+    along = [n for n, x, y, f in sorted(d, key=lambda r: r[1]) if abs(y - y0) < 0.2]  # one wall, by x
+    assert len(along) > 10 and along != sorted(along) and along != sorted(along, reverse=True)
+
+
+def test_sign_count_and_goals_are_kept(tmp_path):
+    generate_building("wings", "blocks", 0, tmp_path, signs=50, goals=[101, 305])
+    nums = [n for n, *_ in doors(tmp_path)]
+    assert len(nums) == 50 and {101, 305} <= set(nums)
+
+
+def test_generate_command_and_errors(tmp_path):
+    r = CliRunner().invoke(app, ["generate", "building", "--layout", "angled", "--numbering", "random", "--seed", "3", "--out", str(tmp_path / "g")])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "g" / "scenario.yaml").is_file()
+    r = CliRunner().invoke(app, ["generate", "building", "--layout", "maze", "--numbering", "random", "--out", str(tmp_path / "x")])
+    assert r.exit_code == 2 and "--layout" in r.output
+    r = CliRunner().invoke(app, ["generate", "building", "--layout", "single", "--numbering", "floor", "--goals", "999", "--out", str(tmp_path / "y")])
+    assert r.exit_code == 2 and "--goals" in r.output
