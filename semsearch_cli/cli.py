@@ -118,7 +118,7 @@ def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
         _fail(exc)
     out.print(f"{scenario}: ok")
     for k, v in info.items():
-        out.print(f"  {k}: {v}")
+        out.print(escape(f"  {k}: {v}"))
 
 
 @app.command()

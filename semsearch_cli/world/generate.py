@@ -15,7 +15,7 @@ Layouts (``LAYOUTS``):
 
 Numbering schemes (``SCHEMES``):
   odd-even-out  odd numbers on one wall, even on the other, rising with the distance from the
-                start along the corridors (the thesis' Normal);
+                middle of the building along the corridors (the thesis' Normal);
   odd-even-in   the same, falling with that distance (its Inverse);
   floor         rising along each corridor, both walls in turn, floor digit first (201, 202, ...);
   blocks        one hundred-block per corridor (101.., 201.., ...), rising along it, with gaps;
@@ -163,8 +163,13 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
                  rng: np.random.Generator, floor: int = 2) -> list[int]:
     """A door number for every slot (gaps included) under ``scheme``."""
     if scheme in ("odd-even-out", "odd-even-in"):
+        # distances along the corridors from the middle of the building (its free cell nearest
+        # the centre of the plan)
         free = img == 255
-        r, c = frame.to_index(*plan.start)
+        fr_, fc_ = np.nonzero(free)
+        mr, mc = frame.to_cell(plan.size[0] / 2, plan.size[1] / 2)
+        k = int(np.argmin((fr_ - mr) ** 2 + (fc_ - mc) ** 2))
+        r, c = fr_[k], fc_[k]
         _, length, _ = dijkstra(free, np.ones((1, 1), np.float32), np.array([r]), np.array([c]), np.zeros_like(free), 0, np.inf)
         d = []
         for s in slots:
@@ -210,7 +215,8 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
 
 def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: float = 0.1,
                       spacing: float = 2.5, signs: int | None = None, goals: list | None = None,
-                      name: str | None = None, density_delta: float = 2.5, planners: list | None = None) -> Path:
+                      name: str | None = None, density_delta: float = 2.5, planners: list | None = None,
+                      floor: int = 2) -> Path:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path.
 
     ``signs`` trims the doors (not the numbers) at random to that count, keeping ``goals``.
@@ -219,7 +225,7 @@ def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: 
     plan = layout(layout_name, rng)
     img, frame = rasterise(plan, res)
     slots = door_slots(plan, img, frame, spacing)
-    nums = number_slots(slots, plan, scheme, img, frame, rng)
+    nums = number_slots(slots, plan, scheme, img, frame, rng, floor)
     keep = [i for i, s in enumerate(slots) if s.ok]
     goal_set = {int(g) for g in goals or []}
     missing = goal_set - {nums[i] for i in keep}

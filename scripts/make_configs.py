@@ -1,0 +1,49 @@
+"""Regenerate the shipped scenario library: configs/{normal,inverse,hotel,kth}.yaml and maps/.
+
+Our own buildings, made by `semsearch generate building`, matching the thesis' Table 4.1 (sign
+counts and goal doors) and its description of each map's numbering. Run from the repository root:
+    python scripts/make_configs.py
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from semsearch_cli.world.generate import generate_building
+
+PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
+
+# name: (layout, numbering, seed, spacing m, signs, goals, floor digit, density delta m^2, description)
+LIBRARY = {
+    "normal": ("grid", "odd-even-out", 3, 3.9, 113, [54, 55, 111, 124], 2, 4.5,
+               "corridors around room blocks; odd and even on opposite walls, rising from the middle to the borders"),
+    "inverse": ("grid", "odd-even-in", 3, 3.9, 116, [54, 55, 111, 124], 2, 4.5,
+                "the Normal building numbered the other way: rising from the borders to the middle"),
+    "hotel": ("wings", "odd-even-out", 0, 3.0, 124, [76, 135, 148, 185], 2, 2.5,
+              "long corridors with wings and a loop; half the door slots unsigned, so runs of numbers are irregular"),
+    "kth": ("angled", "floor", 0, 3.5, 47, [756], 7, 2.5,
+            "corridors at 30 and 120 degrees; numbered along each corridor, floor digit 7 first"),
+}
+
+
+def main() -> None:
+    root = Path(__file__).resolve().parents[1]
+    for name, (lay, scheme, seed, spacing, signs, goals, floor, delta, what) in LIBRARY.items():
+        folder = root / "maps" / name
+        p = generate_building(lay, scheme, seed, folder, spacing=spacing, signs=signs, goals=goals, name=name,
+                              density_delta=delta, planners=PLANNERS, floor=floor)
+        scen = yaml.safe_load(p.read_text())
+        p.unlink()
+        scen["map"]["image"] = f"../maps/{name}/map.png"
+        scen["doors"] = f"../maps/{name}/doors.csv"
+        header = (f"# {name}: {signs} signs, goals {', '.join(map(str, goals))} (as the thesis' Table 4.1); {what}.\n"
+                  f"# Our own building: semsearch generate building --layout {lay} --numbering {scheme} --seed {seed} "
+                  f"--spacing {spacing} --signs {signs} (floor digit {floor}); regenerate with scripts/make_configs.py.\n")
+        (root / "configs" / f"{name}.yaml").write_text(header + yaml.safe_dump(scen, sort_keys=False))
+        print(f"configs/{name}.yaml")
+
+
+if __name__ == "__main__":
+    main()
