@@ -3,7 +3,10 @@
 Step order: sense (laser -> HIMM, door cameras -> reads) -> update belief (free cells, visited
 kernel and density class) -> stop if the goal sign was read -> re-plan if an event asks (no path,
 target reached, a sign reached ``min_reads`` for planners that use signs, ``replan_every`` metres
-travelled) -> move one step along the path -> check the budget.
+travelled) -> move one step along the path -> check the budget. When a re-plan finds no candidate
+the robot first turns on the spot in three quarter turns, sensing after each (its laser covers
+only 180 degrees ahead, so a start facing a dead end would otherwise see nowhere to go); only if
+there is still no candidate is the run ``stuck``.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import numpy as np
 
 from .belief import Belief
 from .config import Scenario
+from .geometry import wrap_angle
 from .navigation import NAVIGATORS
 from .planners import PlanContext, Variant
 from .sensors.devices import DoorCamera, Laser
@@ -81,23 +85,30 @@ class Episode:
         outcome = None
         min_reads = sc.belief.min_reads
         bbox = np.empty(4, np.int64)
-        while outcome is None:
-            # 1. sense
+
+        def sense(x, y, heading, r, c):
+            """Laser into HIMM, door cameras into reads; returns (goal read, a sign reached min_reads)."""
             v, u = fr.to_cell(x, y)
             thetas, dist, hit = self.laser.scan(float(v), float(u), heading, rng)
             bbox[:] = (H, -1, W, -1)
             himm_update(belief.cv, belief.seen, float(v), float(u), thetas, dist, hit,
                         sc.belief.himm_inc, sc.belief.himm_dec, sc.belief.himm_max, bbox)
             belief.refresh_free(bbox)
-            r, c = int(np.floor(v)), int(np.floor(u))
-            event = False
-            found = False
+            found = event = False
             for i, label in self.camera.read(x, y, heading, rng):
                 read_signs.add(i)
                 if i == self.goal_idx and label == self.goal:
                     found = True
                 if belief.reads.add(label, r * W + c, x, y, heading) == min_reads:
                     event = True
+            return found, event
+
+        looked_around = False
+        while outcome is None:
+            # 1. sense
+            v, u = fr.to_cell(x, y)
+            r, c = int(np.floor(v)), int(np.floor(u))
+            found, event = sense(x, y, heading, r, c)
             # 2. belief
             belief.visit(r, c)
             headings.append(heading)
@@ -108,6 +119,19 @@ class Episode:
             if path_r is None or path_i >= len(path_r) or since_plan >= sc.navigation.replan_every or (event and uses_signs):
                 belief.refresh_derived()
                 cands = belief.candidates()
+                if len(cands) == 0 and not looked_around:
+                    # nowhere to go with what the forward laser has seen: turn on the spot (three
+                    # quarter turns, no distance travelled) and look again
+                    looked_around = True
+                    for _ in range(3):
+                        heading = float(wrap_angle(heading + np.pi / 2))
+                        f, e = sense(x, y, heading, r, c)
+                        found, event = found or f, event or e
+                    if found:
+                        outcome = "found"
+                        break
+                    belief.refresh_derived()
+                    cands = belief.candidates()
                 ctx = PlanContext(belief, r, c, x, y, heading, self.goal, rng, headings)
                 path_r = None
                 for _ in range(MAX_RETRIES):
@@ -134,6 +158,7 @@ class Episode:
                     break
                 path_i = 1
                 since_plan = 0.0
+                looked_around = False
             # 4. move one step along the path
             px, py = fr.to_world(path_r, path_c)
             remaining = step_len

@@ -99,3 +99,17 @@ def test_show_draws_the_scenario(demo_dir, tmp_path):
     assert res.exit_code == 0, res.output
     img = matplotlib.image.imread(tmp_path / "m.png")
     assert img.shape[0] > 300 and img.shape[1] > 600
+
+
+def test_start_facing_a_dead_end_turns_around(demo_loaded):
+    """A start at the end of a wing, facing the end wall: the 180-degree laser sees no way on
+    until the robot turns on the spot."""
+    from semsearch_cli.config import StartSpec
+    from semsearch_cli.world.scenario import build_world
+
+    L = demo_loaded
+    sc = L.sc.model_copy(update={"start": StartSpec(x=8.0, y=17.3, heading=90.0)})
+    world = build_world(sc, L.path.parent, str(L.path))
+    res = Episode(world, sc, Variant("greedy", ()), 452, seed=0).run()
+    assert res.outcome == "found"
+    assert res.path[0].tolist() == [8.0, 17.299999237060547]
