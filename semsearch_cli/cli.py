@@ -189,6 +189,23 @@ def import_mobilesim(
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
 
 
+@import_app.command("kth")
+def import_kth(
+    xml_file: Path = typer.Argument(..., help="KTH campus floor-plan XML file."),
+    out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
+    resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
+    goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
+):
+    """Convert a KTH floor plan: corridors become free space, each room-to-corridor portal a sign."""
+    from .world.kth import import_kth as imp
+
+    try:
+        path = imp(xml_file, out_dir, resolution, _split([goals]) if goals else None)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+
+
 @app.command()
 def version():
     """Print the semsearch version."""

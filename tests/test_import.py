@@ -32,3 +32,63 @@ def test_import_reports_bad_start(tmp_path):
     res = CliRunner().invoke(app, ["import", "mobilesim", str(tmp_path / "c.map"), str(tmp_path / "c.doors"),
                                    "--out", str(tmp_path / "o"), "--start", "5,5"])
     assert res.exit_code == 2 and "--start" in res.output
+
+
+KTH_XML = """<?xml version="1.0" encoding="UTF-8"?>
+<floor BuildingName="B" FloorName="F">
+  <Scale PixelDistance="100" RealDistance="1"/>
+  <space name="B_100" type="KORRIDOR"><contour>
+    <linesegment x1="0" y1="0" x2="1000" y2="0" type="Wall" target=""/>
+    <linesegment x1="1000" y1="0" x2="1000" y2="200" type="Portal" target="B_200"/>
+    <linesegment x1="1000" y1="200" x2="0" y2="200" type="Wall" target=""/>
+    <linesegment x1="0" y1="200" x2="0" y2="0" type="Wall" target=""/>
+  </contour></space>
+  <space name="B_200" type="KORRIDOR"><contour>
+    <linesegment x1="1030" y1="0" x2="2000" y2="0" type="Wall" target=""/>
+    <linesegment x1="2000" y1="0" x2="2000" y2="200" type="Wall" target=""/>
+    <linesegment x1="2000" y1="200" x2="1030" y2="200" type="Wall" target=""/>
+    <linesegment x1="1030" y1="200" x2="1030" y2="0" type="Portal" target="B_100"/>
+  </contour></space>
+  <space name="B_101" type="KONTOR"><contour>
+    <linesegment x1="300" y1="-20" x2="400" y2="-20" type="Portal" target="B_100"/>
+    <linesegment x1="600" y1="-20" x2="700" y2="-20" type="Portal" target="B_100"/>
+  </contour></space>
+  <space name="B_WC" type="TOALETT"><contour>
+    <linesegment x1="1500" y1="220" x2="1600" y2="220" type="Portal" target="B_200"/>
+  </contour></space>
+  <space name="B_202" type="KONTOR"><contour>
+    <linesegment x1="1800" y1="-20" x2="1900" y2="-20" type="Portal" target="B_200"/>
+  </contour></space>
+</floor>
+"""
+
+
+def test_import_kth_bridges_corridors_and_labels_doors(tmp_path):
+    (tmp_path / "f.xml").write_text(KTH_XML)
+    res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "f.xml"), "--out", str(tmp_path / "o"), "--goals", "202"])
+    assert res.exit_code == 0, res.output
+    L = Loaded.load(tmp_path / "o" / "scenario.yaml")
+    assert sorted(map(str, L.world.signs.number)) == ["101", "101/2", "202", "WC"]
+    assert L.world.signs.value.tolist().count(-1) == 2  # "101/2" and "WC" are text
+    assert L.world.reach.sum() > 1500  # both corridors (20 m x 2 m) joined through the portal
+    assert all(L.world.readable_mask(i).any() for i in range(4))
+    # pixel y points down: room 101 (y = -20 px) lies above the corridor (0..200 px), so its sign is
+    # on the corridor's upper wall in the world too, facing down into it
+    i = L.world.signs.index_of(101)
+    assert np.degrees(L.world.signs.facing[i]) == -90.0
+    assert L.world.signs.y[i] > L.world.signs.y[L.world.signs.index_of("WC")]
+
+
+def test_import_kth_reference_floor(tmp_path):
+    from .conftest import REF
+
+    f = REF / "kth" / "0510035517_A_40_1_105.xml"
+    if not f.is_file():
+        import pytest
+
+        pytest.skip(f"the KTH sample floor is not at {f} (../shared absent)")
+    from semsearch_cli.world.kth import import_kth
+
+    L = Loaded.load(import_kth(f, tmp_path))
+    assert len(L.world.signs) == 54  # one per room-to-corridor portal
+    assert all(L.world.readable_mask(i).any() for i in range(len(L.world.signs)))

@@ -1,0 +1,131 @@
+"""Import a floor of the KTH campus floor-plan dataset (Aydemir, Jensfelt, Folkesson 2012).
+
+Format: ``<Scale PixelDistance RealDistance>`` gives pixels per metre; each ``<space name=
+"BUILDING_ROOM" type="KONTOR|KORRIDOR|...">`` has a ``<contour>`` of ``<linesegment x1 y1 x2 y2
+type="Wall|Window|Portal" target="other space">``; pixel y points down.
+
+The robot's free space is the union of the KORRIDOR spaces (rooms stay closed, as in the authors'
+maps); their boundary becomes a one-cell wall and everything else "outside". Each Portal from a
+room to a corridor is that room's door: a sign on the corridor wall at the portal's middle, facing
+into the corridor, numbered by the room number after the underscore (a name that is not a number
+is kept as text). A room with several doors gets its number on the first and ``NUMBER/2``, ... (text,
+ignored by the number-based factors) on the others, since sign numbers must be unique.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+from ..errors import ScenarioError
+from ..geometry import GridFrame
+from .mobilesim import MARGIN_M, OUTSIDE_GRAY, _spread_goals, snap_signs
+
+
+def _label(name: str):
+    tail = name.split("_", 1)[1] if "_" in name else name
+    return int(tail) if tail.isdigit() else tail
+
+
+def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None = None, name: str | None = None,
+               density_delta: float = 2.5) -> Path:
+    """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path."""
+    if not xml_path.is_file():
+        raise ScenarioError(str(xml_path), "", "KTH floor-plan file not found")
+    try:
+        root = ET.parse(xml_path).getroot()
+    except ET.ParseError as exc:
+        raise ScenarioError(str(xml_path), "", f"not valid XML: {exc}") from None
+    scale = root.find("Scale")
+    if scale is None:
+        raise ScenarioError(str(xml_path), "Scale", "missing <Scale PixelDistance RealDistance> element")
+    ppm = float(scale.get("PixelDistance")) / float(scale.get("RealDistance"))
+    spaces = root.findall("space")
+    corridors = {s.get("name") for s in spaces if (s.get("type") or "").upper() == "KORRIDOR"}
+    if not corridors:
+        raise ScenarioError(str(xml_path), "space", "no space of type KORRIDOR: nothing for the robot to drive in")
+
+    def seg(ls):
+        return [float(ls.get(k)) / ppm for k in ("x1", "y1", "x2", "y2")]
+
+    polys, portals, links = [], [], {}
+    for s in spaces:
+        segs = [seg(ls) for ls in s.iter("linesegment")]
+        if s.get("name") in corridors:
+            polys.append(np.array([[a, -b] for a, b, _, _ in segs]))
+            for ls in s.iter("linesegment"):
+                if ls.get("type") == "Portal" and ls.get("target") in corridors:
+                    x1, y1, x2, y2 = seg(ls)
+                    links.setdefault((s.get("name"), ls.get("target")), []).append(np.array([[x1, -y1], [x2, -y2]]))
+        else:
+            for ls in s.iter("linesegment"):
+                if ls.get("type") == "Portal" and ls.get("target") in corridors:
+                    x1, y1, x2, y2 = seg(ls)
+                    portals.append((_label(s.get("name")), (x1 + x2) / 2, -(y1 + y2) / 2))
+    allpts = np.concatenate(polys)
+    x0, y0 = allpts.min(axis=0) - MARGIN_M
+    x1, y1 = allpts.max(axis=0) + MARGIN_M
+    W, H = int(np.ceil((x1 - x0) / res)), int(np.ceil((y1 - y0) / res))
+    frame = GridFrame(res, float(x0), float(y0), H, W)
+    free = np.zeros((H, W), np.uint8)
+    for p in polys:
+        r, c = frame.to_cell(p[:, 0], p[:, 1])
+        cv2.fillPoly(free, [np.stack([c, r], axis=1).round().astype(np.int32)], 1)
+    # the two sides of a portal between corridors lie a wall's thickness apart: bridge them
+    for (a, b), segs_ab in links.items():
+        for pa in segs_ab:
+            others = links.get((b, a), [])
+            if not others:
+                continue
+            pb = min(others, key=lambda q: float(np.linalg.norm(q.mean(axis=0) - pa.mean(axis=0))))
+            quad = cv2.convexHull(np.concatenate([pa, pb]).astype(np.float32))[:, 0, :]
+            r, c = frame.to_cell(quad[:, 0], quad[:, 1])
+            cv2.fillPoly(free, [np.stack([c, r], axis=1).round().astype(np.int32)], 1)
+    # erode the outline by one cell: the wall is drawn inside each corridor's contour
+    free = cv2.erode(free, np.ones((3, 3), np.uint8)).astype(bool)
+    walls = cv2.dilate(free.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & ~free
+    n, lab = cv2.connectedComponents(free.astype(np.uint8), connectivity=4)
+    sizes = np.bincount(lab.ravel())
+    sizes[0] = 0
+    main = lab == int(np.argmax(sizes))
+    d = cv2.distanceTransform(main.astype(np.uint8), cv2.DIST_L2, 5)
+    r, c = np.unravel_index(int(np.argmax(d)), d.shape)
+    sx, sy = frame.to_world(r, c)
+    start = (round(float(sx), 2), round(float(sy), 2))
+
+    seen: dict = {}
+    raw = []
+    for label, x, y in portals:
+        k = seen.get(str(label), 0) + 1
+        seen[str(label)] = k
+        raw.append((label if k == 1 else f"{label}/{k}", x, y, 0.0))
+    snapped = snap_signs(free, frame, raw)
+
+    img = np.full((H, W), OUTSIDE_GRAY, np.uint8)
+    img[free] = 255
+    img[walls] = 0
+    out.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(out / "map.png"), img)
+    with (out / "doors.csv").open("w") as fh:
+        fh.write("number,x,y,facing\n")
+        for label, x, y, f in snapped:
+            fh.write(f"{label},{x},{y},{f}\n")
+    if not goals:
+        goals = _spread_goals(main, frame, snapped, start)
+    scen = {
+        "name": name or xml_path.stem,
+        "map": {"image": "map.png", "resolution": res, "origin": [round(frame.origin_x, 4), round(frame.origin_y, 4)]},
+        "start": {"x": start[0], "y": start[1], "heading": "random"},
+        "doors": "doors.csv",
+        "goals": list(goals),
+        "planners": [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}],
+        "belief": {"density_delta": density_delta},
+        "experiment": {"seeds": 10, "base_seed": 0, "max_distance": 2000.0},
+    }
+    path = out / "scenario.yaml"
+    path.write_text(f"# imported from {xml_path.name} by `semsearch import kth`\n" + yaml.safe_dump(scen, sort_keys=False))
+    return path
