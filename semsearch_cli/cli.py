@@ -162,6 +162,22 @@ def generate_building(
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
 
 
+@generate_app.command("batch")
+def generate_batch(
+    out_dir: Path = typer.Option(..., "--out", help="Folder for the buildings (one sub-folder each) and index.txt."),
+    seeds: int = typer.Option(3, "--seeds", min=1, help="Buildings per layout and numbering scheme."),
+    runs: int = typer.Option(3, "--runs", min=1, help="Runs per goal and planner in each scenario."),
+):
+    """Every layout x numbering scheme x seed: a robustness set (4 x 5 x 3 = 60 buildings by default)."""
+    from .world.generate import generate_batch as gen
+
+    try:
+        paths = gen(out_dir, seeds=seeds, runs=runs)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {len(paths)} scenarios under {out_dir} (listed in {out_dir / 'index.txt'})")
+
+
 @import_app.command("mobilesim")
 def import_mobilesim(
     map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),

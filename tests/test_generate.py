@@ -75,3 +75,14 @@ def test_generate_command_and_errors(tmp_path):
     assert r.exit_code == 2 and "--layout" in r.output
     r = CliRunner().invoke(app, ["generate", "building", "--layout", "single", "--numbering", "floor", "--goals", "999", "--out", str(tmp_path / "y")])
     assert r.exit_code == 2 and "--goals" in r.output
+
+
+def test_generate_batch_covers_every_layout_and_scheme(tmp_path):
+    r = CliRunner().invoke(app, ["generate", "batch", "--out", str(tmp_path), "--seeds", "1", "--runs", "2"])
+    assert r.exit_code == 0, r.output
+    index = (tmp_path / "index.txt").read_text().split()
+    assert len(index) == len(LAYOUTS) * len(SCHEMES)
+    names = {line.split("/")[0].rsplit("-", 1)[0] for line in index}
+    assert names == {f"{lay}-{sch}" for lay in LAYOUTS for sch in SCHEMES}
+    L = Loaded.load(tmp_path / index[0])
+    assert L.sc.experiment.seeds == 2 and [p.name for p in L.sc.planners] == ["greedy", "nsos"]
