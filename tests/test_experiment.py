@@ -1,5 +1,6 @@
 """End-to-end runs on the demo building (a small map of our own)."""
 
+import numpy as np
 import pandas as pd
 import pytest
 from typer.testing import CliRunner
@@ -113,3 +114,22 @@ def test_start_facing_a_dead_end_turns_around(demo_loaded):
     res = Episode(world, sc, Variant("greedy", ()), 452, seed=0).run()
     assert res.outcome == "found"
     assert res.path[0].tolist() == [8.0, 17.299999237060547]
+
+
+def test_goal_behind_a_mid_corridor_start_is_found(tmp_path):
+    """The forward laser never sees behind the start: once the corridor ahead is done, the robot
+    must come back for the half it has never seen (the classic frontier)."""
+    from semsearch_cli.config import StartSpec
+    from semsearch_cli.experiment import Loaded
+    from semsearch_cli.world.generate import generate_building
+    from semsearch_cli.world.scenario import build_world
+
+    p = generate_building("single", "floor", 0, tmp_path)
+    L = Loaded.load(p)
+    sc = L.sc.model_copy(update={"start": StartSpec(x=L.sc.start.x, y=L.sc.start.y, heading=0.0)})
+    world = build_world(sc, p.parent, str(p))
+    s = world.signs
+    behind = int(np.argmin(s.x))  # the westernmost sign, behind a robot facing east
+    res = Episode(world, sc, Variant("greedy", ()), s.number[behind], seed=0).run()
+    assert res.outcome == "found"
+    assert res.path[:, 0].max() > L.sc.start.x + 20  # it went east first, then came back

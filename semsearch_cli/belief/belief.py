@@ -240,7 +240,9 @@ class Belief:
         visited, touching a visited cell, where the robot fits), the one farthest from walls;
         groups whose branch does not lead on (fewer than 3 unvisited skeleton cells) are dropped.
         Where the skeleton crosses no frontier at all, each frontier group gives its widest cell
-        instead, so a search never stops while free space remains unvisited.
+        instead, and where no known free space is left unvisited, the classic frontier (cells next
+        to never-seen ones, see :meth:`_unknown_frontier`) is used, so a search never stops while
+        reachable space remains unexplored.
 
         Incremental: only a window around what changed since the last call (visited kernels,
         refreshed maps) is recomputed; candidates elsewhere cannot have changed and are kept.
@@ -272,7 +274,26 @@ class Belief:
         if len(out) == 0:
             r0, r1, c0, c1 = max(0, b[0] - 2), min(H, b[1] + 3), max(0, b[2] - 2), min(W, b[3] + 3)
             out = self._groups(self._front(r0, r1, c0, c1), r0, c0, need_branch=False)
+        if len(out) == 0:
+            out = self._unknown_frontier()
         return out
+
+    def _unknown_frontier(self) -> Candidates:
+        """Last resort, the classic frontier: cells where the robot fits within reach of cells
+        never seen. The forward laser never looks back, so a robot that starts mid-corridor and
+        drives to one end has seen nothing behind its start and, with every known cell visited,
+        would otherwise stop there."""
+        rr, cc = np.nonzero(self.seen)
+        if rr.size == 0:
+            return _empty()
+        H, W = self.seen.shape
+        k = int(np.ceil(self.min_clear / self.frame.res)) + 2
+        r0, r1, c0, c1 = max(0, rr.min() - k), min(H, rr.max() + k + 1), max(0, cc.min() - k), min(W, cc.max() + k + 1)
+        unseen = (~self.seen[r0:r1, c0:c1]).astype(np.uint8)
+        cross = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], np.uint8)
+        edge = cv2.dilate(unseen, cross).astype(bool) & self.free[r0:r1, c0:c1]  # free, 4-adjacent to unseen
+        near = cv2.dilate(edge.astype(np.uint8), np.ones((2 * k + 1, 2 * k + 1), np.uint8)).astype(bool)
+        return self._groups(near & self.passable[r0:r1, c0:c1], r0, c0, need_branch=False)
 
     def _front(self, r0, r1, c0, c1) -> np.ndarray:
         vis = self.visited[r0:r1, c0:c1]
