@@ -34,7 +34,7 @@ import yaml
 from ..errors import ScenarioError
 from ..geometry import GridFrame
 from ..gridalg import dijkstra
-from .mobilesim import OUTSIDE_GRAY
+from .mobilesim import OUTSIDE_GRAY, spread_goals
 
 LAYOUTS = ("grid", "wings", "angled", "single")
 SCHEMES = ("odd-even-out", "odd-even-in", "floor", "blocks", "random")
@@ -247,9 +247,7 @@ def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: 
         for lab, x, y, f in sorted(snapped):
             fh.write(f"{lab},{x},{y},{f}\n")
     if not goals:
-        from .mobilesim import _spread_goals
-
-        goals = _spread_goals(free, frame, snapped, plan.start)
+        goals = spread_goals(free, frame, snapped, plan.start)
     scen = {
         "name": name or f"{layout_name}-{scheme}-{seed}",
         "map": {"image": "map.png", "resolution": res},

@@ -23,7 +23,7 @@ import yaml
 
 from ..errors import ScenarioError
 from ..geometry import GridFrame
-from .mobilesim import MARGIN_M, OUTSIDE_GRAY, _spread_goals, snap_signs
+from .mobilesim import MARGIN_M, OUTSIDE_GRAY, spread_goals, snap_signs
 
 
 def _label(name: str):
@@ -115,7 +115,7 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         for label, x, y, f in snapped:
             fh.write(f"{label},{x},{y},{f}\n")
     if not goals:
-        goals = _spread_goals(main, frame, snapped, start)
+        goals = spread_goals(main, frame, snapped, start)
     scen = {
         "name": name or xml_path.stem,
         "map": {"image": "map.png", "resolution": res, "origin": [round(frame.origin_x, 4), round(frame.origin_y, 4)]},

@@ -144,7 +144,7 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
         for label, x, y, f in snapped:
             fh.write(f"{label},{x},{y},{f}\n")
     if not goals:
-        goals = _spread_goals(free, frame, snapped, start)
+        goals = spread_goals(free, frame, snapped, start)
     scen = {
         "name": name or map_path.stem,
         "map": {"image": "map.png", "resolution": res, "origin": [round(frame.origin_x, 4), round(frame.origin_y, 4)]},
@@ -161,7 +161,7 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
     return path
 
 
-def _spread_goals(free, frame, signs, start, k=4):
+def spread_goals(free, frame, signs, start, k=4):
     """k numeric signs at evenly spread quantiles of distance from the start (a default only)."""
     r, c = frame.to_index(*start)
     _, length, _ = dijkstra(free, np.ones((1, 1), np.float32), np.array([r]), np.array([c]),
