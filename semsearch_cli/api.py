@@ -52,13 +52,31 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
     out_dir = default_out(loaded, out)
+    from .report.build import write_meta
+
+    write_meta(out_dir, loaded.path)
     runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress, trace)
     wanted = {s.key for s in specs}
     mine = runs[[(str(p), str(g), int(s)) in wanted for p, g, s in zip(runs["planner"], runs["goal"], runs["seed"])]]
     summary = write_summary(runs, out_dir)
     if plots:
         write_path_plots(loaded, mine, out_dir)
+        report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
     return RunOutput(out_dir, runs, summary)
+
+
+def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", "html"), replay: bool = True) -> list[Path]:
+    """Rebuild every table and figure of one or several results folders from their runs.csv."""
+    from .errors import ScenarioError
+    from .report.build import ALL_FORMATS, build_report
+
+    bad = [f for f in formats if f not in ALL_FORMATS]
+    if bad:
+        raise ScenarioError("<command line>", "--format", f"unknown format(s) {bad}; valid: {', '.join(ALL_FORMATS)}")
+    for f in folders:
+        if not (Path(f) / "runs.csv").is_file():
+            raise ScenarioError(str(f), "", "no runs.csv here: give a folder written by `semsearch run`")
+    return build_report([Path(f) for f in folders], Path(out) if out else None, formats, replay)
 
 
 def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,

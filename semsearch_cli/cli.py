@@ -108,6 +108,25 @@ def _print_summary(summary):
 
 
 @app.command()
+def report(
+    folders: List[Path] = typer.Argument(..., help="Results folders (each with a runs.csv)."),
+    out_dir: Optional[Path] = typer.Option(None, "--out", help="Where to write (default: into each results folder)."),
+    fmt: str = typer.Option("md,csv,png,html", "--format", help="Comma-separated: md, csv, png, html."),
+    replay: bool = typer.Option(True, "--replay/--no-replay", help="Also re-simulate one run into an animated GIF."),
+):
+    """Rebuild the thesis' tables, significance tests and figures from runs.csv alone, plus one
+    self-contained report.md / report.html per results folder."""
+    from . import api
+
+    try:
+        files = api.report(folders, out_dir, [f.strip() for f in fmt.split(",") if f.strip()], replay)
+    except ScenarioError as exc:
+        _fail(exc)
+    for f in files:
+        out.print(f"wrote {f}")
+
+
+@app.command()
 def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""
     from . import api

@@ -51,8 +51,12 @@ class RunResult:
 class Episode:
     """A single search for ``goal`` by one planner variant in ``world``."""
 
-    def __init__(self, world: World, sc: Scenario, variant: Variant, goal, seed: int, trace: bool = False):
+    def __init__(self, world: World, sc: Scenario, variant: Variant, goal, seed: int, trace: bool = False,
+                 recorder=None):
+        """``recorder(belief, trail, distance, cands, decision)``, when given, is called at each
+        decision (for replays); it must not change the belief."""
         self.world, self.sc, self.variant, self.goal, self.seed = world, sc, variant, goal, seed
+        self.recorder = recorder
         self.goal_idx = world.signs.index_of(goal)
         self.laser = Laser(world, sc.laser)
         self.camera = DoorCamera(world, sc.door_camera)
@@ -140,6 +144,8 @@ class Episode:
                         break
                     kept = dec.info.get("kept", False)
                     decisions += not kept
+                    if self.recorder is not None and not kept:
+                        self.recorder(belief, trail, distance, cands, dec)
                     if self.keep_trace and not kept:
                         tx, ty = fr.to_world(dec.row, dec.col)
                         trace.append({"step": steps, "distance_m": round(distance, 3), "x": round(float(x), 3), "y": round(float(y), 3),

@@ -98,3 +98,79 @@ def plot_scenario(world, goals, title: str, out: Path) -> None:
     fig.savefig(tmp, dpi=130)
     plt.close(fig)
     os.replace(tmp, out)
+
+
+def _save(fig, out: Path) -> None:
+    tmp = out.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, out)
+
+
+def plot_boxes(runs, scenario: str, order: list, out: Path) -> None:
+    """Box plots of distance per goal (one panel each) and planner variant, shortest path dashed."""
+    sub = runs[runs["scenario"] == scenario]
+    goals = sorted(sub["goal"].unique(), key=str)
+    fig, axes = plt.subplots(1, len(goals), figsize=(max(4.5, 1.1 * len(order)) * len(goals) / 1.4, 4.2), squeeze=False)
+    for ax, g in zip(axes[0], goals):
+        d = sub[sub["goal"] == g]
+        labels = [lab for lab in order if (d["planner"] == lab).any()]
+        ax.boxplot([d[d["planner"] == lab]["distance_m"].to_numpy() for lab in labels], tick_labels=labels, showmeans=True)
+        ax.axhline(float(d["shortest_m"].iloc[0]), ls="--", c="tab:green", label="shortest path")
+        ax.set_title(f"{scenario}: goal {g}")
+        ax.set_ylabel("distance travelled (m)")
+        ax.tick_params(axis="x", labelrotation=35, labelsize=7)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    _save(fig, out)
+
+
+def plot_paths_overlay(world, paths: dict, goal, title: str, out: Path) -> None:
+    """The median run of each planner variant for one goal, overlaid on the ground-truth map."""
+    fr = world.frame
+    fig, ax = plt.subplots(figsize=(10, max(3.0, 10 * fr.height / fr.width)))
+    ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+    ax.scatter(world.signs.x, world.signs.y, s=5, c="#9999cc")
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, (lab, (path, dist)) in enumerate(paths.items()):
+        ax.plot(path[:, 0], path[:, 1], "-", lw=1.3, c=colors[k % len(colors)], label=f"{lab}: {dist:.1f} m", alpha=0.85)
+    ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start")
+    i = world.signs.index_of(goal)
+    ax.plot(world.signs.x[i], world.signs.y[i], "*", c="tab:red", ms=14, label=f"goal {goal}")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title)
+    ax.legend(loc="upper right", fontsize=7, framealpha=0.85)
+    fig.tight_layout()
+    _save(fig, out)
+
+
+def animate_run(world, frames: list, title: str, out: Path, fps: int = 5) -> None:
+    """A GIF replay: per frame the map the robot has built (free white, occupied black, unknown
+    gray), its path so far, the candidates and the chosen one."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    fr = world.frame
+    fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * fr.height / fr.width)))
+    ext = _extent(world)
+
+    def draw(k):
+        ax.clear()
+        f = frames[k]
+        ax.imshow(f["map"], cmap="gray", vmin=0, vmax=2, extent=ext, interpolation="nearest")
+        ax.plot(f["path"][:, 0], f["path"][:, 1], "-", c="tab:orange", lw=1)
+        if len(f["cands"]):
+            ax.scatter(f["cands"][:, 0], f["cands"][:, 1], s=25, c="tab:blue", label="candidates")
+        if f["target"] is not None:
+            ax.plot(*f["target"], "o", mfc="none", mec="tab:red", ms=12, mew=2, label="chosen")
+        ax.plot(f["path"][-1, 0], f["path"][-1, 1], "o", c="tab:green", ms=6, label="robot")
+        ax.set_title(f"{title}  {f['distance']:.0f} m")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.legend(loc="upper right", fontsize=6)
+
+    anim = FuncAnimation(fig, draw, frames=len(frames))
+    tmp = out.with_suffix(".tmp.gif")
+    anim.save(tmp, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    os.replace(tmp, out)

@@ -32,3 +32,112 @@ def median_run(runs: pd.DataFrame) -> pd.DataFrame:
         return df.iloc[(len(df) - 1) // 2]
 
     return runs.groupby(["scenario", "goal", "planner"], sort=True)[runs.columns.tolist()].apply(pick).reset_index(drop=True)
+
+
+# ---- the thesis' tables and what it lacked (issue: reports) -------------------------------------
+FIVE = ["median", "mean", "std", "min", "max"]
+
+
+def planner_order(labels) -> list[str]:
+    """greedy, bvp, geometric, other planners, then nsos variants by alpha."""
+    import re
+
+    def key(lab):
+        name = lab.split("[", 1)[0]
+        rank = {"greedy": 0, "bvp": 1, "geometric": 2, "nsos": 4}.get(name, 3)
+        m = re.search(r"alpha=([0-9.]+)", lab)
+        return (rank, name, float(m.group(1)) if m else 0.0, lab)
+
+    return sorted(set(labels), key=key)
+
+
+def five_statistics(runs: pd.DataFrame) -> pd.DataFrame:
+    """Tables 4.2-4.5: rows (scenario, goal, statistic) for the five statistics of distance_m,
+    one column per planner variant."""
+    s = summarise(runs)
+    long = s.melt(id_vars=["scenario", "goal", "planner"], value_vars=FIVE, var_name="statistic")
+    t = long.pivot_table(index=["scenario", "goal", "statistic"], columns="planner", values="value", sort=False)
+    t = t.reindex(columns=planner_order(t.columns))
+    order = {k: i for i, k in enumerate(FIVE)}
+    return t.sort_index(level=[0, 1, 2], key=lambda idx: idx.map(order) if idx.name == "statistic" else idx)
+
+
+def mean_std(runs: pd.DataFrame) -> pd.DataFrame:
+    """Tables 4.6-4.9: ``mean +- std`` per goal and variant beside the shortest path (m)."""
+    s = summarise(runs)
+    s["cell"] = s.apply(lambda r: f"{r['mean']:.2f} ± {0.0 if pd.isna(r['std']) else r['std']:.2f}", axis=1)
+    t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="cell", aggfunc="first")
+    t = t.reindex(columns=planner_order(t.columns))
+    t["shortest_m"] = s.groupby(["scenario", "goal"])["shortest_m"].first()
+    return t
+
+
+def percent_of_optimal(runs: pd.DataFrame) -> pd.DataFrame:
+    """Table 4.10: mean distance as a percentage of the shortest path."""
+    s = summarise(runs)
+    s["pct"] = (100.0 * s["mean"] / s["shortest_m"]).round(2)
+    t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="pct")
+    return t.reindex(columns=planner_order(t.columns))
+
+
+def success_and_spl(runs: pd.DataFrame) -> pd.DataFrame:
+    """Success rate and mean SPL (Anderson et al. 2018) per goal and variant."""
+    g = runs.groupby(["scenario", "goal", "planner"])
+    return g.agg(n=("success", "size"), success_rate=("success", "mean"), spl=("spl", "mean"),
+                 budget=("outcome", lambda o: int((o == "budget").sum())),
+                 stuck=("outcome", lambda o: int((o == "stuck").sum()))).round(3).reset_index()
+
+
+MIN_N = 5
+
+
+def significance(runs: pd.DataFrame, baseline: str = "greedy") -> pd.DataFrame:
+    """Per goal, a two-sided Mann-Whitney U test (SciPy) of distance_m between ``baseline`` and
+    each other variant, with the rank-biserial effect size r = 1 - 2U / (n1 n2) (positive when
+    the variant travels less than the baseline) and a note when either sample has fewer than
+    ``MIN_N`` runs (too few for the test to mean much)."""
+    from scipy.stats import mannwhitneyu
+
+    rows = []
+    for (scen, goal), g in runs.groupby(["scenario", "goal"]):
+        base = g[g["planner"] == baseline]["distance_m"].to_numpy()
+        for lab in planner_order(g["planner"]):
+            if lab == baseline:
+                continue
+            x = g[g["planner"] == lab]["distance_m"].to_numpy()
+            row = {"scenario": scen, "goal": goal, "baseline": baseline, "planner": lab, "n_baseline": len(base), "n": len(x)}
+            if len(base) and len(x):
+                u, p = mannwhitneyu(x, base, alternative="two-sided")
+                row.update(U=float(u), p_value=float(p), effect_r=round(1.0 - 2.0 * float(u) / (len(x) * len(base)), 3))
+            else:
+                row.update(U=float("nan"), p_value=float("nan"), effect_r=float("nan"))
+            row["note"] = f"n < {MIN_N}: too few runs to judge" if min(len(base), len(x)) < MIN_N else ""
+            rows.append(row)
+    return pd.DataFrame(rows, columns=["scenario", "goal", "baseline", "planner", "n_baseline", "n", "U", "p_value", "effect_r", "note"])
+
+
+def markdown(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> str:
+    """A DataFrame as a Markdown table (index levels become leading columns). With ``mark_rows``
+    the smallest value of each row is **bold** and the largest _italic_ (the thesis' green and
+    red cells)."""
+    idx_names = [n or "" for n in (df.index.names if df.index.nlevels > 1 or df.index.name else [])]
+    cols = [str(c) for c in df.columns]
+    lines = ["| " + " | ".join(idx_names + cols) + " |", "|" + "---|" * (len(idx_names) + len(cols))]
+    for key, row in df.iterrows():
+        keys = list(key) if isinstance(key, tuple) else ([key] if idx_names else [])
+        vals = row.to_numpy()
+        num = pd.to_numeric(pd.Series(vals), errors="coerce")
+        lo, hi = (num.min(), num.max()) if mark_rows and num.notna().sum() > 1 else (None, None)
+        cells = []
+        for v, nv in zip(vals, num):
+            if isinstance(v, float) and pd.isna(v):
+                cells.append("")
+                continue
+            text = fmt.format(v) if isinstance(v, (float, int)) and not isinstance(v, bool) else str(v)
+            if lo is not None and nv == lo:
+                text = f"**{text}**"
+            elif hi is not None and nv == hi and hi != lo:
+                text = f"_{text}_"
+            cells.append(text)
+        lines.append("| " + " | ".join([str(k) for k in keys] + cells) + " |")
+    return "\n".join(lines)
