@@ -1,0 +1,90 @@
+"""Reports rebuilt from rows: statistics agree with pandas, half-finished files work."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import mannwhitneyu
+from typer.testing import CliRunner
+
+from semsearch_cli.cli import app
+from semsearch_cli.metrics import COLUMNS
+from semsearch_cli.report import tables as T
+
+
+def fixed_runs(n=6):
+    rng = np.random.default_rng(4)
+    rows = []
+    for goal, shortest in ((54, 17.5), (124, 32.0)):
+        for label, params, scale in (("greedy", "{}", 6.0), ("nsos[alpha=0.9]", '{"alpha": 0.9}', 3.0), ("bvp", "{}", 7.0)):
+            for seed in range(n):
+                d = round(float(shortest * scale * rng.uniform(0.6, 1.4)), 1)
+                rows.append({"scenario": "s", "planner": label, "params": params, "goal": goal, "seed": seed,
+                             "outcome": "found", "success": 1, "distance_m": d, "shortest_m": shortest,
+                             "ratio": d / shortest, "spl": shortest / d, "steps": int(d * 10), "decisions": 5,
+                             "navigator": "geodesic", "wall_s": 0.1})
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def test_statistics_match_pandas():
+    runs = fixed_runs()
+    five = T.five_statistics(runs)
+    for (goal, lab), g in runs.groupby(["goal", "planner"]):
+        d = g["distance_m"]
+        for stat, want in (("median", d.median()), ("mean", d.mean()), ("std", d.std()), ("min", d.min()), ("max", d.max())):
+            assert five.loc[("s", goal, stat), lab] == pytest.approx(want, abs=1e-3)
+    pct = T.percent_of_optimal(runs)
+    g = runs[(runs.goal == 54) & (runs.planner == "bvp")]
+    assert pct.loc[("s", 54), "bvp"] == pytest.approx(100 * g["distance_m"].mean() / 17.5, abs=0.01)
+    assert list(five.columns) == ["greedy", "bvp", "nsos[alpha=0.9]"]
+
+
+def test_significance_is_scipys_mann_whitney():
+    runs = fixed_runs()
+    sig = T.significance(runs).set_index(["goal", "planner"])
+    a = runs[(runs.goal == 124) & (runs.planner == "nsos[alpha=0.9]")]["distance_m"]
+    b = runs[(runs.goal == 124) & (runs.planner == "greedy")]["distance_m"]
+    u, p = mannwhitneyu(a, b, alternative="two-sided")
+    row = sig.loc[(124, "nsos[alpha=0.9]")]
+    assert row["U"] == u and row["p_value"] == pytest.approx(p)
+    assert row["effect_r"] == pytest.approx(1 - 2 * u / 36, abs=1e-3) and row["effect_r"] > 0.5  # nsos travels less
+    assert row["note"] == ""
+    small = T.significance(fixed_runs(3))
+    assert (small["note"].str.contains("too few")).all()
+
+
+def test_best_and_worst_are_marked():
+    md = T.markdown(pd.DataFrame({"a": [1.0, 5.0], "b": [2.0, 3.0]}, index=pd.Index(["x", "y"], name="row")), mark_rows=True)
+    assert "| x | **1.00** | _2.00_ |" in md and "| y | _5.00_ | **3.00** |" in md
+
+
+def test_report_from_a_half_finished_runs_csv(demo_dir, tmp_path):
+    out = tmp_path / "r"
+    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "2", "--goal", "452", "--workers", "1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert (out / "report.md").is_file() and (out / "report.html").is_file()  # run writes the report too
+    text = (out / "runs.csv").read_text().splitlines()
+    (out / "runs.csv").write_text("\n".join(text[:3]) + "\n" + text[3][:20])  # two rows and a torn one
+    res = CliRunner().invoke(app, ["report", str(out), "--out", str(tmp_path / "rep"), "--no-replay"])
+    assert res.exit_code == 0, res.output
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert "2 finished runs" in md and "Mann-Whitney" in md
+    html = (tmp_path / "rep" / "report.html").read_text()
+    assert "data:image/png;base64," in html  # figures inlined: the page stands alone
+    t = pd.read_csv(tmp_path / "rep" / "tables" / "summary.csv")
+    assert t["n"].sum() == 2
+
+
+def test_report_with_replay_and_several_folders(demo_dir, tmp_path):
+    for k in ("a", "b"):
+        res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "1", "--goal", "304", "--workers", "1", "--out", str(tmp_path / k)])
+        assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(app, ["report", str(tmp_path / "a"), str(tmp_path / "b"), "--out", str(tmp_path / "both")])
+    assert res.exit_code == 0, res.output
+    for k in ("a", "b"):
+        assert (tmp_path / "both" / k / "report.html").is_file()
+        assert list((tmp_path / "both" / k / "figures").glob("replay_*.gif"))
+
+
+def test_report_errors(tmp_path):
+    res = CliRunner().invoke(app, ["report", str(tmp_path)])
+    assert res.exit_code == 2 and "runs.csv" in res.output
