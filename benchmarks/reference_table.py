@@ -22,6 +22,7 @@ from thesis import GREEDY, MAPS, NSOS, SHORTEST  # noqa: E402
 from semsearch_cli.config import PlannerSpec  # noqa: E402
 from semsearch_cli.experiment import Loaded, expand, run_batch  # noqa: E402
 from semsearch_cli.planners import expand_variants  # noqa: E402
+from semsearch_cli.report.build import write_meta  # noqa: E402
 from semsearch_cli.report.tables import summarise  # noqa: E402
 from semsearch_cli.world.mobilesim import import_mobilesim  # noqa: E402
 from semsearch_cli.world.scenario import build_world  # noqa: E402
@@ -65,6 +66,7 @@ def main() -> int:
         L.world = build_world(L.sc, p.parent, str(p))
         todo = expand(L, a.seeds)
         t0 = time.perf_counter()
+        write_meta(a.out / name.lower(), p)
         runs = run_batch(L, todo, a.out / name.lower(), a.workers)
         print(f"{name}: {len(todo)} runs in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
         s = summarise(runs).set_index(["goal", "planner"])
