@@ -21,6 +21,7 @@ import pandas as pd
 
 from .. import __version__
 from . import tables as T
+from .tables import goal_key
 
 ALL_FORMATS = ("md", "csv", "png", "html")
 
@@ -126,7 +127,7 @@ def _figures(runs, folder: Path, out: Path, order, meta, replay):
     world = _world(meta, notes)
     if world is not None:
         med = T.median_run(runs)
-        for goal in sorted(med["goal"].unique(), key=str):
+        for goal in sorted(med["goal"].unique(), key=goal_key):
             paths = {}
             for _, r in med[med["goal"] == goal].iterrows():
                 p = folder / "paths" / f"{_stem(r['planner'], goal, int(r['seed']))}.npz"
@@ -179,7 +180,7 @@ def _replay(world, runs, meta, fdir, order, notes):
     w, sc = world
     label = order[-1]
     params = json.loads(runs[runs["planner"] == label]["params"].iloc[0])
-    goal = sorted(runs["goal"].unique(), key=str)[0]
+    goal = sorted(runs["goal"].unique(), key=goal_key)[0]
     med = T.median_run(runs[(runs["planner"] == label) & (runs["goal"] == goal)])
     if med.empty:
         return None

@@ -6,6 +6,8 @@ import json
 import os
 from pathlib import Path
 
+from .tables import goal_key
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -49,7 +51,7 @@ def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy") -> None:
     the baseline planner (greedy) as a dashed line with its spread shaded."""
     nsos = runs[runs["planner"].str.startswith("nsos")].copy()
     nsos["alpha"] = nsos["params"].map(lambda p: json.loads(p).get("alpha", 0.9))
-    goals = sorted(runs["goal"].unique(), key=str)
+    goals = sorted(runs["goal"].unique(), key=goal_key)
     fig, axes = plt.subplots(1, len(goals), figsize=(4.2 * len(goals), 3.6), squeeze=False, sharey=False)
     for ax, g in zip(axes[0], goals):
         d = nsos[nsos["goal"] == g].groupby("alpha")["ratio"].agg(["mean", "std", "count"]).reset_index()
@@ -110,7 +112,7 @@ def _save(fig, out: Path) -> None:
 def plot_boxes(runs, scenario: str, order: list, out: Path) -> None:
     """Box plots of distance per goal (one panel each) and planner variant, shortest path dashed."""
     sub = runs[runs["scenario"] == scenario]
-    goals = sorted(sub["goal"].unique(), key=str)
+    goals = sorted(sub["goal"].unique(), key=goal_key)
     fig, axes = plt.subplots(1, len(goals), figsize=(max(4.5, 1.1 * len(order)) * len(goals) / 1.4, 4.2), squeeze=False)
     for ax, g in zip(axes[0], goals):
         d = sub[sub["goal"] == g]

@@ -38,6 +38,12 @@ def median_run(runs: pd.DataFrame) -> pd.DataFrame:
 FIVE = ["median", "mean", "std", "min", "max"]
 
 
+def goal_key(g):
+    """Sort goals numerically when they are numbers, then as text."""
+    s = str(g)
+    return (0, int(s), "") if s.lstrip("-").isdigit() else (1, 0, s)
+
+
 def planner_order(labels) -> list[str]:
     """greedy, bvp, geometric, other planners, then nsos variants by alpha."""
     import re
