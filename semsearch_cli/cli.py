@@ -127,6 +127,41 @@ def report(
 
 
 @app.command()
+def presence(
+    counts_file: Path = typer.Argument(..., help="CSV: first column the hour (0-23), one column per place."),
+    hours: str = typer.Option(..., "--hours", help="Comma-separated request hours, e.g. 1,10,16,18,22."),
+    out_file: Optional[Path] = typer.Option(None, "--out", help="Also write the scores to this CSV."),
+):
+    """Score every place at each request hour from hourly counts (thesis 5.3.5, Eq. 5.3); the
+    highest of each hour is marked."""
+    from .objects.presence import presence_scores, read_counts
+
+    try:
+        try:
+            hs = [float(h) for h in hours.split(",") if h.strip()]
+        except ValueError:
+            raise ScenarioError("<command line>", "--hours", f"expected comma-separated hours, got {hours!r}") from None
+        if not hs or any(not 0 <= h < 24 for h in hs):
+            raise ScenarioError("<command line>", "--hours", f"hours must lie in 0-23, got {hours!r}")
+        scores = presence_scores(read_counts(counts_file), hs)
+    except ScenarioError as exc:
+        _fail(exc)
+    t = Table(title=f"presence score per place (sum of counts x W, Eq. 5.3), * = highest")
+    t.add_column("hour", justify="right")
+    for c in scores.columns:
+        t.add_column(escape(str(c)), justify="right")
+    for rh, row in scores.iterrows():
+        best = row.idxmax()
+        t.add_row(f"{rh:g}", *[f"{v:.2f}" + ("*" if c == best else "") for c, v in row.items()])
+    out.print(t)
+    if out_file:
+        tmp = out_file.with_suffix(out_file.suffix + ".tmp")
+        scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv(tmp)
+        tmp.replace(out_file)
+        out.print(f"wrote {out_file}")
+
+
+@app.command()
 def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""
     from . import api

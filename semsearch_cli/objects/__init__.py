@@ -1,0 +1,1 @@
+"""Object search over time (thesis chapter 5)."""
