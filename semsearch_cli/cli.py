@@ -146,7 +146,7 @@ def presence(
         scores = presence_scores(read_counts(counts_file), hs)
     except ScenarioError as exc:
         _fail(exc)
-    t = Table(title=f"presence score per place (sum of counts x W, Eq. 5.3), * = highest")
+    t = Table(title="presence score per place (sum of counts x W, Eq. 5.3), * = highest")
     t.add_column("hour", justify="right")
     for c in scores.columns:
         t.add_column(escape(str(c)), justify="right")
