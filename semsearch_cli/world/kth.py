@@ -19,11 +19,11 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-import yaml
 
 from ..errors import ScenarioError
 from ..geometry import GridFrame
-from .mobilesim import MARGIN_M, OUTSIDE_GRAY, spread_goals, snap_signs
+from .files import map_image, scenario_dict, write_building
+from .mobilesim import MARGIN_M, snap_signs, spread_goals
 
 
 def _label(name: str):
@@ -105,27 +105,7 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         raw.append((label if k == 1 else f"{label}/{k}", x, y, 0.0))
     snapped = snap_signs(free, frame, raw)
 
-    img = np.full((H, W), OUTSIDE_GRAY, np.uint8)
-    img[free] = 255
-    img[walls] = 0
-    out.mkdir(parents=True, exist_ok=True)
-    cv2.imwrite(str(out / "map.png"), img)
-    with (out / "doors.csv").open("w") as fh:
-        fh.write("number,x,y,facing\n")
-        for label, x, y, f in snapped:
-            fh.write(f"{label},{x},{y},{f}\n")
     if not goals:
         goals = spread_goals(main, frame, snapped, start)
-    scen = {
-        "name": name or xml_path.stem,
-        "map": {"image": "map.png", "resolution": res, "origin": [round(frame.origin_x, 4), round(frame.origin_y, 4)]},
-        "start": {"x": start[0], "y": start[1], "heading": "random"},
-        "doors": "doors.csv",
-        "goals": list(goals),
-        "planners": [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}],
-        "belief": {"density_delta": density_delta},
-        "experiment": {"seeds": 10, "base_seed": 0, "max_distance": 2000.0},
-    }
-    path = out / "scenario.yaml"
-    path.write_text(f"# imported from {xml_path.name} by `semsearch import kth`\n" + yaml.safe_dump(scen, sort_keys=False))
-    return path
+    scen = scenario_dict(name or xml_path.stem, res, start, goals, None, density_delta, (frame.origin_x, frame.origin_y))
+    return write_building(out, map_image(free, walls), snapped, scen, f"imported from {xml_path.name} by `semsearch import kth`")

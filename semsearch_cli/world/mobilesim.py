@@ -13,15 +13,14 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-import yaml
 from scipy import ndimage
 
 from ..errors import ScenarioError
 from ..geometry import GridFrame
 from ..gridalg import dijkstra
+from .files import map_image, scenario_dict, write_building
 
 MARGIN_M = 1.0
-OUTSIDE_GRAY = 160
 
 
 def read_mobilesim_lines(path: Path) -> np.ndarray:
@@ -134,31 +133,12 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
     free = lab == lab[r, c]
     snapped = snap_signs(free, frame, signs)
 
-    img = np.full(free.shape, OUTSIDE_GRAY, np.uint8)
-    img[free] = 255
-    img[walls] = 0
-    out.mkdir(parents=True, exist_ok=True)
-    cv2.imwrite(str(out / "map.png"), img)
-    with (out / "doors.csv").open("w") as fh:
-        fh.write("number,x,y,facing\n")
-        for label, x, y, f in snapped:
-            fh.write(f"{label},{x},{y},{f}\n")
     if not goals:
         goals = spread_goals(free, frame, snapped, start)
-    scen = {
-        "name": name or map_path.stem,
-        "map": {"image": "map.png", "resolution": res, "origin": [round(frame.origin_x, 4), round(frame.origin_y, 4)]},
-        "start": {"x": float(start[0]), "y": float(start[1]), "heading": "random"},
-        "doors": "doors.csv",
-        "goals": list(goals),
-        "planners": [{"name": "greedy"}, {"name": "bvp"}],
-        "belief": {"density_delta": density_delta},
-        "experiment": {"seeds": 10, "base_seed": 0, "max_distance": 2000.0},
-    }
-    path = out / "scenario.yaml"
-    path.write_text(f"# imported from {map_path.name} and {doors_path.name} by `semsearch import mobilesim`\n"
-                    + yaml.safe_dump(scen, sort_keys=False))
-    return path
+    scen = scenario_dict(name or map_path.stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
+                         density_delta, (frame.origin_x, frame.origin_y))
+    return write_building(out, map_image(free, walls), snapped, scen,
+                          f"imported from {map_path.name} and {doors_path.name} by `semsearch import mobilesim`")
 
 
 def spread_goals(free, frame, signs, start, k=4):

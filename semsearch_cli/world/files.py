@@ -1,0 +1,52 @@
+"""Writing a building as a scenario folder (map.png, doors.csv, scenario.yaml): shared by the
+importers and the generator."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+OUTSIDE_GRAY = 160
+DEFAULT_PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
+
+
+def map_image(free: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """(H, W) uint8: free 255, walls 0, everything else the "outside" gray."""
+    img = np.full(free.shape, OUTSIDE_GRAY, np.uint8)
+    img[free] = 255
+    img[walls] = 0
+    return img
+
+
+def scenario_dict(name: str, res: float, start, goals, planners=None, density_delta: float = 2.5, origin=None) -> dict:
+    """The scenario of a building folder, with the experiment defaults (10 seeds, 2000 m)."""
+    m = {"image": "map.png", "resolution": res}
+    if origin is not None:
+        m["origin"] = [round(float(origin[0]), 4), round(float(origin[1]), 4)]
+    return {
+        "name": name,
+        "map": m,
+        "start": {"x": round(float(start[0]), 3), "y": round(float(start[1]), 3), "heading": "random"},
+        "doors": "doors.csv",
+        "goals": [int(g) if isinstance(g, (int, np.integer)) else g for g in goals],
+        "planners": planners or DEFAULT_PLANNERS,
+        "belief": {"density_delta": density_delta},
+        "experiment": {"seeds": 10, "base_seed": 0, "max_distance": 2000.0},
+    }
+
+
+def write_building(out: Path, img: np.ndarray, signs, scen: dict, header: str) -> Path:
+    """Write ``out/map.png``, ``out/doors.csv`` (signs: (label, x, y, facing_deg)) and
+    ``out/scenario.yaml`` (prefixed by the comment ``header``); returns the YAML path."""
+    out.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(out / "map.png"), img)
+    with (out / "doors.csv").open("w") as fh:
+        fh.write("number,x,y,facing\n")
+        for label, x, y, f in signs:
+            fh.write(f"{label},{x},{y},{f}\n")
+    path = out / "scenario.yaml"
+    path.write_text(f"# {header}\n" + yaml.safe_dump(scen, sort_keys=False))
+    return path
