@@ -13,8 +13,11 @@ OUTSIDE_GRAY = 160
 DEFAULT_PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
 
 
-def map_image(free: np.ndarray, walls: np.ndarray) -> np.ndarray:
-    """(H, W) uint8: free 255, walls 0, everything else the "outside" gray."""
+def map_image(free: np.ndarray, walls: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) uint8: free 255, walls 0, everything else the "outside" gray. Without ``walls`` the
+    wall is the one-cell ring around the free space."""
+    if walls is None:
+        walls = cv2.dilate(free.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & ~free
     img = np.full(free.shape, OUTSIDE_GRAY, np.uint8)
     img[free] = 255
     img[walls] = 0

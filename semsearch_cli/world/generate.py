@@ -112,9 +112,7 @@ def rasterise(plan: Plan, res: float) -> tuple[np.ndarray, GridFrame]:
         pts = [a - u * ea + n * h, b + u * h + n * h, b + u * h - n * h, a - u * ea - n * h]
         r, cc = frame.to_cell(np.array([p[0] for p in pts]), np.array([p[1] for p in pts]))
         cv2.fillPoly(free, [np.stack([cc, r], axis=1).round().astype(np.int32)], 1)
-    free = free.astype(bool)
-    walls = cv2.dilate(free.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & ~free
-    return map_image(free, walls), frame
+    return map_image(free.astype(bool)), frame
 
 
 @dataclass

@@ -87,7 +87,6 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
             cv2.fillPoly(free, [np.stack([c, r], axis=1).round().astype(np.int32)], 1)
     # erode the outline by one cell: the wall is drawn inside each corridor's contour
     free = cv2.erode(free, np.ones((3, 3), np.uint8)).astype(bool)
-    walls = cv2.dilate(free.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & ~free
     n, lab = cv2.connectedComponents(free.astype(np.uint8), connectivity=4)
     sizes = np.bincount(lab.ravel())
     sizes[0] = 0
@@ -108,4 +107,4 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
     if not goals:
         goals = spread_goals(main, frame, snapped, start)
     scen = scenario_dict(name or xml_path.stem, res, start, goals, None, density_delta, (frame.origin_x, frame.origin_y))
-    return write_building(out, map_image(free, walls), snapped, scen, f"imported from {xml_path.name} by `semsearch import kth`")
+    return write_building(out, map_image(free), snapped, scen, f"imported from {xml_path.name} by `semsearch import kth`")
