@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import ScenarioError
-from .experiment import Loaded, expand, file_stem, read_runs, run_batch
+from .experiment import Loaded, expand, file_stem, run_batch
 
 
 @dataclass
@@ -168,7 +168,3 @@ def show(scenario: str | Path, out: str | Path) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     plot_scenario(world, sc.goals, f"{sc.name}: {len(world.signs)} signs, goals {', '.join(map(str, sc.goals))}", out)
     return out
-
-
-def read_results(folder: str | Path) -> pd.DataFrame:
-    return read_runs(Path(folder) / "runs.csv")

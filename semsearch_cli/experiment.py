@@ -57,7 +57,7 @@ class Loaded:
     shortest: dict
 
     @classmethod
-    def load(cls, path: Path, check: bool = True) -> "Loaded":
+    def load(cls, path: Path) -> "Loaded":
         sc = load_scenario(path)
         world = build_world(sc, path.parent, str(path))
         shortest = check_goals_reachable(world, sc.goals, str(path))

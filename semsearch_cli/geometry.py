@@ -54,6 +54,3 @@ class GridFrame:
         x = self.origin_x + (np.asarray(col, float) + 0.5) * self.res
         y = self.origin_y + (self.height - np.asarray(row, float) - 0.5) * self.res
         return x, y
-
-    def inside(self, row, col) -> bool:
-        return 0 <= row < self.height and 0 <= col < self.width

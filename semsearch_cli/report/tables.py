@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import pandas as pd
 
-STATS = ["n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]
-
-
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     """Per scenario x goal x planner variant: n, success rate, median, mean, std (ddof=1, as the
     thesis' tables), min and max of distance_m, the shortest path and the mean ratio."""
