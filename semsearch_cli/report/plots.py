@@ -20,12 +20,34 @@ def _extent(world):
     return (fr.origin_x, fr.origin_x + fr.width * fr.res, fr.origin_y, fr.origin_y + fr.height * fr.res)
 
 
+def _map_figure(world, width: float = 10.0):
+    """A figure with the ground-truth map drawn (free light, the rest dark), axes in metres."""
+    fr = world.frame
+    fig, ax = plt.subplots(figsize=(width, max(3.0, width * fr.height / fr.width)))
+    ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+    return fig, ax
+
+
+def _finish_map(fig, ax, title: str, out: Path, dpi: int = 110) -> None:
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title)
+    ax.legend(loc="upper right", fontsize=7, framealpha=0.85)
+    fig.tight_layout()
+    _save(fig, out, dpi)
+
+
+def _save(fig, out: Path, dpi: int = 110) -> None:
+    """Write a figure atomically and close it."""
+    tmp = out.with_suffix(".tmp" + out.suffix)
+    fig.savefig(tmp, dpi=dpi)
+    plt.close(fig)
+    os.replace(tmp, out)
+
+
 def plot_path(world, path: np.ndarray, read_signs, goal, title: str, out: Path) -> None:
     """The path of one run over the ground-truth map with the start, the signs read and the goal."""
-    fr = world.frame
-    aspect = fr.height / fr.width
-    fig, ax = plt.subplots(figsize=(10, max(3.0, 10 * aspect)))
-    ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+    fig, ax = _map_figure(world)
     s = world.signs
     ax.scatter(s.x, s.y, s=6, c="#9999cc", label="signs")
     if len(read_signs):
@@ -35,15 +57,7 @@ def plot_path(world, path: np.ndarray, read_signs, goal, title: str, out: Path) 
     ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start")
     g = s.index_of(goal)
     ax.plot(s.x[g], s.y[g], "*", c="tab:red", ms=14, label=f"goal {goal}")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(title)
-    ax.legend(loc="upper right", fontsize=7, framealpha=0.8)
-    fig.tight_layout()
-    tmp = out.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    os.replace(tmp, out)
+    _finish_map(fig, ax, title, out)
 
 
 def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy") -> None:
@@ -68,18 +82,12 @@ def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy") -> None:
         ax.legend(fontsize=7)
     fig.suptitle("alpha sweep: mean ratio to the shortest path, +- std over seeds")
     fig.tight_layout()
-    tmp = out.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    os.replace(tmp, out)
+    _save(fig, out)
 
 
 def plot_scenario(world, goals, title: str, out: Path) -> None:
     """The ground-truth map with every sign (dot, number, facing tick), the start and the goals."""
-    fr = world.frame
-    aspect = fr.height / fr.width
-    fig, ax = plt.subplots(figsize=(12, max(3.5, 12 * aspect)))
-    ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+    fig, ax = _map_figure(world, 12.0)
     s = world.signs
     ax.quiver(s.x, s.y, np.cos(s.facing), np.sin(s.facing), color="tab:blue", scale=40, width=0.002)
     ax.scatter(s.x, s.y, s=8, c="tab:blue", label=f"signs ({len(s)})")
@@ -91,22 +99,7 @@ def plot_scenario(world, goals, title: str, out: Path) -> None:
         ax.plot(s.x[i], s.y[i], "*", c="tab:red", ms=14)
         ax.annotate(f"goal {g}", (s.x[i], s.y[i]), fontsize=8, color="tab:red", xytext=(4, -10), textcoords="offset points")
     ax.plot(*world.start_xy, "s", c="tab:green", ms=9, label="start")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(title)
-    ax.legend(loc="upper right", fontsize=7, framealpha=0.8)
-    fig.tight_layout()
-    tmp = out.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=130)
-    plt.close(fig)
-    os.replace(tmp, out)
-
-
-def _save(fig, out: Path) -> None:
-    tmp = out.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    os.replace(tmp, out)
+    _finish_map(fig, ax, title, out, dpi=130)
 
 
 def plot_boxes(runs, scenario: str, order: list, out: Path) -> None:
@@ -129,9 +122,7 @@ def plot_boxes(runs, scenario: str, order: list, out: Path) -> None:
 
 def plot_paths_overlay(world, paths: dict, goal, title: str, out: Path) -> None:
     """The median run of each planner variant for one goal, overlaid on the ground-truth map."""
-    fr = world.frame
-    fig, ax = plt.subplots(figsize=(10, max(3.0, 10 * fr.height / fr.width)))
-    ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+    fig, ax = _map_figure(world)
     ax.scatter(world.signs.x, world.signs.y, s=5, c="#9999cc")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (lab, (path, dist)) in enumerate(paths.items()):
@@ -139,12 +130,7 @@ def plot_paths_overlay(world, paths: dict, goal, title: str, out: Path) -> None:
     ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start")
     i = world.signs.index_of(goal)
     ax.plot(world.signs.x[i], world.signs.y[i], "*", c="tab:red", ms=14, label=f"goal {goal}")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(title)
-    ax.legend(loc="upper right", fontsize=7, framealpha=0.85)
-    fig.tight_layout()
-    _save(fig, out)
+    _finish_map(fig, ax, title, out)
 
 
 def animate_run(world, frames: list, title: str, out: Path, fps: int = 5) -> None:
