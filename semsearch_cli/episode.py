@@ -154,6 +154,7 @@ class Episode:
                     p = navigator.plan(belief, r, c, dec.row, dec.col)
                     if p is not None and len(p[0]) >= 2:
                         path_r, path_c = p
+                        px, py = fr.to_world(path_r, path_c)
                         break
                     keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
                     if keep.all():
@@ -166,7 +167,6 @@ class Episode:
                 since_plan = 0.0
                 looked_around = False
             # 4. move one step along the path
-            px, py = fr.to_world(path_r, path_c)
             remaining = step_len
             moved = 0.0
             while remaining > 1e-12 and path_i < len(path_r):

@@ -21,7 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ..navigation.harmonic import FLAT, ascend, harmonic_field
 from .base import Decision, Planner, register_planner
-from .greedy import Greedy
+from .greedy import nearest_candidate
 
 
 class BVPParams(BaseModel):
@@ -74,7 +74,7 @@ class BVP(Planner):
                     fr, fcol = np.nonzero(front[br : br + k, bc : bc + k])
                     j = int(np.argmin((fr + br - (ctx.row - r0)) ** 2 + (fcol + bc - (ctx.col - c0)) ** 2))
                     return Decision(int(fr[j] + br + r0), int(fcol[j] + bc + c0), {"u_robot": float(u[rr, rc])})
-        d = Greedy(self.params).choose(ctx, cands)
+        d = nearest_candidate(ctx, cands)
         if d is not None:
             d.info["fallback"] = "nearest"
         return d

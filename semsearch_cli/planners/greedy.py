@@ -7,15 +7,20 @@ import numpy as np
 from .base import Decision, Planner, register_planner
 
 
+def nearest_candidate(ctx, cands) -> Decision | None:
+    """The candidate nearest to the robot along the skeleton (ties: the run's generator)."""
+    if len(cands) == 0:
+        return None
+    gs = ctx.belief.search(ctx.row, ctx.col, cands.rows, cands.cols, 1)
+    d = gs.lengths(cands.rows, cands.cols)
+    if not np.isfinite(d).any():
+        return None
+    best = np.flatnonzero(d == d.min())
+    k = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+    return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k])})
+
+
 @register_planner("greedy")
 class Greedy(Planner):
     def choose(self, ctx, cands):
-        if len(cands) == 0:
-            return None
-        gs = ctx.belief.search(ctx.row, ctx.col, cands.rows, cands.cols, 1)
-        d = gs.lengths(cands.rows, cands.cols)
-        if not np.isfinite(d).any():
-            return None
-        best = np.flatnonzero(d == d.min())
-        k = int(best[0] if best.size == 1 else ctx.rng.choice(best))
-        return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k])})
+        return nearest_candidate(ctx, cands)

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from ..experiment import file_stem
 from . import tables as T
 from .tables import goal_key
 
@@ -45,12 +46,6 @@ def _atomic_text(path: Path, text: str) -> None:
     tmp = path.with_suffix(path.suffix + ".tmp")
     tmp.write_text(text)
     os.replace(tmp, path)
-
-
-def _stem(label: str, goal, seed=None) -> str:
-    from ..experiment import file_stem
-
-    return file_stem(label, goal, seed)
 
 
 def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMATS, replay: bool = True) -> list[Path]:
@@ -130,7 +125,7 @@ def _figures(runs, folder: Path, out: Path, order, meta, replay):
         for goal in sorted(med["goal"].unique(), key=goal_key):
             paths = {}
             for _, r in med[med["goal"] == goal].iterrows():
-                p = folder / "paths" / f"{_stem(r['planner'], goal, int(r['seed']))}.npz"
+                p = folder / "paths" / f"{file_stem(r['planner'], goal, int(r['seed']))}.npz"
                 if p.is_file():
                     paths[r["planner"]] = (np.load(p)["path"], float(r["distance_m"]))
             if paths:
@@ -203,7 +198,7 @@ def _replay(world, runs, meta, fdir, order, notes):
     res = Episode(w, sc, Variant(label.split("[")[0], tuple(sorted(params.items()))), g, seed, recorder=rec).run()
     if not frames:
         return None
-    f = fdir / f"replay_{_stem(label, goal, seed)}.gif"
+    f = fdir / f"replay_{file_stem(label, goal, seed)}.gif"
     animate_run(w, frames, f"{label}, goal {goal}, seed {seed}", f)
     return (f"Replay of {label}, goal {goal}, seed {seed} ({res.outcome}, {res.distance_m:.1f} m): "
             "the map as built (white free, black occupied, gray unknown), candidates and the chosen one", f)
