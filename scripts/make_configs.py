@@ -1,4 +1,4 @@
-"""Regenerate the shipped scenario library: configs/{normal,inverse,hotel,kth}.yaml and maps/.
+"""Regenerate the shipped scenario library: configs/{normal,inverse,hotel,kth,office}.yaml and maps/.
 
 Our own buildings, made by `semsearch generate building`, matching the thesis' Table 4.1 (sign
 counts and goal doors) and its description of each map's numbering. Run from the repository root:
@@ -11,7 +11,10 @@ from pathlib import Path
 
 import yaml
 
+import cv2
+
 from semsearch_cli.world.generate import generate_building
+from semsearch_cli.world.office import office_image, office_scenario
 
 PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
 
@@ -43,6 +46,14 @@ def main() -> None:
                   f"--spacing {spacing} --signs {signs} (floor digit {floor}); regenerate with scripts/make_configs.py.\n")
         (root / "configs" / f"{name}.yaml").write_text(header + yaml.safe_dump(scen, sort_keys=False))
         print(f"configs/{name}.yaml")
+    (root / "maps" / "office").mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(root / "maps" / "office" / "map.png"), office_image())
+    header = ("# office: object search over time (thesis 5.3): 20.5 m x 14.5 m, seven rooms, places A-J,\n"
+              "# the mug patterns of Table 5.1, requests at 12:00 and 00:00 (ground truth of Table 5.2),\n"
+              "# the combined-patterns run and the moved-mug run. Regenerate with scripts/make_configs.py.\n")
+    scen = office_scenario(image="../maps/office/map.png")
+    (root / "configs" / "office.yaml").write_text(header + yaml.safe_dump(scen, sort_keys=False, default_flow_style=None))
+    print("configs/office.yaml")
 
 
 if __name__ == "__main__":

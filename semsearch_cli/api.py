@@ -44,10 +44,10 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     if planner_specs is not None:
         loaded.sc = loaded.sc.model_copy(update={"planners": planner_specs})
     if goals:
-        known = {str(g) for g in loaded.sc.goals}
+        known = {str(g) for g in loaded.goals}
         for g in goals:
             if str(g) not in known:
-                raise ScenarioError("<command line>", "--goal", f"goal {g} is not among the scenario's goals {loaded.sc.goals}")
+                raise ScenarioError("<command line>", "--goal", f"goal {g} is not among the scenario's goals {loaded.goals}")
     specs = expand(loaded, seeds, goals, planners)
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
@@ -55,12 +55,18 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     from .report.build import write_meta
 
     write_meta(out_dir, loaded.path)
+    if loaded.task is not None:
+        from .objects.task import write_log
+
+        for case, log in loaded.logs.items():
+            write_log(log, out_dir / "logs" / f"{case}.csv")
     runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress, trace)
     wanted = {s.key for s in specs}
     mine = runs[[(str(p), str(g), int(s)) in wanted for p, g, s in zip(runs["planner"], runs["goal"], runs["seed"])]]
     summary = write_summary(runs, out_dir)
     if plots:
-        write_path_plots(loaded, mine, out_dir)
+        if loaded.task is None:  # object-search paths are drawn by the report, beside the heat maps
+            write_path_plots(loaded, mine, out_dir)
         report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
     return RunOutput(out_dir, runs, summary)
 

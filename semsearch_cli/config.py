@@ -9,11 +9,12 @@ and the field; checks that need the map (start in a wall, goals reachable) live 
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any, Literal, Union
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .errors import ScenarioError
 
@@ -94,12 +95,61 @@ class ExperimentSpec(Strict):
     out: str | None = Field(None, description="output folder (default results/<name>)")
 
 
+NAME = r"^[A-Za-z0-9_\-]+$"
+
+
+class PlaceSpec(Strict):
+    name: str = Field(pattern=NAME, description="a place where objects stand, e.g. A")
+    x: float
+    y: float
+
+
+class ObjectCameraSpec(Strict):
+    fov: float = Field(60.0, gt=0.0, le=360.0, description="degrees, centred on the heading")
+    range: float = Field(3.0, gt=0.0, description="m")
+    p_detect: float = Field(0.9, ge=0.0, le=1.0, description="probability a visible object is detected in one frame")
+
+
+class RequestSpec(Strict):
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    cls: str = Field(alias="class", pattern=NAME, description="object class to find")
+    hour: float = Field(ge=0.0, lt=24.0)
+    at: list[str] | None = Field(None, description="places holding the class at the request (ground truth); "
+                                                   "default: the case's truth timeline at that hour")
+
+
+class CaseSpec(Strict):
+    name: str = Field(pattern=NAME)
+    record: Union[str, list[str]] = Field(description="timeline names to record (one day each, in order), "
+                                                      "or a detection-log CSV path")
+    truth: str | None = Field(None, description="timeline giving the ground truth at request hours")
+    requests: list[RequestSpec] | None = Field(None, description="default: objects.requests")
+
+
+Timeline = dict[str, dict[float, Union[str, list[str], None]]]
+
+
+class ObjectsSpec(Strict):
+    """Object search over time (thesis ch. 5, SPEC 6)."""
+
+    places: list[PlaceSpec] = Field(min_length=1)
+    fixed: dict[str, Union[str, list[str]]] = Field(default_factory=dict, description="place -> class(es) standing there all day")
+    route: list[str] | None = Field(None, description="patrol order of the places (default: as listed)")
+    timelines: dict[str, Timeline] = Field(default_factory=dict,
+                                           description="pattern -> class -> {hour: place(s) from that hour on}")
+    recording_hours: list[float] = Field(default_factory=lambda: [3, 5, 7, 9, 11, 15, 17, 19, 21, 23])
+    requests: list[RequestSpec] = Field(default_factory=list)
+    cases: list[CaseSpec] | None = Field(None, description="default: one case per timeline, recorded from it")
+    camera: ObjectCameraSpec = ObjectCameraSpec()
+
+
 class Scenario(Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
     map: MapSpec
     start: StartSpec
-    doors: Union[str, list[DoorSpec]]
-    goals: list[Union[int, str]] = Field(min_length=1)
+    doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
+    goals: list[Union[int, str]] = Field(default_factory=list)
+    objects: ObjectsSpec | None = None
     planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
     experiment: ExperimentSpec = ExperimentSpec()
     robot: RobotSpec = RobotSpec()
@@ -115,13 +165,29 @@ class Scenario(Strict):
             raise ValueError("goals must not repeat")
         return v
 
+    @model_validator(mode="after")
+    def _task(self):
+        if self.objects is None and not self.goals:
+            raise ValueError("give door numbers under goals (door search) or an objects section (object search)")
+        if self.objects is not None and self.goals:
+            raise ValueError("an object-search scenario takes its goals from objects.requests; remove goals")
+        return self
+
+    @property
+    def is_objects(self) -> bool:
+        return self.objects is not None
+
+
+_TYPE_PART = re.compile(r"^(int|str|float|bool|none|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec)$")
+
 
 def _loc(loc: tuple) -> str:
+    """pydantic's error location as a dotted field path, without the union-branch type names."""
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("int", "str", "float", "list[DoorSpec]", "literal['random']", "function-after[_unique_goals(), list[union[int,str]]]"):
+        elif _TYPE_PART.match(str(part)):
             continue
         else:
             out += ("." if out else "") + str(part)

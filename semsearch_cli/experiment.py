@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .config import Scenario, load_scenario
+from .errors import ScenarioError
 from .episode import Episode
 from .metrics import COLUMNS, run_row
 from .planners import Variant, expand_variants
@@ -49,19 +50,51 @@ def file_stem(label: str, goal, seed=None) -> str:
 
 @dataclass
 class Loaded:
-    """A scenario with its world and the shortest path of each goal, built once per process."""
+    """A scenario with its world and the shortest path of each goal, built once per process.
+
+    For object search, ``task`` holds the places, cases and requests, ``logs`` each case's
+    detection log (recorded once, here), and the goals are the request labels (``Static.mug@12``).
+    """
 
     path: Path
     sc: Scenario
     world: World
     shortest: dict
+    task: object = None
+    logs: dict | None = None
+
+    @property
+    def goals(self) -> list:
+        return [r.label for r in self.task.requests] if self.task is not None else list(self.sc.goals)
 
     @classmethod
     def load(cls, path: Path) -> "Loaded":
         sc = load_scenario(path)
         world = build_world(sc, path.parent, str(path))
-        shortest = check_goals_reachable(world, sc.goals, str(path))
-        return cls(path, sc, world, shortest)
+        if sc.is_objects:
+            from .objects.task import ObjectTask
+
+            task = ObjectTask(sc, world, path.parent, str(path))
+            logs = {c.name: task.log(c) for c in task.cases}
+            shortest = {r.label: task.shortest(r) for r in task.requests}
+            loaded = cls(path, sc, world, shortest, task, logs)
+        else:
+            loaded = cls(path, sc, world, check_goals_reachable(world, sc.goals, str(path)))
+        loaded.check_planners()
+        return loaded
+
+    def check_planners(self) -> None:
+        """Every planner must answer this kind of scenario (door or object search)."""
+        from .planners import PLANNERS
+
+        kind = "objects" if self.sc.is_objects else "doors"
+        for i, spec in enumerate(self.sc.planners):
+            cls = PLANNERS.get(spec.name)
+            if cls is not None and cls.task != kind:
+                valid = sorted(n for n, c in PLANNERS.items() if c.task == kind)
+                raise ScenarioError(str(self.path), f"planners[{i}].name",
+                                    f"{spec.name!r} is a {cls.task.rstrip('s')}-search planner; this is a "
+                                    f"{kind.rstrip('s')}-search scenario (valid: {', '.join(valid)})")
 
 
 _CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process once
@@ -73,7 +106,13 @@ def _worker_init(loaded: Loaded) -> None:
 
 def execute(loaded: Loaded, spec: RunSpec, trace: bool = False):
     """Run one spec; returns (row, result)."""
-    res = Episode(loaded.world, loaded.sc, spec.variant, spec.goal, spec.seed, trace=trace).run()
+    if loaded.task is not None:
+        from .objects.search import ObjectEpisode
+
+        req = loaded.task.request(spec.goal)
+        res = ObjectEpisode(loaded.task, spec.variant, req, loaded.logs[req.case], spec.seed, trace).run()
+    else:
+        res = Episode(loaded.world, loaded.sc, spec.variant, spec.goal, spec.seed, trace=trace).run()
     row = run_row(loaded.sc.name, spec.variant, spec.goal, spec.seed, res, loaded.shortest[spec.goal], loaded.sc.navigation.navigator)
     return row, res
 
@@ -109,7 +148,7 @@ def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) 
     variants = expand_variants(sc.planners, str(loaded.path))
     if planners:
         variants = [v for v in variants if v.name in planners or v.label in planners]
-    gl = [g for g in sc.goals if goals is None or str(g) in {str(x) for x in goals}]
+    gl = [g for g in loaded.goals if goals is None or str(g) in {str(x) for x in goals}]
     n = seeds or sc.experiment.seeds
     return [RunSpec(g, v, s) for g in gl for v in variants for s in range(n)]
 

@@ -50,6 +50,7 @@ class Planner:
     """Base class: ``choose`` returns a :class:`Decision` or None when there is nowhere to go."""
 
     name: ClassVar[str] = ""
+    task: ClassVar[str] = "doors"  # or "objects": which kind of scenario the planner answers
     Params: ClassVar[type[BaseModel]] = NoParams
 
     def __init__(self, params: BaseModel):

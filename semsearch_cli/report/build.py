@@ -70,6 +70,10 @@ def _report_one(folder: Path, out: Path, formats: set, replay: bool) -> list[Pat
         raise ScenarioError(str(folder / "runs.csv"), "", "no finished runs to report (is this a semsearch results folder?)")
     out.mkdir(parents=True, exist_ok=True)
     meta = json.loads((folder / "meta.json").read_text()) if (folder / "meta.json").is_file() else {}
+    from .objects import is_object_runs, report_objects
+
+    if is_object_runs(runs):
+        return report_objects(runs, folder, out, formats, meta)
     order = T.planner_order(runs["planner"])
     tabs = {
         "summary": T.summarise(runs),

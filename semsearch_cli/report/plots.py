@@ -162,3 +162,75 @@ def animate_run(world, frames: list, title: str, out: Path, fps: int = 5) -> Non
     anim.save(tmp, writer=PillowWriter(fps=fps))
     plt.close(fig)
     os.replace(tmp, out)
+
+
+# ---- object search (thesis ch. 5) ---------------------------------------------------------------
+def _places(ax, places: dict, truth=(), instances=()) -> None:
+    """Places as labelled dots; the ones holding the target at the request ringed in red."""
+    for name, (x, y) in places.items():
+        ax.plot(x, y, "o", ms=5, c="#555555")
+        ax.annotate(name, (x, y), xytext=(4, 4), textcoords="offset points", fontsize=9, weight="bold")
+    for name in truth:
+        x, y = places[name]
+        ax.plot(x, y, "o", ms=13, mfc="none", mec="tab:red", mew=2)
+    if truth:
+        ax.plot([], [], "o", ms=9, mfc="none", mec="tab:red", mew=2, label="target at the request")
+
+
+def plot_heat(world, heat: np.ndarray, places: dict, truth, goals, title: str, out: Path) -> None:
+    """LSOS heat map (Eq. 5.4) over the map, the goals (Eqs. 5.5-5.6) numbered in visiting order."""
+    fig, ax = _map_figure(world, 9.0)
+    h = np.ma.masked_where(heat <= 0, heat)
+    im = ax.imshow(h, cmap="hot_r", extent=_extent(world), interpolation="nearest", alpha=0.85)
+    fig.colorbar(im, ax=ax, shrink=0.7, label="heat")
+    _places(ax, places, truth)
+    for k, (x, y, phi) in enumerate(goals):
+        ax.plot(x, y, "X", c="tab:blue", ms=10, label="goals (in order)" if k == 0 else None)
+        ax.annotate(str(k + 1), (x, y), xytext=(-12, -12), textcoords="offset points", color="tab:blue", weight="bold")
+    ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start R")
+    _finish_map(fig, ax, title, out)
+
+
+def plot_object_paths(world, paths: dict, places: dict, truth, title: str, out: Path) -> None:
+    """The median run of each planner for one request; ``paths``: label -> (path, distance, outcome)."""
+    fig, ax = _map_figure(world, 9.0)
+    _places(ax, places, truth)
+    for k, (lab, (p, d, outcome)) in enumerate(paths.items()):
+        ax.plot(p[:, 0], p[:, 1], "-", lw=1.4, c=f"C{k}", label=f"{lab}: {d:.1f} m, {outcome}")
+        ax.plot(p[-1, 0], p[-1, 1], "o", c=f"C{k}", ms=5)
+    ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start R")
+    _finish_map(fig, ax, title, out)
+
+
+def plot_object_bars(table, order: list, out: Path) -> None:
+    """The thesis' Figure 5.12: per case, mean +- std distance per request hour and planner;
+    the share of runs that found the object is written on each bar (red when below 1)."""
+    cases = list(dict.fromkeys(table["case"]))
+    n = len(cases)
+    cols = min(3, n)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.3 * rows), squeeze=False)
+    width = 0.8 / max(1, len(order))
+    for ax, case in zip(axes.flat, cases):
+        sub = table[table["case"] == case]
+        hours = sorted(sub["hour"].unique(), key=lambda h: (h == 0, h))  # noon before midnight, as the thesis
+        for k, lab in enumerate(order):
+            s = sub[sub["planner"] == lab].set_index("hour")
+            xs = np.arange(len(hours)) + (k - (len(order) - 1) / 2) * width
+            mean = [float(s["mean"].get(h, np.nan)) for h in hours]
+            std = [float(s["std"].get(h, 0.0)) if not np.isnan(s["std"].get(h, np.nan)) else 0.0 for h in hours]
+            ax.bar(xs, mean, width, yerr=std, capsize=2, color=f"C{k}", label=lab)
+            for x, m, h in zip(xs, mean, hours):
+                if h in s.index:
+                    rate = float(s.loc[h, "success_rate"])
+                    ax.text(x, (m if np.isfinite(m) else 0) + 1, f"{rate:.0%}", ha="center", va="bottom", fontsize=6,
+                            color="tab:red" if rate < 1 else "black", rotation=90)
+        ax.set_xticks(range(len(hours)), [f"{h:02.0f}:{(h % 1) * 60:02.0f}" for h in hours])
+        ax.set_title(case, fontsize=10)
+        ax.set_ylabel("distance (m)")
+    for ax in list(axes.flat)[n:]:
+        ax.axis("off")
+    axes.flat[0].legend(fontsize=7)
+    fig.suptitle("Distance until the object is seen (mean +- std; % = runs that found it)", fontsize=10)
+    fig.tight_layout()
+    _save(fig, out)

@@ -207,7 +207,7 @@ def build_world(sc: Scenario, base: Path, file: str) -> World:
 
     doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
     dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file
-    if not doors:
+    if not doors and not sc.is_objects:
         raise ScenarioError(dfile, "doors", "no door signs given")
     labels = [d.number for d in doors]
     seen: set[str] = set()

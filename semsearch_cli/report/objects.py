@@ -1,0 +1,178 @@
+"""Object-search reports (thesis 5.3.4, Figure 5.12): tables per case, request hour and planner,
+the bar figure, the LSOS heat map of every request, and the median paths. Tables come from
+runs.csv alone; heat maps and paths also need the scenario named in meta.json."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..experiment import file_stem
+from ..objects.task import is_object_label, parse_label
+from . import tables as T
+
+ORDER = {"brute_force": 0, "last_seen": 1, "lsos": 2}
+
+
+def is_object_runs(runs: pd.DataFrame) -> bool:
+    return len(runs) > 0 and all(is_object_label(g) for g in runs["goal"].unique())
+
+
+def planner_order(labels) -> list[str]:
+    return sorted(set(labels), key=lambda lab: (ORDER.get(lab.split("[", 1)[0], 3), lab))
+
+
+def object_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Per case x class x request hour x planner: n, found, success rate, mean, std (ddof 1),
+    min, max of the distance until the object was seen (or the search gave up), the shortest."""
+    df = runs.copy()
+    parts = [parse_label(g) for g in df["goal"]]
+    df["case"] = [p[0] for p in parts]
+    df["class"] = [p[1] for p in parts]
+    df["hour"] = [p[2] for p in parts]
+    g = df.groupby(["case", "class", "hour", "planner"], sort=False)
+    out = g.agg(n=("distance_m", "size"), found=("success", "sum"), success_rate=("success", "mean"),
+                mean=("distance_m", "mean"), std=("distance_m", "std"), min=("distance_m", "min"),
+                max=("distance_m", "max"), shortest_m=("shortest_m", "first")).reset_index()
+    case_order = list(dict.fromkeys(df["case"]))
+    out["_c"] = out["case"].map(case_order.index)
+    out["_h"] = out["hour"].map(lambda h: (h == 0, h))
+    out["_p"] = out["planner"].map(lambda p: planner_order(df["planner"]).index(p))
+    return out.sort_values(["_c", "class", "_h", "_p"]).drop(columns=["_c", "_h", "_p"]).round(3).reset_index(drop=True)
+
+
+def figure_table(table: pd.DataFrame) -> pd.DataFrame:
+    """Wide: rows (case, request), one column per planner, cells ``mean ± std (found/n)``."""
+    t = table.copy()
+    t["request"] = [f"{c} {h:02.0f}:{(h % 1) * 60:02.0f}" for c, h in zip(t["class"], t["hour"])]
+    t["cell"] = [f"{m:.1f} ± {0.0 if np.isnan(s) else s:.1f} ({f}/{n})" for m, s, f, n in
+                 zip(t["mean"], t["std"], t["found"], t["n"])]
+    wide = t.pivot_table(index=["case", "request"], columns="planner", values="cell", aggfunc="first", sort=False)
+    wide = wide[[p for p in planner_order(t["planner"]) if p in wide.columns]]
+    wide["shortest (m)"] = t.groupby(["case", "request"], sort=False)["shortest_m"].first().map(lambda v: f"{v:.1f}")
+    wide.columns.name = None
+    return wide
+
+
+def report_objects(runs: pd.DataFrame, folder: Path, out: Path, formats: set, meta: dict) -> list[Path]:
+    t0 = time.perf_counter()
+    table = object_table(runs)
+    wide = figure_table(table)
+    tdir = out / "tables"
+    tdir.mkdir(parents=True, exist_ok=True)
+    if "csv" in formats:
+        for name, df in (("objects", table), ("summary", T.summarise(runs))):
+            tmp = tdir / f".{name}.csv.tmp"
+            df.to_csv(tmp, index=False)
+            os.replace(tmp, tdir / f"{name}.csv")
+    figs, notes = [], []
+    if formats & {"png", "html", "md"}:
+        figs, notes = _figures(runs, table, folder, out, meta)
+    md = _markdown(runs, wide, figs, notes, meta, folder, out)
+    files = []
+    if "md" in formats or "html" in formats:
+        from .build import _atomic_text
+
+        _atomic_text(tdir / "objects.md", T.markdown(wide))
+        _atomic_text(out / "report.md", md)
+        files.append(out / "report.md")
+    if "html" in formats:
+        from .build import _atomic_text, _html
+
+        _atomic_text(out / "report.html", _html(md, out))
+        files.append(out / "report.html")
+    print(f"report of {folder}: {len(runs)} runs, {len(figs)} figures, {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    return files
+
+
+def _figures(runs, table, folder: Path, out: Path, meta):
+    from .plots import plot_heat, plot_object_bars, plot_object_paths
+
+    fdir = out / "figures"
+    fdir.mkdir(exist_ok=True)
+    order = planner_order(runs["planner"])
+    f = fdir / "objects_by_case.png"
+    plot_object_bars(table, order, f)
+    figs = [("Distance until the mug is seen per case, request hour and planner (the thesis' Figure 5.12)", f)]
+    notes = []
+    loaded = _loaded(meta, notes)
+    if loaded is None:
+        return figs, notes
+    task, world = loaded.task, loaded.world
+    med = T.median_run(runs)
+    lsos = next((lab for lab in order if lab.split("[", 1)[0] == "lsos"), None)
+    for label in dict.fromkeys(runs["goal"]):
+        try:
+            req = task.request(label)
+        except StopIteration:
+            notes.append(f"{label}: not a request of the scenario any more; its figures were skipped.")
+            continue
+        stem = label  # letters, digits, - _ . @ only
+        if lsos is not None:
+            from ..objects.search import LsosParams, lsos_goals
+
+            params = json.loads(runs[runs["planner"] == lsos]["params"].iloc[0])
+            heat, goals = lsos_goals(task, loaded.logs[req.case], req.cls, req.hour, LsosParams(**params))
+            gx = [(*world.frame.to_world(r, c), phi) for r, c, phi in goals]
+            f = fdir / f"heat_{stem}.png"
+            plot_heat(world, heat, task.places, req.truth, gx,
+                      f"{req.case}: {req.cls} at {req.hour:g}:00, {lsos} heat map (Eq. 5.4) and goals (Eqs. 5.5-5.6)", f)
+            figs.append((f"Heat map for {label}; red rings: where the {req.cls} is", f))
+        paths = {}
+        for _, r in med[med["goal"] == label].iterrows():
+            p = folder / "paths" / f"{file_stem(r['planner'], label, int(r['seed']))}.npz"
+            if p.is_file():
+                paths[r["planner"]] = (np.load(p)["path"], float(r["distance_m"]), r["outcome"])
+        if paths:
+            f = fdir / f"paths_{stem}.png"
+            plot_object_paths(world, {k: paths[k] for k in order if k in paths}, task.places, req.truth,
+                              f"{req.case}: {req.cls} at {req.hour:g}:00, median run of each planner", f)
+            figs.append((f"Median runs for {label}", f))
+    return figs, notes
+
+
+def _loaded(meta, notes):
+    from ..errors import ScenarioError
+    from ..experiment import Loaded
+
+    path = Path(meta.get("scenario", ""))
+    if not meta.get("scenario") or not path.is_file():
+        notes.append("Heat maps and paths were skipped: the scenario file named in meta.json is not available.")
+        return None
+    try:
+        return Loaded.load(path)
+    except ScenarioError as exc:
+        notes.append(f"Heat maps and paths skipped: {exc}")
+        return None
+
+
+def _markdown(runs, wide, figs, notes, meta, folder: Path, out: Path) -> str:
+    import datetime
+
+    from .. import __version__
+
+    now = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    scen = ", ".join(sorted(runs["scenario"].unique()))
+    lines = [f"# semsearch report: {scen} (object search)", "",
+             f"semsearch {__version__}, {now}; {len(runs)} finished runs from `{folder / 'runs.csv'}`.", ""]
+    if meta.get("commands"):
+        lines += ["Produced by:", "", *[f"    {c}" for c in meta["commands"]], "", f"Report: `semsearch report {folder}`", ""]
+    lines += ["## Distance until the object is seen (m): mean ± std (found / runs)", "",
+              "A run that does not find the object counts the distance until the planner gave up "
+              "(Last Seen after its one spot, Brute Force after its whole route).", "",
+              T.markdown(wide), ""]
+    if meta.get("scenario") and Path(meta["scenario"]).is_file():
+        lines += ["## Scenario", "", "```yaml", Path(meta["scenario"]).read_text().strip(), "```", ""]
+    if figs:
+        lines += ["## Figures", ""]
+        for caption, f in figs:
+            lines += [f"![{caption}]({os.path.relpath(f, out)})", "", f"*{caption}*", ""]
+    for n in notes:
+        lines += [f"> {n}", ""]
+    return "\n".join(lines)
