@@ -145,13 +145,42 @@ def _goal_value(loaded: Loaded, g):
     return g
 
 
+def record(scenario: str | Path, out: str | Path, cases=None) -> list[tuple[Path, int]]:
+    """Write each case's detection log (recorded by patrolling, or read from its CSV) to ``out``."""
+    from .objects.task import write_log
+
+    loaded = Loaded.load(Path(scenario))
+    if loaded.task is None:
+        raise ScenarioError(str(scenario), "objects", "recording needs an object-search scenario (an objects section)")
+    names = [c.name for c in loaded.task.cases]
+    for c in cases or []:
+        if str(c) not in names:
+            raise ScenarioError("<command line>", "--case", f"no case {c!r}; cases are {', '.join(names)}")
+    written = []
+    for name in names:
+        if cases and name not in {str(c) for c in cases}:
+            continue
+        f = Path(out) / f"{name}.csv"
+        write_log(loaded.logs[name], f)
+        written.append((f, len(loaded.logs[name])))
+    return written
+
+
 def validate(scenario: str | Path) -> dict:
     """Every check of the loader, plus counts and each goal's shortest path (no simulation)."""
     loaded = Loaded.load(Path(scenario))
     w = loaded.world
     from .planners import expand_variants
 
-    variants = expand_variants(loaded.sc.planners, str(loaded.path))
+    variants = expand_variants(loaded.sc.planners, str(loaded.path), loaded.kind)
+    if loaded.task is not None:
+        t = loaded.task
+        return {"name": loaded.sc.name, "places": len(t.places), "route": " ".join(t.route),
+                "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
+                "cases": {c.name: f"{len(loaded.logs[c.name])} detections recorded" for c in t.cases},
+                "planners": [v.label for v in variants],
+                "requests (ground truth: shortest m)": {r.label: f"{','.join(r.truth) or 'absent'}: {loaded.shortest[r.label]:.2f}"
+                                                        for r in t.requests}}
     readable = 0
     for i in range(len(w.signs)):
         if w.readable_mask(i).any():
@@ -172,5 +201,14 @@ def show(scenario: str | Path, out: str | Path) -> Path:
     world = build_world(sc, path.parent, str(path))
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
+    if sc.is_objects:
+        from .objects.task import ObjectTask
+        from .report.plots import plot_object_paths
+
+        task = ObjectTask(sc, world, path.parent, str(path))
+        route = [world.start_xy, *(task.places[n] for n in task.route), world.start_xy]
+        plot_object_paths(world, {}, task.places, (), f"{sc.name}: places {' '.join(task.places)}; "
+                          f"patrol route dotted", out, route=np.asarray(route))
+        return out
     plot_scenario(world, sc.goals, f"{sc.name}: {len(world.signs)} signs, goals {', '.join(map(str, sc.goals))}", out)
     return out

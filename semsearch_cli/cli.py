@@ -94,7 +94,8 @@ def _batch(call):
     except ScenarioError as exc:
         _fail(exc)
     _print_summary(res.summary)
-    out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  plots: {res.out / 'plots'}")
+    figs = res.out / ("figures" if (res.out / "logs").is_dir() else "plots")
+    out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {figs}  report: {res.out / 'report.md'}")
     return res
 
 
@@ -159,6 +160,25 @@ def presence(
         scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv(tmp)
         tmp.replace(out_file)
         out.print(f"wrote {out_file}")
+
+
+@app.command()
+def record(
+    scenario: Path = typer.Argument(..., help="Object-search scenario YAML file."),
+    out_dir: Path = typer.Option(Path("logs"), "--out", help="Folder for the detection logs (one CSV per case)."),
+    cases: Optional[List[str]] = typer.Option(None, "--case", help="Only these cases (repeat or comma-separate)."),
+):
+    """Recording mode: patrol the route at each recording hour and write the detection log of
+    every case (day, hour, class, x, y, robot_x, robot_y, place). A scenario can replay a log
+    with `record: path/to/log.csv` in its case."""
+    from . import api
+
+    try:
+        written = api.record(scenario, out_dir, _split(cases))
+    except ScenarioError as exc:
+        _fail(exc)
+    for f, n in written:
+        out.print(f"wrote {f} ({n} detections)")
 
 
 @app.command()

@@ -83,18 +83,13 @@ class Loaded:
         loaded.check_planners()
         return loaded
 
-    def check_planners(self) -> None:
-        """Every planner must answer this kind of scenario (door or object search)."""
-        from .planners import PLANNERS
+    @property
+    def kind(self) -> str:
+        return "objects" if self.sc.is_objects else "doors"
 
-        kind = "objects" if self.sc.is_objects else "doors"
-        for i, spec in enumerate(self.sc.planners):
-            cls = PLANNERS.get(spec.name)
-            if cls is not None and cls.task != kind:
-                valid = sorted(n for n, c in PLANNERS.items() if c.task == kind)
-                raise ScenarioError(str(self.path), f"planners[{i}].name",
-                                    f"{spec.name!r} is a {cls.task.rstrip('s')}-search planner; this is a "
-                                    f"{kind.rstrip('s')}-search scenario (valid: {', '.join(valid)})")
+    def check_planners(self) -> None:
+        """Every planner entry must name a planner for this kind of search, with valid parameters."""
+        expand_variants(self.sc.planners, str(self.path), self.kind)
 
 
 _CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process once
@@ -145,7 +140,7 @@ def save_run_files(out: Path, spec: RunSpec, res) -> None:
 def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> list[RunSpec]:
     """goals x planner variants x seeds, in that nesting order."""
     sc = loaded.sc
-    variants = expand_variants(sc.planners, str(loaded.path))
+    variants = expand_variants(sc.planners, str(loaded.path), loaded.kind)
     if planners:
         variants = [v for v in variants if v.name in planners or v.label in planners]
     gl = [g for g in loaded.goals if goals is None or str(g) in {str(x) for x in goals}]

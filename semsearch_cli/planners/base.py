@@ -94,13 +94,19 @@ class Variant:
         return cls(cls.Params(**dict(self.params)))
 
 
-def expand_variants(specs, file: str = "<scenario>") -> list[Variant]:
-    """Planner entries -> variants; list-valued parameters expand into one variant per value."""
+def expand_variants(specs, file: str = "<scenario>", task: str | None = None) -> list[Variant]:
+    """Planner entries -> variants; list-valued parameters expand into one variant per value.
+    With ``task`` ("doors" or "objects"), planners for the other kind of search are refused."""
     out: list[Variant] = []
     for i, spec in enumerate(specs):
         name, params = spec.name, spec.params()
+        valid = sorted(n for n, c in PLANNERS.items() if task is None or c.task == task)
         if name not in PLANNERS:
-            raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}; valid: {', '.join(sorted(PLANNERS))}")
+            raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}; valid: {', '.join(valid)}")
+        if task is not None and PLANNERS[name].task != task:
+            kind = {"doors": "door", "objects": "object"}
+            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} is a {kind[PLANNERS[name].task]}-search planner and this is "
+                                f"a {kind[task]}-search scenario; valid: {', '.join(valid)}")
         keys = sorted(params)
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]
         for combo in itertools.product(*values):

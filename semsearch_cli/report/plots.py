@@ -191,10 +191,13 @@ def plot_heat(world, heat: np.ndarray, places: dict, truth, goals, title: str, o
     _finish_map(fig, ax, title, out)
 
 
-def plot_object_paths(world, paths: dict, places: dict, truth, title: str, out: Path) -> None:
-    """The median run of each planner for one request; ``paths``: label -> (path, distance, outcome)."""
+def plot_object_paths(world, paths: dict, places: dict, truth, title: str, out: Path, route=None) -> None:
+    """The median run of each planner for one request; ``paths``: label -> (path, distance, outcome).
+    ``route`` (n, 2), when given, is drawn dotted (the patrol order)."""
     fig, ax = _map_figure(world, 9.0)
     _places(ax, places, truth)
+    if route is not None:
+        ax.plot(route[:, 0], route[:, 1], ":", c="tab:red", lw=1.2, label="patrol order")
     for k, (lab, (p, d, outcome)) in enumerate(paths.items()):
         ax.plot(p[:, 0], p[:, 1], "-", lw=1.4, c=f"C{k}", label=f"{lab}: {d:.1f} m, {outcome}")
         ax.plot(p[-1, 0], p[-1, 1], "o", c=f"C{k}", ms=5)
