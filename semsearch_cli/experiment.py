@@ -20,7 +20,6 @@ import numpy as np
 import pandas as pd
 
 from .config import Scenario, load_scenario
-from .errors import ScenarioError
 from .episode import Episode
 from .metrics import COLUMNS, run_row
 from .planners import Variant, expand_variants
