@@ -212,7 +212,7 @@ def plot_object_bars(table, order: list, out: Path) -> None:
     n = len(cases)
     cols = min(3, n)
     rows = (n + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.3 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.3 * rows), squeeze=False, sharey=True)
     width = 0.8 / max(1, len(order))
     for ax, case in zip(axes.flat, cases):
         sub = table[table["case"] == case]
@@ -222,18 +222,26 @@ def plot_object_bars(table, order: list, out: Path) -> None:
             xs = np.arange(len(hours)) + (k - (len(order) - 1) / 2) * width
             mean = [float(s["mean"].get(h, np.nan)) for h in hours]
             std = [float(s["std"].get(h, 0.0)) if not np.isnan(s["std"].get(h, np.nan)) else 0.0 for h in hours]
-            ax.bar(xs, mean, width, yerr=std, capsize=2, color=f"C{k}", label=lab)
-            for x, m, h in zip(xs, mean, hours):
+            bars = ax.bar(xs, mean, width, yerr=std, capsize=2, color=f"C{k}", label=lab)
+            for bar, x, m, h in zip(bars, xs, mean, hours):
                 if h in s.index:
                     rate = float(s.loc[h, "success_rate"])
-                    ax.text(x, (m if np.isfinite(m) else 0) + 1, f"{rate:.0%}", ha="center", va="bottom", fontsize=6,
-                            color="tab:red" if rate < 1 else "black", rotation=90)
+                    if rate < 1:  # runs that gave up: hatched, the share found in red
+                        bar.set_hatch("///")
+                        bar.set_alpha(0.6)
+                    ax.text(x, (m if np.isfinite(m) else 0), f"{rate:.0%}", ha="center", va="bottom", fontsize=7,
+                            color="tab:red" if rate < 1 else "black")
         ax.set_xticks(range(len(hours)), [f"{h:02.0f}:{(h % 1) * 60:02.0f}" for h in hours])
         ax.set_title(case, fontsize=10)
         ax.set_ylabel("distance (m)")
     for ax in list(axes.flat)[n:]:
         ax.axis("off")
-    axes.flat[0].legend(fontsize=7)
-    fig.suptitle("Distance until the object is seen (mean +- std; % = runs that found it)", fontsize=10)
+    top = axes.flat[0].get_ylim()[1]
+    axes.flat[0].set_ylim(0, top * 1.1)
+    from matplotlib.patches import Patch
+
+    axes.flat[0].legend(handles=[Patch(color=f"C{k}", label=lab) for k, lab in enumerate(order)], fontsize=7)
+    fig.suptitle("Distance until the object is seen or the search gave up (mean +- std; % = runs that found it, "
+                 "hatched when some did not)", fontsize=10)
     fig.tight_layout()
     _save(fig, out)
