@@ -92,6 +92,9 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = N
     from .config import PlannerSpec, load_scenario
 
     sc = load_scenario(scenario)
+    if sc.is_objects:
+        raise ScenarioError(str(scenario), "objects", "sweep-alpha varies the door-search planner nsos; this is an "
+                            "object-search scenario (use `semsearch run`, with list-valued lsos parameters to sweep them)")
     base = next((p.params() for p in sc.planners if p.name == "nsos"), {})
     base.pop("alpha", None)
     specs = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[float(a) for a in alphas], **base)]

@@ -160,3 +160,26 @@ def test_run_writes_the_object_report(tmp_path):
     for f in ("figures/objects_by_case.png", "figures/heat_Static.mug@12.png", "figures/paths_Static.mug@0.png",
               "logs/Static.csv", "report.html", "tables/objects.csv"):
         assert (out / f).is_file(), f
+
+
+def test_when_the_mug_is_gone_lsos_and_brute_force_look_everywhere_then_give_up(tmp_path):
+    def edit(d):
+        d["objects"]["cases"] = [{"name": "Gone", "record": ["Static"], "truth": "Static",
+                                  "requests": [{"class": "mug", "hour": 12, "at": []}]}]
+
+    gone = Loaded.load(office_copy(tmp_path, edit))
+    req = gone.task.request("Gone.mug@12")
+    assert req.truth == () and gone.shortest["Gone.mug@12"] == float("inf")
+    for planner in ("lsos", "brute_force"):
+        ep = ObjectEpisode(gone.task, Variant(planner, ()), req, gone.logs["Gone"], 0)
+        res = ep.run()
+        assert res.outcome == "not_found"
+    # lsos went to its heat-map goals, then to every place the camera had not yet seen, in patrol order
+    trace = ObjectEpisode(gone.task, Variant("lsos", ()), req, gone.logs["Gone"], 0, trace=True).run().trace
+    kinds = [t["kind"] for t in trace]
+    k = kinds.count("heat")
+    assert k == 2 and kinds == ["heat"] * k + ["patrol"] * (len(kinds) - k)
+    visited = [t["place"] for t in trace[k:]]
+    route = gone.task.route
+    assert visited == sorted(visited, key=route.index) and "A" not in visited and "H" not in visited
+    assert 0 < len(visited) < len(route)  # places seen on the way were skipped

@@ -33,7 +33,9 @@ from .task import ObjectCamera, ObjectTask, Request
 
 class Drive:
     """The robot on the recorded map with the object camera: ``go`` drives to a point, sensing
-    at every step; ``on_detect(i, x, y)`` is called for each detection and returns True to stop."""
+    at every step; ``on_detect(i, x, y)`` is called for each detection of instance ``i`` and
+    returns True to stop. ``seen_places``: the places the camera has had in view (range, field of
+    view, line of sight), whether or not anything stood there."""
 
     def __init__(self, task: ObjectTask, instances, rng: np.random.Generator, heading: float,
                  budget: float = np.inf):
@@ -42,8 +44,11 @@ class Drive:
         self.map = task.known_map
         self.step_len = task.sc.robot.step
         self.p = task.spec.camera.p_detect
-        self.camera = ObjectCamera(w, task.spec.camera, [task.places[p][0] for _, p in instances],
-                                   [task.places[p][1] for _, p in instances])
+        # the camera looks at the places; the instances standing at a place are detected from there
+        self.place_names = list(task.places)
+        self.camera = ObjectCamera(w, task.spec.camera, [task.places[n][0] for n in self.place_names],
+                                   [task.places[n][1] for n in self.place_names])
+        self.at_place = [[i for i, (_, p) in enumerate(instances) if p == n] for n in self.place_names]
         self.x, self.y = w.start_xy
         self.heading = heading
         self.budget = budget
@@ -56,10 +61,11 @@ class Drive:
         self.spent = False  # the budget ran out
 
     def sense(self) -> None:
-        for i in self.camera.visible(self.x, self.y, self.heading):
-            self.seen_places.add(self.instances[i][1])
-            if self.rng.random() < self.p and self.on_detect(int(i), self.x, self.y):
-                self.stopped = True
+        for k in self.camera.visible(self.x, self.y, self.heading):
+            self.seen_places.add(self.place_names[k])
+            for i in self.at_place[k]:
+                if self.rng.random() < self.p and self.on_detect(i, self.x, self.y):
+                    self.stopped = True
 
     def go(self, x: float, y: float, look: bool = True) -> bool:
         """Drive to the reachable cell nearest (x, y); False when it cannot be reached."""
