@@ -183,3 +183,18 @@ def test_when_the_mug_is_gone_lsos_and_brute_force_look_everywhere_then_give_up(
     route = gone.task.route
     assert visited == sorted(visited, key=route.index) and "A" not in visited and "H" not in visited
     assert 0 < len(visited) < len(route)  # places seen on the way were skipped
+
+
+def test_a_bad_detection_log_names_the_file_and_column(tmp_path):
+    (tmp_path / "log.csv").write_text("class,x,y,hour,robot_x\nmug,1,13.4,3,2.6\n")
+
+    def edit(d):
+        d["objects"]["cases"] = [{"name": "L", "record": "log.csv", "truth": "Static"}]
+
+    r = CliRunner().invoke(app, ["validate", str(office_copy(tmp_path, edit))])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2 and "log.csv" in text and "robot_y" in text, text
+    (tmp_path / "log.csv").write_text("class,x,y,hour,robot_x,robot_y\nmug,1,13.4,noon,2.6,11.8\n")
+    r = CliRunner().invoke(app, ["validate", str(office_copy(tmp_path, edit))])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2 and "'hour'" in text and "numbers" in text, text
