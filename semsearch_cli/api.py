@@ -208,10 +208,15 @@ def show(scenario: str | Path, out: str | Path) -> Path:
         from .objects.task import ObjectTask
         from .report.plots import plot_object_paths
 
+        from .objects.search import Drive
+
         task = ObjectTask(sc, world, path.parent, str(path))
-        route = [world.start_xy, *(task.places[n] for n in task.route), world.start_xy]
-        plot_object_paths(world, {}, task.places, (), f"{sc.name}: places {' '.join(task.places)}; "
-                          f"patrol route dotted", out, route=np.asarray(route))
+        drive = Drive(task, [], np.random.default_rng(0), world.start_heading or 0.0)
+        for n in task.route:
+            drive.go(*task.places[n], look=False)
+        drive.go(*world.start_xy, look=False)
+        plot_object_paths(world, {}, task.places, (), f"{sc.name}: places {' '.join(task.places)}; patrol route "
+                          f"{drive.distance:.1f} m (dotted)", out, route=np.asarray(drive.trail))
         return out
     plot_scenario(world, sc.goals, f"{sc.name}: {len(world.signs)} signs, goals {', '.join(map(str, sc.goals))}", out)
     return out

@@ -118,7 +118,7 @@ def _figures(runs, table, folder: Path, out: Path, meta):
             from ..objects.search import LsosParams, lsos_goals
 
             params = json.loads(runs[runs["planner"] == lsos]["params"].iloc[0])
-            heat, goals = lsos_goals(task, loaded.logs[req.case], req.cls, req.hour, LsosParams(**params))
+            heat, goals = lsos_goals(task, _log(folder, loaded, req.case), req.cls, req.hour, LsosParams(**params))
             gx = [(*world.frame.to_world(r, c), phi) for r, c, phi in goals]
             f = fdir / f"heat_{stem}.png"
             plot_heat(world, heat, task.places, req.truth, gx,
@@ -135,6 +135,14 @@ def _figures(runs, table, folder: Path, out: Path, meta):
                               f"{req.case}: {req.cls} at {req.hour:g}:00, median run of each planner", f)
             figs.append((f"Median runs for {label}", f))
     return figs, notes
+
+
+def _log(folder: Path, loaded, case: str) -> pd.DataFrame:
+    """The detection log the runs used (``logs/<case>.csv`` beside runs.csv), else the scenario's."""
+    from ..objects.task import read_log
+
+    f = folder / "logs" / f"{case}.csv"
+    return read_log(f) if f.is_file() else loaded.logs[case]
 
 
 def _loaded(meta, notes):

@@ -197,7 +197,7 @@ def plot_object_paths(world, paths: dict, places: dict, truth, title: str, out: 
     fig, ax = _map_figure(world, 9.0)
     _places(ax, places, truth)
     if route is not None:
-        ax.plot(route[:, 0], route[:, 1], ":", c="tab:red", lw=1.2, label="patrol order")
+        ax.plot(route[:, 0], route[:, 1], ":", c="tab:red", lw=1.2, label="patrol route")
     for k, (lab, (p, d, outcome)) in enumerate(paths.items()):
         ax.plot(p[:, 0], p[:, 1], "-", lw=1.4, c=f"C{k}", label=f"{lab}: {d:.1f} m, {outcome}")
         ax.plot(p[-1, 0], p[-1, 1], "o", c=f"C{k}", ms=5)
