@@ -102,12 +102,76 @@ class PlaceSpec(Strict):
     name: str = Field(pattern=NAME, description="a place where objects stand, e.g. A")
     x: float
     y: float
+    facing: float = Field(0.0, description="degrees, the direction the objects there face (for angle tables)")
+
+
+class DetectTable(Strict):
+    """Detection probability by camera-object distance and view angle (Loncomilla et al. 2018,
+    Table 1): ``p[a][d]`` at ``angles[a]`` and ``distances[d]``. Distances interpolate linearly
+    (clamped at the ends); the view angle (the object's facing against the direction from the object
+    to the camera, 0 = seen from the front) takes the nearest tabulated angle. Without ``angles``,
+    ``p`` is one row."""
+
+    distances: list[float] = Field(min_length=1, description="m, increasing")
+    angles: list[float] | None = Field(None, description="degrees")
+    p: list[list[float]] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _shape(self):
+        if any(b <= a for a, b in zip(self.distances, self.distances[1:])):
+            raise ValueError("distances must increase")
+        rows = len(self.angles) if self.angles else 1
+        if len(self.p) != rows or any(len(r) != len(self.distances) for r in self.p):
+            raise ValueError(f"p must have {rows} row(s) (one per angle) of {len(self.distances)} values (one per distance)")
+        if any(not 0.0 <= v <= 1.0 for r in self.p for v in r):
+            raise ValueError("probabilities must lie in [0, 1]")
+        return self
+
+
+class ClassCameraSpec(Strict):
+    fov: float | None = Field(None, gt=0.0, le=360.0)
+    range: float | None = Field(None, gt=0.0)
+    p_detect: Union[float, DetectTable, None] = None
+
+    @field_validator("p_detect")
+    @classmethod
+    def _p(cls, v):
+        if isinstance(v, float) and not 0.0 <= v <= 1.0:
+            raise ValueError("p_detect must lie in [0, 1]")
+        return v
 
 
 class ObjectCameraSpec(Strict):
+    """Forward object camera (SPEC 2): field of view and range, detection probability constant or
+    a :class:`DetectTable`, with per-class overrides under ``classes``."""
+
     fov: float = Field(60.0, gt=0.0, le=360.0, description="degrees, centred on the heading")
     range: float = Field(3.0, gt=0.0, description="m")
-    p_detect: float = Field(0.9, ge=0.0, le=1.0, description="probability a visible object is detected in one frame")
+    p_detect: Union[float, DetectTable] = Field(0.9, description="probability a visible object is detected in one frame")
+    classes: dict[str, ClassCameraSpec] = Field(default_factory=dict, description="class -> fov / range / p_detect")
+
+    @field_validator("p_detect")
+    @classmethod
+    def _p(cls, v):
+        if isinstance(v, float) and not 0.0 <= v <= 1.0:
+            raise ValueError("p_detect must lie in [0, 1]")
+        return v
+
+    def for_class(self, cls: str) -> tuple[float, float, Union[float, DetectTable]]:
+        """(fov, range, p_detect) for a class."""
+        c = self.classes.get(cls)
+        if c is None:
+            return self.fov, self.range, self.p_detect
+        return (c.fov if c.fov is not None else self.fov, c.range if c.range is not None else self.range,
+                c.p_detect if c.p_detect is not None else self.p_detect)
+
+    @property
+    def max_range(self) -> float:
+        return max([self.range] + [c.range for c in self.classes.values() if c.range is not None])
+
+    @property
+    def max_fov(self) -> float:
+        return max([self.fov] + [c.fov for c in self.classes.values() if c.fov is not None])
 
 
 class RequestSpec(Strict):

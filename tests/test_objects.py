@@ -198,3 +198,32 @@ def test_a_bad_detection_log_names_the_file_and_column(tmp_path):
     r = CliRunner().invoke(app, ["validate", str(office_copy(tmp_path, edit))])
     text = " ".join(r.output.split())
     assert r.exit_code == 2 and "'hour'" in text and "numbers" in text, text
+
+
+def test_detection_table_by_distance_and_view_angle():
+    from semsearch_cli.config import DetectTable
+    from semsearch_cli.objects.task import detect_probability
+
+    t = DetectTable(distances=[0.8, 1.2, 1.6], angles=[0, 90, 180, 270], p=[[0.8, 0.6, 0.4], [0.1, 0.1, 0.0], [0.5, 0.5, 0.5], [0.2, 0.2, 0.2]])
+    assert detect_probability(t, 1.0, 0.0) == pytest.approx(0.7)  # halfway between 0.8 and 0.6
+    assert detect_probability(t, 0.3, 350.0) == pytest.approx(0.8)  # clamped; 350 is nearest 0
+    assert detect_probability(t, 2.0, 100.0) == pytest.approx(0.0)  # clamped at 1.6, nearest 90
+    assert detect_probability(t, 1.4, 200.0) == pytest.approx(0.5)
+    assert detect_probability(0.9, 5.0, 0.0) == 0.9
+    with pytest.raises(ValueError):
+        DetectTable(distances=[1.0, 0.5], p=[[0.5, 0.5]])
+
+
+def test_a_class_with_a_short_camera_range_is_seen_later(tmp_path):
+    def edit(d):
+        d["objects"]["camera"]["p_detect"] = 1.0
+        d["objects"]["camera"]["classes"] = {"mug": {"range": 1.0}}
+
+    short = Loaded.load(office_copy(tmp_path, edit))
+    full = Loaded.load(office_copy(tmp_path, lambda d: d["objects"]["camera"].update(p_detect=1.0)))
+    label = "Static.mug@0"
+    a = ObjectEpisode(short.task, Variant("last_seen", ()), short.task.request(label), short.logs["Static"], 0).run()
+    b = ObjectEpisode(full.task, Variant("last_seen", ()), full.task.request(label), full.logs["Static"], 0).run()
+    assert a.outcome == b.outcome == "found"
+    assert a.distance_m > b.distance_m + 1.5  # about 2 m later: the mug's range is 1 m, not 3 m
+    assert short.shortest[label] > full.shortest[label] + 1.5

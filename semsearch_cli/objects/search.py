@@ -28,7 +28,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ..planners.base import NoParams, Planner, register_planner
 from .heatmap import goal_cells, heat_map
-from .task import ObjectCamera, ObjectTask, Request
+from ..geometry import wrap_angle
+from .task import ObjectCamera, ObjectTask, Request, detect_probability
 
 
 class Drive:
@@ -43,12 +44,15 @@ class Drive:
         self.task, self.world, self.instances, self.rng = task, w, instances, rng
         self.map = task.known_map
         self.step_len = task.sc.robot.step
-        self.p = task.spec.camera.p_detect
-        # the camera looks at the places; the instances standing at a place are detected from there
+        cam = task.spec.camera
+        # the camera looks at the places (widest fov, longest range of any class); each instance
+        # standing at a place in view is then checked against its own class's fov and range
         self.place_names = list(task.places)
-        self.camera = ObjectCamera(w, task.spec.camera, [task.places[n][0] for n in self.place_names],
+        self.camera = ObjectCamera(w, cam.max_fov, cam.max_range, [task.places[n][0] for n in self.place_names],
                                    [task.places[n][1] for n in self.place_names])
         self.at_place = [[i for i, (_, p) in enumerate(instances) if p == n] for n in self.place_names]
+        self.cam = [cam.for_class(cls) for cls, _ in instances]  # (fov, range, p_detect) per instance
+        self.uniform = all(c == (cam.max_fov, cam.max_range, cam.p_detect) and isinstance(c[2], float) for c in self.cam)
         self.x, self.y = w.start_xy
         self.heading = heading
         self.budget = budget
@@ -62,9 +66,19 @@ class Drive:
 
     def sense(self) -> None:
         for k in self.camera.visible(self.x, self.y, self.heading):
-            self.seen_places.add(self.place_names[k])
+            name = self.place_names[k]
+            self.seen_places.add(name)
             for i in self.at_place[k]:
-                if self.rng.random() < self.p and self.on_detect(i, self.x, self.y):
+                fov, rng_m, p = self.cam[i]
+                if not self.uniform:
+                    px, py = self.task.places[name]
+                    d = float(np.hypot(px - self.x, py - self.y))
+                    bearing = float(np.arctan2(py - self.y, px - self.x))
+                    if d > rng_m or abs(float(wrap_angle(bearing - self.heading))) > np.radians(fov) / 2:
+                        continue
+                    view = float(np.degrees(bearing + np.pi - self.task.facing[name])) % 360.0
+                    p = detect_probability(p, d, view)
+                if self.rng.random() < p and self.on_detect(i, self.x, self.y):
                     self.stopped = True
 
     def go(self, x: float, y: float, look: bool = True) -> bool:

@@ -136,21 +136,35 @@ class KnownMap:
         return self._paths[key]
 
 
-class ObjectCamera:
-    """Forward camera: instances within ``range`` and ``fov`` around the heading, in line of sight."""
+def detect_probability(p, distance: float, view_deg: float) -> float:
+    """p_detect of the camera spec: a constant, or a :class:`~semsearch_cli.config.DetectTable`
+    read at ``distance`` (m, linear, clamped) and ``view_deg`` (nearest tabulated angle)."""
+    if isinstance(p, (int, float)):
+        return float(p)
+    row = 0
+    if p.angles:
+        a = np.asarray(p.angles, float)
+        diff = np.abs((a - view_deg + 180.0) % 360.0 - 180.0)
+        row = int(np.argmin(diff))
+    return float(np.interp(distance, p.distances, p.p[row]))
 
-    def __init__(self, world, spec, xs, ys):
-        self.world, self.spec = world, spec
+
+class ObjectCamera:
+    """Forward camera: points within ``range`` (m) and ``fov`` (degrees) around the heading, in
+    line of sight."""
+
+    def __init__(self, world, fov: float, range_m: float, xs, ys):
+        self.world, self.range = world, range_m
         self.x, self.y = np.asarray(xs, float), np.asarray(ys, float)
         self.v, self.u = world.frame.to_cell(self.x, self.y)
-        self.half = np.radians(spec.fov) / 2
+        self.half = np.radians(fov) / 2
 
     def visible(self, x: float, y: float, heading: float) -> np.ndarray:
-        """Indices of the instances in view from pose (x, y, heading)."""
+        """Indices of the points in view from pose (x, y, heading)."""
         if self.x.size == 0:
             return np.zeros(0, np.int64)
         dx, dy = self.x - x, self.y - y
-        near = np.flatnonzero(dx * dx + dy * dy <= self.spec.range**2)
+        near = np.flatnonzero(dx * dx + dy * dy <= self.range**2)
         if near.size and self.half < np.pi:
             rel = np.abs(wrap_angle(np.arctan2(dy[near], dx[near]) - heading))
             near = near[rel <= self.half]
@@ -169,6 +183,7 @@ class ObjectTask:
         if len(set(names)) != len(names):
             raise ScenarioError(file, "objects.places", "place names must be unique")
         self.places = {p.name: (p.x, p.y) for p in spec.places}
+        self.facing = {p.name: float(np.radians(p.facing)) for p in spec.places}
         fr = world.frame
         for k, p in enumerate(spec.places):
             r, c = fr.to_index(p.x, p.y)
@@ -176,7 +191,7 @@ class ObjectTask:
                 raise ScenarioError(file, f"objects.places[{k}]", f"place {p.name} at ({p.x}, {p.y}) m lies outside the map")
             if not self.view_mask(p.x, p.y).any():
                 raise ScenarioError(file, f"objects.places[{k}]", f"place {p.name} at ({p.x}, {p.y}) m cannot be seen by the "
-                                    f"object camera ({spec.camera.range} m range) from any pose reachable from the start")
+                                    f"object camera ({spec.camera.max_range} m range) from any pose reachable from the start")
         self.route = list(spec.route) if spec.route is not None else names
         for k, n in enumerate(self.route):
             self._check_place(n, f"objects.route[{k}]")
@@ -266,9 +281,11 @@ class ObjectTask:
         others = [(cl, p) for cl, p in self.instances(case.truth, req.hour) if cl != req.cls]
         return others + [(req.cls, p) for p in req.truth]
 
-    def view_mask(self, x: float, y: float) -> np.ndarray:
-        """Reachable cells from which a point at (x, y) is within camera range and in line of sight."""
-        w, fr, rng = self.world, self.world.frame, self.spec.camera.range
+    def view_mask(self, x: float, y: float, rng: float | None = None) -> np.ndarray:
+        """Reachable cells from which a point at (x, y) is within ``rng`` (default: the camera's
+        longest range) and in line of sight."""
+        w, fr = self.world, self.world.frame
+        rng = self.spec.camera.max_range if rng is None else rng
         v, u = fr.to_cell(x, y)
         R = int(np.ceil(rng / fr.res)) + 1
         r0, r1 = max(0, int(v) - R), min(fr.height, int(v) + R + 1)
@@ -295,8 +312,9 @@ class ObjectTask:
         """Geodesic from the start to the nearest pose that sees an instance of the target
         (heading free); inf when the request's ground truth holds none."""
         best = np.inf
+        rng = self.spec.camera.for_class(req.cls)[1]
         for p in req.truth:
-            m = self.view_mask(*self.places[p])
+            m = self.view_mask(*self.places[p], rng)
             if m.any():
                 best = min(best, float(self.start_distance[m].min()))
         return best
