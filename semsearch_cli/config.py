@@ -242,7 +242,7 @@ class Scenario(Strict):
         return self.objects is not None
 
 
-_TYPE_PART = re.compile(r"^(int|str|float|bool|none|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec)$")
+_TYPE_PART = re.compile(r"^(int|str|float|bool|none|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec|DetectTable)$")
 
 
 def _loc(loc: tuple) -> str:
@@ -265,7 +265,12 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
+        errs = exc.errors()
+        err = errs[0]
+        # a value matching no branch of a union gets one error per branch: report the deepest one
+        # under the same field (the branch the input was meant for, e.g. a table given as a mapping)
+        same = [e for e in errs if _loc(e["loc"]).startswith(_loc(err["loc"]))]
+        err = max(same, key=lambda e: (len(e["loc"]), not e["type"].endswith("_type")))
         field = _loc(err["loc"])
         msg = err["msg"]
         if err["type"] == "extra_forbidden":
