@@ -93,10 +93,24 @@ def _batch(call):
             res = call(tick)
     except ScenarioError as exc:
         _fail(exc)
-    _print_summary(res.summary)
+    from .report.objects import figure_table, is_object_runs, object_table
+
+    if is_object_runs(res.runs):
+        _print_object_table(figure_table(object_table(res.runs)))
+    else:
+        _print_summary(res.summary)
     figs = res.out / ("figures" if (res.out / "logs").is_dir() else "plots")
     out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {figs}  report: {res.out / 'report.md'}")
     return res
+
+
+def _print_object_table(wide):
+    t = Table(title="distance until the object is seen (m): mean ± std (found / runs)")
+    for col in ["case", "request", *wide.columns]:
+        t.add_column(str(col), justify="left" if col in ("case", "request") else "right")
+    for (case, req), r in wide.iterrows():
+        t.add_row(escape(case), escape(req), *[escape(str(v)) for v in r])
+    out.print(t)
 
 
 def _print_summary(summary):
