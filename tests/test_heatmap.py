@@ -54,3 +54,15 @@ def test_a_sighting_twelve_hours_away_weighs_nothing():
     fr = GridFrame(1.0, 0.0, 0.0, 20, 20)
     assert heat_map([("mug", 5.5, 5.5, 0.0, 8.5, 5.5)], "mug", 12.0, fr, radius_m=3.0).sum() == 0.0
     assert goal_cells(np.zeros((20, 20)), 2.0) == []
+
+
+def test_a_kernel_wide_window_puts_the_goal_at_the_kernel_edge_toward_the_robot():
+    fr = GridFrame(0.1, 0.0, 0.0, 100, 100)
+    dets = [("mug", 5.05, 5.05, 12.0, 5.05, 2.05)]  # the robot saw it from 3 m south
+    heat = heat_map(dets, "mug", 12.0, fr, radius_m=1.5, sector_deg=45.0)
+    (r, c, phi), = goal_cells(heat, window_cells=15.0)
+    orow, ocol = fr.to_index(5.05, 5.05)
+    dr, dc = r - orow, c - ocol
+    assert abs(dr) + abs(dc) == 15  # on the kernel's edge (Manhattan d = r), its warmest cells
+    assert dr > 0 and abs(dc) <= dr  # within 45 degrees of due south, toward where the robot stood
+    assert phi == pytest.approx(heat.sum())  # the window holds the whole kernel

@@ -107,6 +107,7 @@ def _figures(runs, table, folder: Path, out: Path, meta):
     task, world = loaded.task, loaded.world
     med = T.median_run(runs)
     lsos = next((lab for lab in order if lab.split("[", 1)[0] == "lsos"), None)
+    stepped: set[str] = set()
     for label in dict.fromkeys(runs["goal"]):
         try:
             req = task.request(label)
@@ -124,6 +125,11 @@ def _figures(runs, table, folder: Path, out: Path, meta):
             plot_heat(world, heat, task.places, req.truth, gx,
                       f"{req.case}: {req.cls} at {req.hour:g}:00, {lsos} heat map (Eq. 5.4) and goals (Eqs. 5.5-5.6)", f)
             figs.append((f"Heat map for {label}; red rings: where the {req.cls} is", f))
+            if req.case not in stepped:  # the construction, once per case (thesis Figures 5.7-5.8)
+                stepped.add(req.case)
+                f = fdir / f"heat_steps_{stem}.png"
+                _heat_steps(task, world, _log(folder, loaded, req.case), req, LsosParams(**params), f)
+                figs.append((f"How the heat map for {label} is built (thesis Figures 5.7-5.8)", f))
         paths = {}
         for _, r in med[med["goal"] == label].iterrows():
             p = folder / "paths" / f"{file_stem(r['planner'], label, int(r['seed']))}.npz"
@@ -135,6 +141,22 @@ def _figures(runs, table, folder: Path, out: Path, meta):
                               f"{req.case}: {req.cls} at {req.hour:g}:00, median run of each planner", f)
             figs.append((f"Median runs for {label}", f))
     return figs, notes
+
+
+def _heat_steps(task, world, log, req, p, out: Path) -> None:
+    from ..objects.heatmap import heat_map
+    from .plots import plot_heat_steps
+
+    rows = list(zip(log["class"], log["x"], log["y"], log["hour"], log["robot_x"], log["robot_y"]))
+    args = (req.hour, world.frame, p.radius, task.known)
+    panels = [
+        ("(a) every detection, circular kernel K (Eq. 5.1)", heat_map(rows, None, *args, sector_deg=180.0, inverted=False)),
+        (f"(b) kernels cut to {p.sector:g} degrees toward the robot pose", heat_map(rows, None, *args, sector_deg=p.sector, inverted=False)),
+        (f"(c) only the class {req.cls}", heat_map(rows, req.cls, *args, sector_deg=p.sector, inverted=False)),
+        ("(d) inverted kernel IK (Eq. 5.4): what LSOS uses", heat_map(rows, req.cls, *args, sector_deg=p.sector, inverted=True)),
+    ]
+    plot_heat_steps(world, panels, task.places, f"{req.case}: heat map for {req.cls} at {req.hour:g}:00, step by step "
+                    f"(r = {p.radius:g} m, W of Eq. 5.3)", out)
 
 
 def _log(folder: Path, loaded, case: str) -> pd.DataFrame:

@@ -245,3 +245,29 @@ def plot_object_bars(table, order: list, out: Path) -> None:
                  "hatched when some did not)", fontsize=10)
     fig.tight_layout()
     _save(fig, out)
+
+
+def plot_heat_steps(world, panels: list, places: dict, title: str, out: Path) -> None:
+    """The heat map built step by step (the thesis' Figures 5.7-5.8): ``panels`` is a list of
+    (caption, heat) drawn side by side over the map."""
+    fr = world.frame
+    n = len(panels)
+    cols = 2
+    rows = (n + 1) // 2
+    w = 6.0
+    fig, axes = plt.subplots(rows, cols, figsize=(w * cols, w * fr.height / fr.width * rows + 0.8), squeeze=False)
+    for ax, (caption, heat) in zip(axes.flat, panels):
+        ax.imshow(np.where(world.free, 1.0, 0.25), cmap="gray", vmin=0, vmax=1, extent=_extent(world), interpolation="nearest")
+        h = np.ma.masked_where(heat <= 0, heat)
+        ax.imshow(h, cmap="hot_r", extent=_extent(world), interpolation="nearest", alpha=0.85)
+        for name, (x, y) in places.items():
+            ax.plot(x, y, "o", ms=3, c="#555555")
+            ax.annotate(name, (x, y), xytext=(3, 3), textcoords="offset points", fontsize=7)
+        ax.set_title(caption, fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    for ax in list(axes.flat)[n:]:
+        ax.axis("off")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    _save(fig, out)
