@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any, Literal, Union
+from typing import Annotated, Any, Literal, Union
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -128,17 +128,13 @@ class DetectTable(Strict):
         return self
 
 
+Probability = Annotated[float, Field(ge=0.0, le=1.0)]
+
+
 class ClassCameraSpec(Strict):
     fov: float | None = Field(None, gt=0.0, le=360.0)
     range: float | None = Field(None, gt=0.0)
-    p_detect: Union[float, DetectTable, None] = None
-
-    @field_validator("p_detect")
-    @classmethod
-    def _p(cls, v):
-        if isinstance(v, float) and not 0.0 <= v <= 1.0:
-            raise ValueError("p_detect must lie in [0, 1]")
-        return v
+    p_detect: Union[Probability, DetectTable, None] = None
 
 
 class ObjectCameraSpec(Strict):
@@ -147,15 +143,8 @@ class ObjectCameraSpec(Strict):
 
     fov: float = Field(60.0, gt=0.0, le=360.0, description="degrees, centred on the heading")
     range: float = Field(3.0, gt=0.0, description="m")
-    p_detect: Union[float, DetectTable] = Field(0.9, description="probability a visible object is detected in one frame")
+    p_detect: Union[Probability, DetectTable] = Field(0.9, description="probability a visible object is detected in one frame")
     classes: dict[str, ClassCameraSpec] = Field(default_factory=dict, description="class -> fov / range / p_detect")
-
-    @field_validator("p_detect")
-    @classmethod
-    def _p(cls, v):
-        if isinstance(v, float) and not 0.0 <= v <= 1.0:
-            raise ValueError("p_detect must lie in [0, 1]")
-        return v
 
     def for_class(self, cls: str) -> tuple[float, float, Union[float, DetectTable]]:
         """(fov, range, p_detect) for a class."""
@@ -242,7 +231,7 @@ class Scenario(Strict):
         return self.objects is not None
 
 
-_TYPE_PART = re.compile(r"^(int|str|float|bool|none|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec|DetectTable)$")
+_TYPE_PART = re.compile(r"^(int|str|float|bool|none|constrained-\w+|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec|DetectTable)$")
 
 
 def _loc(loc: tuple) -> str:

@@ -146,19 +146,13 @@ def _figures(runs, folder: Path, out: Path, order, meta, replay):
 
 def _world(meta, notes):
     from ..config import load_scenario
-    from ..errors import ScenarioError
     from ..world.scenario import build_world
 
-    path = Path(meta.get("scenario", ""))
-    if not meta.get("scenario") or not path.is_file():
-        notes.append("Path figures and the replay were skipped: the scenario file named in meta.json is not available.")
-        return None
-    try:
+    def load(path):
         sc = load_scenario(path)
         return build_world(sc, path.parent, str(path)), sc
-    except ScenarioError as exc:
-        notes.append(f"Path figures skipped: {exc}")
-        return None
+
+    return from_meta(meta, notes, "Path figures and the replay", load)
 
 
 def _goal(world, goal):
@@ -208,16 +202,50 @@ def _replay(world, runs, meta, fdir, order, notes):
             "the map as built (white free, black occupied, gray unknown), candidates and the chosen one", f)
 
 
-def _markdown(runs, tabs, figs, notes, meta, folder: Path, out: Path) -> str:
+def head_lines(runs, meta, folder: Path, kind: str = "") -> list[str]:
+    """The top of a report: title, version, the commands that produced the rows, the scenario."""
     now = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     scen = ", ".join(sorted(runs["scenario"].unique()))
-    lines = [f"# semsearch report: {scen}", "",
+    lines = [f"# semsearch report: {scen}{kind}", "",
              f"semsearch {__version__}, {now}; {len(runs)} finished runs from `{folder / 'runs.csv'}`.", ""]
     if meta.get("commands"):
         lines += ["Produced by:", "", *[f"    {c}" for c in meta["commands"]], "",
                   f"Report: `semsearch report {folder}`", ""]
     if meta.get("scenario") and Path(meta["scenario"]).is_file():
         lines += ["## Scenario", "", "```yaml", Path(meta["scenario"]).read_text().strip(), "```", ""]
+    return lines
+
+
+def tail_lines(figs, notes, out: Path) -> list[str]:
+    """The end of a report: the figures with their captions, then the notes."""
+    lines = []
+    if figs:
+        lines += ["## Figures", ""]
+        for caption, f in figs:
+            lines += [f"![{caption}]({os.path.relpath(f, out)})", "", f"*{caption}*", ""]
+    for n in notes:
+        lines += [f"> {n}", ""]
+    return lines
+
+
+def from_meta(meta, notes, what: str, load):
+    """``load(path)`` of the scenario named in meta.json, or None with a note saying that
+    ``what`` were skipped and why."""
+    from ..errors import ScenarioError
+
+    path = Path(meta.get("scenario", ""))
+    if not meta.get("scenario") or not path.is_file():
+        notes.append(f"{what} were skipped: the scenario file named in meta.json is not available.")
+        return None
+    try:
+        return load(path)
+    except ScenarioError as exc:
+        notes.append(f"{what} were skipped: {exc}")
+        return None
+
+
+def _markdown(runs, tabs, figs, notes, meta, folder: Path, out: Path) -> str:
+    lines = head_lines(runs, meta, folder)
     lines += ["## Distance travelled (m): median, mean, std, min, max (thesis Tables 4.2-4.5)", "",
               "Best of each row in **bold**, worst in _italics_.", "", T.markdown(tabs["five_statistics"], mark_rows=True), "",
               "## Mean ± std beside the shortest path (Tables 4.6-4.9)", "", T.markdown(tabs["mean_std"]), "",
@@ -226,13 +254,7 @@ def _markdown(runs, tabs, figs, notes, meta, folder: Path, out: Path) -> str:
               "## Is the difference significant? (Mann-Whitney U against greedy, two-sided)", "",
               "effect_r: rank-biserial correlation, positive when the planner travels less than greedy.", "",
               T.markdown(tabs["significance"].set_index(["scenario", "goal", "planner"]).drop(columns=["baseline"]), fmt="{:.3g}"), ""]
-    if figs:
-        lines += ["## Figures", ""]
-        for caption, f in figs:
-            lines += [f"![{caption}]({os.path.relpath(f, out)})", "", f"*{caption}*", ""]
-    for n in notes:
-        lines += [f"> {n}", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + tail_lines(figs, notes, out))
 
 
 def _html(md: str, out: Path) -> str:

@@ -168,41 +168,18 @@ def _log(folder: Path, loaded, case: str) -> pd.DataFrame:
 
 
 def _loaded(meta, notes):
-    from ..errors import ScenarioError
     from ..experiment import Loaded
+    from .build import from_meta
 
-    path = Path(meta.get("scenario", ""))
-    if not meta.get("scenario") or not path.is_file():
-        notes.append("Heat maps and paths were skipped: the scenario file named in meta.json is not available.")
-        return None
-    try:
-        return Loaded.load(path)
-    except ScenarioError as exc:
-        notes.append(f"Heat maps and paths skipped: {exc}")
-        return None
+    return from_meta(meta, notes, "Heat maps and paths", Loaded.load)
 
 
 def _markdown(runs, wide, figs, notes, meta, folder: Path, out: Path) -> str:
-    import datetime
+    from .build import head_lines, tail_lines
 
-    from .. import __version__
-
-    now = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
-    scen = ", ".join(sorted(runs["scenario"].unique()))
-    lines = [f"# semsearch report: {scen} (object search)", "",
-             f"semsearch {__version__}, {now}; {len(runs)} finished runs from `{folder / 'runs.csv'}`.", ""]
-    if meta.get("commands"):
-        lines += ["Produced by:", "", *[f"    {c}" for c in meta["commands"]], "", f"Report: `semsearch report {folder}`", ""]
+    lines = head_lines(runs, meta, folder, " (object search)")
     lines += ["## Distance until the object is seen (m): mean ± std (found / runs)", "",
               "A run that does not find the object counts the distance until the planner gave up "
               "(Last Seen after its one spot, Brute Force after its whole route).", "",
               T.markdown(wide), ""]
-    if meta.get("scenario") and Path(meta["scenario"]).is_file():
-        lines += ["## Scenario", "", "```yaml", Path(meta["scenario"]).read_text().strip(), "```", ""]
-    if figs:
-        lines += ["## Figures", ""]
-        for caption, f in figs:
-            lines += [f"![{caption}]({os.path.relpath(f, out)})", "", f"*{caption}*", ""]
-    for n in notes:
-        lines += [f"> {n}", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + tail_lines(figs, notes, out))
