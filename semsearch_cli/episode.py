@@ -19,7 +19,7 @@ import numpy as np
 
 from .belief import Belief
 from .config import Scenario
-from .geometry import wrap_angle
+from .geometry import advance, wrap_angle
 from .navigation import NAVIGATORS
 from .planners import PlanContext, Variant
 from .sensors.devices import DoorCamera, Laser
@@ -167,23 +167,7 @@ class Episode:
                 since_plan = 0.0
                 looked_around = False
             # 4. move one step along the path
-            remaining = step_len
-            moved = 0.0
-            while remaining > 1e-12 and path_i < len(path_r):
-                dx, dy = px[path_i] - x, py[path_i] - y
-                d = float(np.hypot(dx, dy))
-                if d <= remaining:
-                    x, y = float(px[path_i]), float(py[path_i])
-                    path_i += 1
-                    remaining -= d
-                    moved += d
-                else:
-                    x += dx / d * remaining
-                    y += dy / d * remaining
-                    moved += remaining
-                    remaining = 0.0
-                if d > 1e-9:
-                    heading = float(np.arctan2(dy, dx))
+            x, y, path_i, heading, moved = advance(px, py, path_i, x, y, heading, step_len)
             distance += moved
             since_plan += moved
             steps += 1

@@ -28,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ..planners.base import NoParams, Planner, register_planner
 from .heatmap import goal_cells, heat_map
-from ..geometry import wrap_angle
+from ..geometry import advance, wrap_angle
 from .task import ObjectCamera, ObjectTask, Request, detect_probability
 
 
@@ -92,22 +92,8 @@ class Drive:
         px, py = fr.to_world(p[0], p[1])
         i = 1
         while i < len(px) and not self.stopped:
-            remaining = self.step_len
-            while remaining > 1e-12 and i < len(px):
-                dx, dy = px[i] - self.x, py[i] - self.y
-                d = float(np.hypot(dx, dy))
-                if d > 1e-9:
-                    self.heading = float(np.arctan2(dy, dx))
-                if d <= remaining:
-                    self.x, self.y = float(px[i]), float(py[i])
-                    i += 1
-                    remaining -= d
-                    self.distance += d
-                else:
-                    self.x += dx / d * remaining
-                    self.y += dy / d * remaining
-                    self.distance += remaining
-                    remaining = 0.0
+            self.x, self.y, i, self.heading, moved = advance(px, py, i, self.x, self.y, self.heading, self.step_len)
+            self.distance += moved
             self.steps += 1
             self.trail.append((self.x, self.y))
             self.sense()
@@ -116,7 +102,7 @@ class Drive:
                 return True
         if look and not self.stopped:
             for _ in range(3):
-                self.heading = float((self.heading + np.pi / 2 + np.pi) % (2 * np.pi) - np.pi)
+                self.heading = float(wrap_angle(self.heading + np.pi / 2))
                 self.sense()
                 if self.stopped:
                     break

@@ -284,21 +284,7 @@ class ObjectTask:
     def view_mask(self, x: float, y: float, rng: float | None = None) -> np.ndarray:
         """Reachable cells from which a point at (x, y) is within ``rng`` (default: the camera's
         longest range) and in line of sight."""
-        w, fr = self.world, self.world.frame
-        rng = self.spec.camera.max_range if rng is None else rng
-        v, u = fr.to_cell(x, y)
-        R = int(np.ceil(rng / fr.res)) + 1
-        r0, r1 = max(0, int(v) - R), min(fr.height, int(v) + R + 1)
-        c0, c1 = max(0, int(u) - R), min(fr.width, int(u) + R + 1)
-        out = np.zeros(w.free.shape, bool)
-        rr, cc = np.nonzero(w.reach[r0:r1, c0:c1])
-        rr, cc = rr + r0, cc + c0
-        px, py = fr.to_world(rr, cc)
-        ok = (px - x) ** 2 + (py - y) ** 2 <= rng * rng
-        for r, c in zip(rr[ok], cc[ok]):
-            if line_of_sight(w.occ, r + 0.5, c + 0.5, float(v), float(u), 0.5):
-                out[r, c] = True
-        return out
+        return self.world.sight_mask(x, y, self.spec.camera.max_range if rng is None else rng, 0.5)
 
     @cached_property
     def start_distance(self) -> np.ndarray:

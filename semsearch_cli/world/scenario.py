@@ -144,32 +144,40 @@ class World:
             return np.zeros_like(self.cspace)
         return lab == lab[r, c]
 
+    def sight_mask(self, x: float, y: float, rng: float, stop_short: float, facing: float | None = None,
+                   within: np.ndarray | None = None) -> np.ndarray:
+        """(H, W) bool: cells of ``within`` (default: reachable) within ``rng`` m of the point
+        (x, y) and in line of sight of it (the last ``stop_short`` cells of the line unchecked);
+        with ``facing`` (radians), only cells in front of it."""
+        within = self.reach if within is None else within
+        fr = self.frame
+        v, u = fr.to_cell(x, y)
+        R = int(np.ceil(rng / fr.res)) + 1
+        r0, r1 = max(0, int(v) - R), min(fr.height, int(v) + R + 1)
+        c0, c1 = max(0, int(u) - R), min(fr.width, int(u) + R + 1)
+        out = np.zeros(self.free.shape, bool)
+        rr, cc = np.nonzero(within[r0:r1, c0:c1])
+        rr += r0
+        cc += c0
+        px, py = fr.to_world(rr, cc)
+        dx, dy = px - x, py - y
+        ok = dx * dx + dy * dy <= rng * rng
+        if facing is not None:
+            ok &= dx * np.cos(facing) + dy * np.sin(facing) > 0
+        occ = self.occ
+        for r, c in zip(rr[ok], cc[ok]):
+            if line_of_sight(occ, r + 0.5, c + 0.5, float(v), float(u), stop_short):
+                out[r, c] = True
+        return out
+
     def readable_mask(self, i: int, within: np.ndarray | None = None) -> np.ndarray:
         """(H, W) bool: cells of ``within`` (default: reachable) from which sign ``i`` can be read.
 
         A pose reads a sign within camera range, in line of sight, in front of the sign's face
         (SPEC 2); the side cameras can always be turned onto it, so heading is free.
         """
-        within = self.reach if within is None else within
-        fr = self.frame
-        sr, sc = fr.to_cell(self.signs.x[i], self.signs.y[i])
-        R = int(np.ceil(self.read_range / fr.res)) + 1
-        r0, r1 = max(0, int(sr) - R), min(fr.height, int(sr) + R + 1)
-        c0, c1 = max(0, int(sc) - R), min(fr.width, int(sc) + R + 1)
-        out = np.zeros(self.free.shape, bool)
-        rr, cc = np.nonzero(within[r0:r1, c0:c1])
-        rr += r0
-        cc += c0
-        x, y = fr.to_world(rr, cc)
-        dx, dy = x - self.signs.x[i], y - self.signs.y[i]
-        ok = (dx * dx + dy * dy <= self.read_range**2) & (
-            dx * np.cos(self.signs.facing[i]) + dy * np.sin(self.signs.facing[i]) > 0
-        )
-        occ = self.occ
-        for r, c in zip(rr[ok], cc[ok]):
-            if line_of_sight(occ, r + 0.5, c + 0.5, sr, sc, 0.75):
-                out[r, c] = True
-        return out
+        s = self.signs
+        return self.sight_mask(s.x[i], s.y[i], self.read_range, 0.75, s.facing[i], within)
 
     def shortest_path(self, label) -> float:
         """Ground-truth geodesic (m), with the robot's clearance, from the start to the pose that
