@@ -24,12 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from semsearch_cli.belief import Belief
-from semsearch_cli.episode import Episode
-from semsearch_cli.experiment import Loaded, expand, run_batch
+from semsearch_cli.config import NavigationSpec, PlannerSpec
+from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.tasks import build_task
 from semsearch_cli.navigation import GeodesicNavigator, HarmonicNavigator
 from semsearch_cli.planners import Variant
 from semsearch_cli.sensors.devices import DoorCamera, Laser
-from semsearch_cli.sensors.raycast import himm_update
+from semsearch_cli.kernels.raycast import himm_update
 from semsearch_cli.world.mobilesim import import_mobilesim
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
@@ -108,10 +109,10 @@ def main() -> int:
     say()
     # 1. one run per planner
     for variant in (Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),))):
-        Episode(L.world, L.sc, variant, 148, 0).run()  # warm-up (numba cache, imports)
+        L.task.run(variant, 148, 0)  # warm-up (numba cache, imports)
         walls, base = [], []
         for _ in range(a.repeat):
-            res = Episode(L.world, L.sc, variant, 148, 0).run()
+            res = L.task.run(variant, 148, 0)
             walls.append(res.wall_s)
             base.append(sensing_only(L, res.path.astype(float)))
         med, bmed = statistics.median(walls), statistics.median(base)
@@ -147,18 +148,16 @@ def main() -> int:
     say(f"harmonic path length vs geodesic: mean {rel.mean() * 100:+.1f}%, median {np.median(rel) * 100:+.1f}%, "
         f"range {rel.min() * 100:+.1f}% .. {rel.max() * 100:+.1f}%; harmonic fell back to geodesic {har.fallbacks} times")
     say(f"time to drive one pair: geodesic median {statistics.median(tg) * 1000:.0f} ms, harmonic median {statistics.median(th) * 1000:.0f} ms")
-    from semsearch_cli.config import NavigationSpec
-
     sc_h = L.sc.model_copy(update={"navigation": NavigationSpec(navigator="harmonic")})
+    task_h = build_task(sc_h, L.world, L.path)
     dg, dh = [], []
     for s in range(3):
-        dg.append(Episode(L.world, L.sc, Variant("greedy", ()), 148, s).run().distance_m)
-        dh.append(Episode(L.world, sc_h, Variant("greedy", ()), 148, s).run().distance_m)
+        dg.append(L.task.run(Variant("greedy", ()), 148, s).distance_m)
+        dh.append(task_h.run(Variant("greedy", ()), 148, s).distance_m)
     say("greedy runs, goal 148, seeds 0-2: geodesic " + ", ".join(f"{d:.1f}" for d in dg)
         + " m; harmonic " + ", ".join(f"{d:.1f}" for d in dh) + " m")
     say()
     # 3. whole tables
-    from semsearch_cli.config import PlannerSpec
 
     tables = {"bvp": [PlannerSpec(name="greedy"), PlannerSpec(name="bvp")],
               "nsos": [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[0.8, 0.9, 1.0])]}

@@ -20,9 +20,8 @@ import time
 from pathlib import Path
 
 from semsearch_cli.config import load_scenario
-from semsearch_cli.experiment import Loaded, expand, run_batch
-from semsearch_cli.objects.search import ObjectEpisode
-from semsearch_cli.objects.task import ObjectTask
+from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.tasks.objects import ObjectTask
 from semsearch_cli.planners import Variant
 from semsearch_cli.world.scenario import build_world
 
@@ -46,7 +45,7 @@ def main() -> None:
 
     def checks_only():
         sc = load_scenario(OFFICE)
-        return ObjectTask(sc, build_world(sc, OFFICE.parent, str(OFFICE)), OFFICE.parent, str(OFFICE))
+        return ObjectTask(sc, build_world(sc, OFFICE.parent, str(OFFICE)), OFFICE)
 
     t_checks, _ = median_time(checks_only, args.repeat)
     t_load, L = median_time(lambda: Loaded.load(OFFICE), args.repeat)
@@ -55,9 +54,7 @@ def main() -> None:
           f"(recording = {t_load / t_checks:.1f}x the checks) |")
     for label, planner in (("Moved-mug.mug@0", "lsos"), ("Moved-mug.mug@0", "brute_force"),
                            ("Moved-mug.mug@0", "last_seen"), ("Static.mug@0", "brute_force")):
-        req = L.task.request(label)
-        t, res = median_time(lambda req=req, planner=planner: ObjectEpisode(L.task, Variant(planner, ()), req,
-                                                                           L.logs[req.case], 0).run(), args.repeat)
+        t, res = median_time(lambda label=label, planner=planner: L.task.run(Variant(planner, ()), label, 0), args.repeat)
         print(f"| {planner}, {label}, seed 0 | {t * 1000:.0f} ms | {res.distance_m:.1f} m, {res.outcome}, "
               f"{t / max(res.distance_m, 1e-9) * 100 * 1000:.0f} ms per 100 m |")
     with tempfile.TemporaryDirectory() as d:

@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from thesis import GREEDY, MAPS, NSOS, SHORTEST  # noqa: E402
 
 from semsearch_cli.config import PlannerSpec  # noqa: E402
-from semsearch_cli.experiment import Loaded, expand, run_batch  # noqa: E402
+from semsearch_cli.runner import Loaded, expand, run_batch  # noqa: E402
 from semsearch_cli.planners import expand_variants  # noqa: E402
 from semsearch_cli.report.build import write_meta  # noqa: E402
 from semsearch_cli.report.tables import summarise  # noqa: E402

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from semsearch_cli.experiment import Loaded, expand, run_batch
+from semsearch_cli.runner import Loaded, expand, run_batch
 
 
 def main() -> int:

@@ -12,8 +12,14 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
-from . import __version__
+from . import __version__, api
+from .belief.presence import presence_scores, read_counts
 from .errors import ScenarioError
+from .report.build import console_tables
+from .world.generate import generate_batch as gen_batch
+from .world.generate import generate_building as gen_building
+from .world.kth import import_kth as imp_kth
+from .world.mobilesim import import_mobilesim as imp_mobilesim
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
@@ -47,7 +53,6 @@ def run(
 ):
     """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
-    from . import api
 
     _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick, trace=trace))
 
@@ -64,7 +69,6 @@ def sweep_alpha(
 ):
     """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
     plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
-    from . import api
 
     try:
         values = [float(a) for a in alphas.split(",") if a.strip()]
@@ -93,32 +97,24 @@ def _batch(call):
             res = call(tick)
     except ScenarioError as exc:
         _fail(exc)
-    from .report.objects import figure_table, is_object_runs, object_table
-
-    if is_object_runs(res.runs):
-        _print_object_table(figure_table(object_table(res.runs)))
-    else:
-        _print_summary(res.summary)
-    figs = res.out / ("figures" if (res.out / "logs").is_dir() else "plots")
-    out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {figs}  report: {res.out / 'report.md'}")
+    for title, df in console_tables(res.runs):
+        _print_table(title, df)
+    errors = res.runs[res.runs["outcome"] == "error"]
+    if len(errors):
+        err.print(escape(f"warning: {len(errors)} run(s) raised an error (outcome error in runs.csv), e.g. "
+                         f"{errors['planner'].iloc[0]}: {errors['message'].iloc[0]}"), highlight=False)
+    out.print(escape(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {res.out / 'figures'}  "
+                     f"report: {res.out / 'report.md'}"))
     return res
 
 
-def _print_object_table(wide):
-    t = Table(title="distance until the object is seen (m): mean ± std (found / runs)")
-    for col in ["case", "request", *wide.columns]:
-        t.add_column(str(col), justify="left" if col in ("case", "request") else "right")
-    for (case, req), r in wide.iterrows():
-        t.add_row(escape(case), escape(req), *[escape(str(v)) for v in r])
-    out.print(t)
-
-
-def _print_summary(summary):
-    t = Table(title="distance travelled (m) per goal and planner")
-    for col in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]:
-        t.add_column(col, justify="right" if col not in ("planner",) else "left")
-    for _, r in summary.iterrows():
-        t.add_row(*[escape(str(r[c])) for c in ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]])
+def _print_table(title: str, df) -> None:
+    """A DataFrame as a console table; text columns left-aligned, numbers right."""
+    t = Table(title=escape(title))
+    for col in df.columns:
+        t.add_column(escape(str(col)), justify="left" if df[col].dtype == object else "right")
+    for _, r in df.iterrows():
+        t.add_row(*[escape(str(v)) for v in r])
     out.print(t)
 
 
@@ -131,7 +127,6 @@ def report(
 ):
     """Rebuild the thesis' tables, significance tests and figures from runs.csv alone, plus one
     self-contained report.md / report.html per results folder."""
-    from . import api
 
     try:
         files = api.report(folders, out_dir, [f.strip() for f in fmt.split(",") if f.strip()], replay)
@@ -149,8 +144,6 @@ def presence(
 ):
     """Score every place at each request hour from hourly counts (thesis 5.3.5, Eq. 5.3); the
     highest of each hour is marked."""
-    from .objects.presence import presence_scores, read_counts
-
     try:
         try:
             hs = [float(h) for h in hours.split(",") if h.strip()]
@@ -185,7 +178,6 @@ def record(
     """Recording mode: patrol the route at each recording hour and write the detection log of
     every case (day, hour, class, x, y, robot_x, robot_y, place). A scenario can replay a log
     with `record: path/to/log.csv` in its case."""
-    from . import api
 
     try:
         written = api.record(scenario, out_dir, _split(cases))
@@ -198,7 +190,6 @@ def record(
 @app.command()
 def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""
-    from . import api
 
     try:
         info = api.validate(scenario)
@@ -215,7 +206,6 @@ def show(
     out_file: Path = typer.Option(Path("map.png"), "--out", help="PNG to write."),
 ):
     """Draw a scenario: the map with every sign and its number, the start and the goals."""
-    from . import api
 
     try:
         path = api.show(scenario, out_file)
@@ -240,10 +230,8 @@ def generate_building(
     name: Optional[str] = typer.Option(None, "--name", help="Scenario name (default LAYOUT-NUMBERING-SEED)."),
 ):
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
-    from .world.generate import generate_building as gen
-
     try:
-        path = gen(layout, numbering, seed, out_dir, spacing=spacing, signs=signs,
+        path = gen_building(layout, numbering, seed, out_dir, spacing=spacing, signs=signs,
                    goals=_split([goals]) if goals else None, name=name)
     except ScenarioError as exc:
         _fail(exc)
@@ -257,10 +245,8 @@ def generate_batch(
     runs: int = typer.Option(3, "--runs", min=1, help="Runs per goal and planner in each scenario."),
 ):
     """Every layout x numbering scheme x seed: a robustness set (4 x 5 x 3 = 60 buildings by default)."""
-    from .world.generate import generate_batch as gen
-
     try:
-        paths = gen(out_dir, seeds=seeds, runs=runs)
+        paths = gen_batch(out_dir, seeds=seeds, runs=runs)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {len(paths)} scenarios under {out_dir} (listed in {out_dir / 'index.txt'})")
@@ -277,8 +263,6 @@ def import_mobilesim(
     density_delta: float = typer.Option(2.5, "--density-delta", help="m^2, segmentation delta (Eq. 4.4)."),
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
-    from .world.mobilesim import import_mobilesim as imp
-
     try:
         xy = None
         if start:
@@ -287,7 +271,7 @@ def import_mobilesim(
                 xy = (float(xs), float(ys))
             except ValueError:
                 raise ScenarioError("<command line>", "--start", f"expected X,Y in metres, got {start!r}") from None
-        path = imp(map_file, doors_file, out_dir, resolution, xy, _split([goals]) if goals else None, density_delta)
+        path = imp_mobilesim(map_file, doors_file, out_dir, resolution, xy, _split([goals]) if goals else None, density_delta)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
@@ -301,10 +285,8 @@ def import_kth(
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
 ):
     """Convert a KTH floor plan: corridors become free space, each room-to-corridor portal a sign."""
-    from .world.kth import import_kth as imp
-
     try:
-        path = imp(xml_file, out_dir, resolution, _split([goals]) if goals else None)
+        path = imp_kth(xml_file, out_dir, resolution, _split([goals]) if goals else None)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")

@@ -54,26 +54,3 @@ class GridFrame:
         x = self.origin_x + (np.asarray(col, float) + 0.5) * self.res
         y = self.origin_y + (self.height - np.asarray(row, float) - 0.5) * self.res
         return x, y
-
-
-def advance(px, py, i: int, x: float, y: float, heading: float, step: float):
-    """Move up to ``step`` metres from (x, y) along the waypoints ``px, py`` starting at index
-    ``i``; the heading follows the segment being travelled. Returns (x, y, i, heading, moved)."""
-    remaining = step
-    moved = 0.0
-    while remaining > 1e-12 and i < len(px):
-        dx, dy = px[i] - x, py[i] - y
-        d = float(np.hypot(dx, dy))
-        if d <= remaining:
-            x, y = float(px[i]), float(py[i])
-            i += 1
-            remaining -= d
-            moved += d
-        else:
-            x += dx / d * remaining
-            y += dy / d * remaining
-            moved += remaining
-            remaining = 0.0
-        if d > 1e-9:
-            heading = float(np.arctan2(dy, dx))
-    return x, y, i, heading, moved

@@ -20,7 +20,7 @@ def demo_dir(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def demo_loaded(demo_dir):
-    from semsearch_cli.experiment import Loaded
+    from semsearch_cli.runner import Loaded
 
     return Loaded.load(demo_dir / "scenario.yaml")
 

@@ -3,7 +3,7 @@ import numpy as np
 from semsearch_cli.belief import Belief
 from semsearch_cli.config import BeliefSpec
 from semsearch_cli.geometry import GridFrame
-from semsearch_cli.gridalg import dijkstra, local_reach
+from semsearch_cli.kernels.grid import dijkstra, local_reach
 
 
 def make_belief(free):

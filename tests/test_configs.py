@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from semsearch_cli.experiment import Loaded
+from semsearch_cli.runner import Loaded
 from semsearch_cli.planners import expand_variants
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"

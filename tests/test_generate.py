@@ -7,7 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.experiment import Loaded
+from semsearch_cli.runner import Loaded
 from semsearch_cli.world.generate import LAYOUTS, SCHEMES, generate_building
 
 

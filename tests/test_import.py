@@ -4,7 +4,7 @@ import numpy as np
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.experiment import Loaded
+from semsearch_cli.runner import Loaded
 
 
 def test_import_mobilesim_snaps_signs_and_runs(tmp_path):

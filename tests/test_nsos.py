@@ -8,7 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.planners.nsos import (
+from semsearch_cli.planners.doors.nsos import (
     closeness,
     growing_direction,
     heading_histogram,
@@ -186,7 +186,7 @@ def test_geometric_is_eq_4_6_alone():
 
 
 def test_rolling_histogram_matches_the_plain_one():
-    from semsearch_cli.planners.nsos import RollingHistogram
+    from semsearch_cli.planners.doors.nsos import RollingHistogram
 
     rng = np.random.default_rng(1)
     items: list = []

@@ -9,9 +9,9 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.experiment import Loaded, execute, expand, run_batch
-from semsearch_cli.objects.search import LsosParams, ObjectEpisode, lsos_goals
-from semsearch_cli.objects.task import parse_label, request_label, timeline_at
+from semsearch_cli.runner import Loaded, execute, expand, run_batch
+from semsearch_cli.planners import LsosParams, lsos_goals
+from semsearch_cli.tasks.objects import parse_label, request_label, timeline_at
 from semsearch_cli.planners import Variant
 from semsearch_cli.world.office import HOURS, TABLE_5_1
 
@@ -27,7 +27,7 @@ def office():
 
 def run(office, label, planner, seed=0):
     req = office.task.request(label)
-    return ObjectEpisode(office.task, Variant(planner, ()), req, office.logs[req.case], seed).run()
+    return office.task.run(Variant(planner, ()), req.label, seed)
 
 
 def test_timeline_gives_table_5_2():
@@ -48,7 +48,7 @@ def test_requests_and_their_ground_truth(office):
 
 
 def test_recording_logs_where_the_mug_stood(office):
-    log = office.logs["Static"]
+    log = office.task.logs["Static"]
     mug = log[log["class"] == "mug"]
     assert list(mug["hour"]) == HOURS
     assert "".join(mug["place"]) == TABLE_5_1["Static"]
@@ -57,7 +57,7 @@ def test_recording_logs_where_the_mug_stood(office):
     assert (d <= 3.0 + 1e-6).all()
     # every fixed object was seen on every patrol; the combined case has one day per pattern
     assert len(log) == 9 * len(HOURS)
-    comb = office.logs["Combined"]
+    comb = office.task.logs["Combined"]
     assert sorted(comb["day"].unique()) == [0, 1, 2, 3, 4] and len(comb) == 5 * len(log)
     assert (comb[comb["day"] == 0].drop(columns="day").reset_index(drop=True)
             .equals(log.drop(columns="day").reset_index(drop=True)))
@@ -84,13 +84,13 @@ def test_lsos_goal_order_follows_the_hour_weights(office):
     """Mobile at noon: A weighs 0.25+0.583+0.917+0.583+0.25 = 2.583 (3, 7, 11, 17, 21 h), H 2.417."""
     t = office.task
     fr = office.world.frame
-    _, goals = lsos_goals(t, office.logs["Mobile"], "mug", 12.0, LsosParams())
+    _, goals = lsos_goals(t.world.frame, t.known, office.task.logs["Mobile"], "mug", 12.0, LsosParams())
     assert len(goals) == 2
     first = np.array(fr.to_world(goals[0][0], goals[0][1]))
     near = min(t.places, key=lambda n: np.hypot(*(first - np.array(t.places[n]))))
     assert near == "A" and goals[0][2] > goals[1][2]
     # other classes never heat the map
-    heat, _ = lsos_goals(t, office.logs["Mobile"], "umbrella", 12.0, LsosParams())
+    heat, _ = lsos_goals(t.world.frame, t.known, office.task.logs["Mobile"], "umbrella", 12.0, LsosParams())
     assert heat.sum() == 0.0
 
 
@@ -106,7 +106,7 @@ def test_rows_do_not_depend_on_workers(office, tmp_path):
     b = run_batch(office, specs, tmp_path / "b", workers=2).sort_values(["planner", "goal", "seed"])
     cols = ["planner", "goal", "seed", "outcome", "distance_m", "steps", "decisions"]
     assert a[cols].reset_index(drop=True).equals(b[cols].reset_index(drop=True))
-    row, _ = execute(office, specs[0])
+    (row,), _ = execute(office, specs[0])
     assert row["goal"] == specs[0].goal and row["shortest_m"] > 0
 
 
@@ -129,7 +129,7 @@ def test_a_recorded_log_replays_like_its_timeline(office, tmp_path):
     replay = Loaded.load(office_copy(tmp_path, edit))
     for label in ("Static.mug@12", "Static.mug@0"):
         req = replay.task.request(label)
-        a = ObjectEpisode(replay.task, Variant("lsos", ()), req, replay.logs["Static"], 3).run()
+        a = replay.task.run(Variant("lsos", ()), req.label, 3)
         b = run(office, label, "lsos", 3)
         assert (a.outcome, a.distance_m) == (b.outcome, b.distance_m)
 
@@ -173,11 +173,10 @@ def test_when_the_mug_is_gone_lsos_and_brute_force_look_everywhere_then_give_up(
     req = gone.task.request("Gone.mug@12")
     assert req.truth == () and gone.shortest["Gone.mug@12"] == float("inf")
     for planner in ("lsos", "brute_force"):
-        ep = ObjectEpisode(gone.task, Variant(planner, ()), req, gone.logs["Gone"], 0)
-        res = ep.run()
+        res = gone.task.run(Variant(planner, ()), req.label, 0)
         assert res.outcome == "not_found"
     # lsos went to its heat-map goals, then to every place the camera had not yet seen, in patrol order
-    trace = ObjectEpisode(gone.task, Variant("lsos", ()), req, gone.logs["Gone"], 0, trace=True).run().trace
+    trace = gone.task.run(Variant("lsos", ()), req.label, 0, trace=True).trace
     kinds = [t["kind"] for t in trace]
     k = kinds.count("heat")
     assert k == 2 and kinds == ["heat"] * k + ["patrol"] * (len(kinds) - k)
@@ -204,7 +203,7 @@ def test_a_bad_detection_log_names_the_file_and_column(tmp_path):
 
 def test_detection_table_by_distance_and_view_angle():
     from semsearch_cli.config import DetectTable
-    from semsearch_cli.objects.task import detect_probability
+    from semsearch_cli.sensors import detect_probability
 
     t = DetectTable(distances=[0.8, 1.2, 1.6], angles=[0, 90, 180, 270], p=[[0.8, 0.6, 0.4], [0.1, 0.1, 0.0], [0.5, 0.5, 0.5], [0.2, 0.2, 0.2]])
     assert detect_probability(t, 1.0, 0.0) == pytest.approx(0.7)  # halfway between 0.8 and 0.6
@@ -224,8 +223,8 @@ def test_a_class_with_a_short_camera_range_is_seen_later(tmp_path):
     short = Loaded.load(office_copy(tmp_path, edit))
     full = Loaded.load(office_copy(tmp_path, lambda d: d["objects"]["camera"].update(p_detect=1.0)))
     label = "Static.mug@0"
-    a = ObjectEpisode(short.task, Variant("last_seen", ()), short.task.request(label), short.logs["Static"], 0).run()
-    b = ObjectEpisode(full.task, Variant("last_seen", ()), full.task.request(label), full.logs["Static"], 0).run()
+    a = short.task.run(Variant("last_seen", ()), label, 0)
+    b = full.task.run(Variant("last_seen", ()), label, 0)
     assert a.outcome == b.outcome == "found"
     assert a.distance_m > b.distance_m + 1.5  # about 2 m later: the mug's range is 1 m, not 3 m
     assert short.shortest[label] > full.shortest[label] + 1.5

@@ -8,7 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.objects.presence import hour_weight, presence_scores, read_counts
+from semsearch_cli.belief.presence import hour_weight, presence_scores, read_counts
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "configs" / "hh106_counts.csv"
 

@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 
-from semsearch_cli.sensors.raycast import cast_ray, cast_rays, himm_update, line_of_sight
+from semsearch_cli.kernels.raycast import cast_ray, cast_rays, himm_update, line_of_sight
 
 
 def slow_ray(occ, v0, u0, theta, max_cells, step=1e-4):

@@ -9,6 +9,7 @@ from typer.testing import CliRunner
 from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
 from semsearch_cli.report import tables as T
+from semsearch_cli.report.document import markdown_table
 
 
 def fixed_runs(n=6):
@@ -53,7 +54,7 @@ def test_significance_is_scipys_mann_whitney():
 
 
 def test_best_and_worst_are_marked():
-    md = T.markdown(pd.DataFrame({"a": [1.0, 5.0], "b": [2.0, 3.0]}, index=pd.Index(["x", "y"], name="row")), mark_rows=True)
+    md = markdown_table(pd.DataFrame({"a": [1.0, 5.0], "b": [2.0, 3.0]}, index=pd.Index(["x", "y"], name="row")), mark_rows=True)
     assert "| x | **1.00** | _2.00_ |" in md and "| y | _5.00_ | **3.00** |" in md
 
 
@@ -67,7 +68,7 @@ def test_report_from_a_half_finished_runs_csv(demo_dir, tmp_path):
     res = CliRunner().invoke(app, ["report", str(out), "--out", str(tmp_path / "rep"), "--no-replay"])
     assert res.exit_code == 0, res.output
     md = (tmp_path / "rep" / "report.md").read_text()
-    assert "2 finished runs" in md and "Mann-Whitney" in md
+    assert "; 2 rows from" in md and "Mann-Whitney" in md
     html = (tmp_path / "rep" / "report.html").read_text()
     assert "data:image/png;base64," in html  # figures inlined: the page stands alone
     t = pd.read_csv(tmp_path / "rep" / "tables" / "summary.csv")
@@ -80,9 +81,10 @@ def test_report_with_replay_and_several_folders(demo_dir, tmp_path):
         assert res.exit_code == 0, res.output
     res = CliRunner().invoke(app, ["report", str(tmp_path / "a"), str(tmp_path / "b"), "--out", str(tmp_path / "both")])
     assert res.exit_code == 0, res.output
-    for k in ("a", "b"):
-        assert (tmp_path / "both" / k / "report.html").is_file()
-        assert list((tmp_path / "both" / k / "figures").glob("replay_*.gif"))
+    md = (tmp_path / "both" / "report.md").read_text()  # one document over both folders
+    assert "; 4 rows from" in md and md.count("## Door search (4 runs)") == 1
+    assert all(f"How {tmp_path / k} was produced" in md for k in ("a", "b"))
+    assert list((tmp_path / "both" / "figures").glob("replay_*.gif"))
 
 
 def test_report_errors(tmp_path):

@@ -15,7 +15,7 @@ from skimage.morphology import skeletonize
 
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
-from ..gridalg import GridSearch, branch_walk, local_reach, segment_flood
+from ..kernels.grid import GridSearch, branch_walk, local_reach, segment_flood
 
 CLEARANCE_CAP_M = 1.0
 CONNECT_M = 1.5

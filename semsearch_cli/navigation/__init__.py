@@ -1,3 +1,8 @@
+"""Navigation (SPEC 5): navigators on the belief (geodesic, harmonic), paths on a known map, and
+motion along a path."""
+
+from .known import KnownMap
+from .motion import advance
 from .navigators import NAVIGATORS, GeodesicNavigator, HarmonicNavigator
 
-__all__ = ["NAVIGATORS", "GeodesicNavigator", "HarmonicNavigator"]
+__all__ = ["NAVIGATORS", "GeodesicNavigator", "HarmonicNavigator", "KnownMap", "advance"]

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .harmonic import ascend, harmonic_field
+from ..kernels.harmonic import ascend, harmonic_field
 
 HARMONIC_MARGIN_M = 3.0
 LOOKAHEAD_M = 8.0

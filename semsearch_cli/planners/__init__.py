@@ -1,8 +1,15 @@
-"""Planners: importing this package registers the built-in ones."""
+"""Planners: the protocol, the registry and the built-in planners (importing this package
+registers them).
 
-from . import bvp, greedy, nsos  # noqa: F401  (registration side effect)
-from .base import PLANNERS, Decision, PlanContext, Planner, Variant, expand_variants, register_planner
+The public API for planner authors: :class:`Planner`, :class:`Decision`, :class:`PlanContext`
+and :func:`register_planner` (door search), :class:`ObjectPlanner` and :class:`ObjectContext`
+(object search).
+"""
 
-from ..objects import search as _object_planners  # noqa: F401,E402  (lsos, brute_force, last_seen)
+from .base import (PLANNERS, Decision, NoParams, PlanContext, Planner, Variant, expand_variants, load_entry_points,
+                   load_planner_file, register_planner)
+from .doors import bvp, greedy, nsos  # noqa: F401  (registration side effect)
+from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 
-__all__ = ["PLANNERS", "Decision", "PlanContext", "Planner", "Variant", "expand_variants", "register_planner"]
+__all__ = ["PLANNERS", "Decision", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "PlanContext", "Planner",
+           "Variant", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "register_planner"]

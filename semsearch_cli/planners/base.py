@@ -2,15 +2,27 @@
 
 A planner picks the next target from the belief. It sees a :class:`PlanContext` and the frontier
 :class:`~semsearch_cli.belief.Candidates`, and returns a :class:`Decision` (a target cell and the
-numbers behind the choice, for traces). Adding a planner: subclass :class:`Planner` in a module of
-this package, give it a pydantic ``Params`` model, and decorate it with ``@register_planner(name)``;
-nothing in the simulator changes.
+numbers behind the choice, for traces). Adding a planner: subclass :class:`Planner`, give it a
+pydantic ``Params`` model, and decorate it with ``@register_planner(name)``; nothing in the
+simulator changes. The class may live in this package, in a file of the user's named by a
+scenario (``{name: mine, module: my_planner.py}``), or in an installed package that declares it
+under the entry-point group ``semsearch.planners``.
+
+A :class:`Decision` is a new target. A planner that keeps its previous target returns it with
+``info["kept"] = True``: that is not a decision, and ``decisions`` in the rows counts only new
+targets, for every planner alike.
 """
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import itertools
+import sys
+import traceback
 from dataclasses import dataclass, field
+from importlib.metadata import entry_points
+from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -68,7 +80,7 @@ def register_planner(name: str):
 
     def deco(cls):
         if name in PLANNERS:
-            raise ValueError(f"planner {name!r} is already registered by {PLANNERS[name].__module__}")
+            raise ValueError(f"planner {name!r} is already registered (by {PLANNERS[name].__module__}); choose another name")
         cls.name = name
         PLANNERS[name] = cls
         return cls
@@ -76,12 +88,67 @@ def register_planner(name: str):
     return deco
 
 
+ENTRY_POINT_GROUP = "semsearch.planners"
+_LOADED_FILES: dict[str, list[str]] = {}  # resolved path -> planner names it registered
+_ENTRY_POINTS_LOADED = False
+
+
+def load_entry_points() -> None:
+    """Import every module registered under the entry-point group ``semsearch.planners`` (once
+    per process); each registers its planners with :func:`register_planner`."""
+    global _ENTRY_POINTS_LOADED
+    if _ENTRY_POINTS_LOADED:
+        return
+    _ENTRY_POINTS_LOADED = True
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        try:
+            ep.load()
+        except Exception as exc:
+            raise ScenarioError(f"entry point {ep.name} = {ep.value}", ENTRY_POINT_GROUP,
+                                f"the planner package failed to load: {type(exc).__name__}: {exc}") from None
+
+
+def load_planner_file(path: str | Path) -> list[str]:
+    """Import a user's planner file (once per process) and return the planner names it
+    registered. A broken file (it raises, it registers nothing, it reuses a registered name)
+    is a :class:`ScenarioError` naming the file."""
+    path = Path(path).resolve()
+    key = str(path)
+    if key in _LOADED_FILES:
+        return _LOADED_FILES[key]
+    if not path.is_file():
+        raise ScenarioError(key, "", "planner file not found")
+    mod_name = f"semsearch_user_planners.{path.stem}_{hashlib.sha1(key.encode()).hexdigest()[:8]}"
+    spec = importlib.util.spec_from_file_location(mod_name, path)
+    module = importlib.util.module_from_spec(spec)
+    before = set(PLANNERS)
+    sys.modules[mod_name] = module
+    try:
+        spec.loader.exec_module(module)
+    except SyntaxError as exc:
+        del sys.modules[mod_name]
+        raise ScenarioError(key, f"line {exc.lineno}", f"not valid Python: {exc.msg}") from None
+    except Exception as exc:
+        del sys.modules[mod_name]
+        line = traceback.extract_tb(exc.__traceback__)[-1].lineno
+        raise ScenarioError(key, f"line {line}", f"the planner file raised {type(exc).__name__}: {exc}") from None
+    names = [n for n in PLANNERS if n not in before]
+    if not names:
+        raise ScenarioError(key, "", "registers no planner: decorate a Planner subclass with "
+                            "@register_planner(\"name\") (from semsearch_cli.planners)")
+    _LOADED_FILES[key] = names
+    return names
+
+
 @dataclass(frozen=True)
 class Variant:
-    """One planner with fixed parameters; ``label`` names it in rows, e.g. ``nsos[alpha=0.9]``."""
+    """One planner with fixed parameters; ``label`` names it in rows, e.g. ``nsos[alpha=0.9]``.
+    ``module``: the user's file that registers the planner (absolute path), loaded on demand in
+    whichever process builds the planner."""
 
     name: str
     params: tuple  # sorted (key, value) pairs as given by the user
+    module: str | None = None
 
     @property
     def label(self) -> str:
@@ -90,23 +157,37 @@ class Variant:
         return f"{self.name}[" + ",".join(f"{k}={v}" for k, v in self.params) + "]"
 
     def build(self) -> Planner:
+        if self.module is not None:
+            load_planner_file(self.module)
+        elif self.name not in PLANNERS:
+            load_entry_points()
         cls = PLANNERS[self.name]
         return cls(cls.Params(**dict(self.params)))
 
 
-def expand_variants(specs, file: str = "<scenario>", task: str | None = None) -> list[Variant]:
+def expand_variants(specs, file: str = "<scenario>", task: str | None = None, base: Path | None = None) -> list[Variant]:
     """Planner entries -> variants; list-valued parameters expand into one variant per value.
-    With ``task`` ("doors" or "objects"), planners for the other kind of search are refused."""
+    With ``task`` ("doors" or "objects"), planners for the other kind of search are refused.
+    An entry with ``module`` first loads that file (relative to ``base``, the scenario's folder);
+    a name nothing registered is looked for among the installed entry points."""
     out: list[Variant] = []
     for i, spec in enumerate(specs):
         name, params = spec.name, spec.params()
+        module = None
+        if spec.module is not None:
+            module = str(((base or Path(".")) / spec.module).resolve())
+            names = load_planner_file(module)
+            if name not in names:
+                raise ScenarioError(file, f"planners[{i}].name", f"{module} registers {', '.join(names)}, not {name!r}")
+        elif name not in PLANNERS:
+            load_entry_points()
         valid = sorted(n for n, c in PLANNERS.items() if task is None or c.task == task)
         if name not in PLANNERS:
             raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}; valid: {', '.join(valid)}")
         if task is not None and PLANNERS[name].task != task:
-            kind = {"doors": "door", "objects": "object"}
-            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} is a {kind[PLANNERS[name].task]}-search planner and this is "
-                                f"a {kind[task]}-search scenario; valid: {', '.join(valid)}")
+            kind = {"doors": "door", "objects": "object"}.get
+            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} is a {kind(PLANNERS[name].task, PLANNERS[name].task)}-search planner and this is "
+                                f"a {kind(task, task)}-search scenario; valid: {', '.join(valid)}")
         keys = sorted(params)
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]
         for combo in itertools.product(*values):
@@ -117,7 +198,7 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None) ->
                 e = exc.errors()[0]
                 loc = ".".join(str(x) for x in e["loc"])
                 raise ScenarioError(file, f"planners[{i}].{loc}", e["msg"] if e["type"] != "extra_forbidden" else f"unknown parameter for planner {name!r}") from None
-            v = Variant(name, p)
+            v = Variant(name, p, module)
             if v not in out:
                 out.append(v)
     return out

@@ -5,23 +5,20 @@ runs.csv alone; heat maps and paths also need the scenario named in meta.json.""
 from __future__ import annotations
 
 import json
-import os
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..experiment import file_stem
-from ..objects.task import is_object_label, parse_label
+from ..belief.heatmap import heat_map
+from ..planners import LsosParams, lsos_goals
+from ..runner import file_stem, run_rows
+from ..tasks.objects import parse_label, read_log
 from . import tables as T
+from .document import Document, atomic_text, markdown_table, write_table
+from .plots import plot_heat, plot_heat_steps, plot_object_bars, plot_object_paths
 
 ORDER = {"brute_force": 0, "last_seen": 1, "lsos": 2}
-
-
-def is_object_runs(runs: pd.DataFrame) -> bool:
-    return len(runs) > 0 and all(is_object_label(g) for g in runs["goal"].unique())
 
 
 def planner_order(labels) -> list[str]:
@@ -60,50 +57,48 @@ def figure_table(table: pd.DataFrame) -> pd.DataFrame:
     return wide
 
 
-def report_objects(runs: pd.DataFrame, folder: Path, out: Path, formats: set, meta: dict) -> list[Path]:
-    t0 = time.perf_counter()
+def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, notes: list) -> None:
+    runs = pd.concat([run_rows(p.runs) for p in parts], ignore_index=True)
     table = object_table(runs)
     wide = figure_table(table)
     tdir = out / "tables"
-    tdir.mkdir(parents=True, exist_ok=True)
-    if "csv" in formats:
-        for name, df in (("objects", table), ("summary", T.summarise(runs))):
-            tmp = tdir / f".{name}.csv.tmp"
-            df.to_csv(tmp, index=False)
-            os.replace(tmp, tdir / f"{name}.csv")
-    figs, notes = [], []
+    write_table(tdir, "objects", table, formats)
+    if formats & {"md", "html"}:
+        atomic_text(tdir / "objects.md", markdown_table(wide))
+    doc.heading(2, f"Object search over time ({len(runs)} runs)")
+    doc.heading(3, "Distance until the object is seen (m): mean ± std (found / runs)")
+    doc.para("A run that does not find the object counts the distance until the planner gave up "
+             "(Last Seen after its one spot, Brute Force after its whole route).")
+    doc.table(wide)
     if formats & {"png", "html", "md"}:
-        figs, notes = _figures(runs, table, folder, out, meta)
-    md = _markdown(runs, wide, figs, notes, meta, folder, out)
-    files = []
-    if "md" in formats or "html" in formats:
-        from .build import _atomic_text
-
-        _atomic_text(tdir / "objects.md", T.markdown(wide))
-        _atomic_text(out / "report.md", md)
-        files.append(out / "report.md")
-    if "html" in formats:
-        from .build import _atomic_text, _html
-
-        _atomic_text(out / "report.html", _html(md, out))
-        files.append(out / "report.html")
-    print(f"report of {folder}: {len(runs)} runs, {len(figs)} figures, {time.perf_counter() - t0:.1f} s", file=sys.stderr)
-    return files
+        doc.heading(3, "Figures")
+        fdir = out / "figures"
+        f = fdir / "objects_by_case.png"
+        plot_object_bars(table, planner_order(runs["planner"]), f)
+        doc.figure(f, "Distance until the object is seen per case, request hour and planner (the thesis' Figure 5.12)")
+        for part in parts:
+            _figures(doc, run_rows(part.runs), part, fdir, notes)
 
 
-def _figures(runs, table, folder: Path, out: Path, meta):
-    from .plots import plot_heat, plot_object_bars, plot_object_paths
+def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
+    return [("distance until the object is seen (m): mean ± std (found / runs)",
+             figure_table(object_table(run_rows(runs))).reset_index())]
 
-    fdir = out / "figures"
-    fdir.mkdir(exist_ok=True)
+
+def show(loaded, out: Path) -> None:
+    task, sc = loaded.task, loaded.sc
+    route = task.patrol_route()
+    length = float(np.hypot(*np.diff(route, axis=0).T).sum())
+    plot_object_paths(loaded.world, {}, task.places, (), f"{sc.name}: places {' '.join(task.places)}; patrol route "
+                      f"{length:.1f} m (dotted)", out, route=route)
+
+
+def _figures(doc, runs, part, fdir: Path, notes: list) -> None:
     order = planner_order(runs["planner"])
-    f = fdir / "objects_by_case.png"
-    plot_object_bars(table, order, f)
-    figs = [("Distance until the mug is seen per case, request hour and planner (the thesis' Figure 5.12)", f)]
-    notes = []
-    loaded = _loaded(meta, notes)
+    folder = part.folder
+    loaded = part.loaded(notes, "Heat maps and paths")
     if loaded is None:
-        return figs, notes
+        return
     task, world = loaded.task, loaded.world
     med = T.median_run(runs)
     lsos = next((lab for lab in order if lab.split("[", 1)[0] == "lsos"), None)
@@ -116,20 +111,18 @@ def _figures(runs, table, folder: Path, out: Path, meta):
             continue
         stem = label  # letters, digits, - _ . @ only
         if lsos is not None:
-            from ..objects.search import LsosParams, lsos_goals
-
             params = json.loads(runs[runs["planner"] == lsos]["params"].iloc[0])
-            heat, goals = lsos_goals(task, _log(folder, loaded, req.case), req.cls, req.hour, LsosParams(**params))
+            heat, goals = lsos_goals(world.frame, task.known, _log(folder, loaded, req.case), req.cls, req.hour, LsosParams(**params))
             gx = [(*world.frame.to_world(r, c), phi) for r, c, phi in goals]
             f = fdir / f"heat_{stem}.png"
             plot_heat(world, heat, task.places, req.truth, gx,
                       f"{req.case}: {req.cls} at {req.hour:g}:00, {lsos} heat map (Eq. 5.4) and goals (Eqs. 5.5-5.6)", f)
-            figs.append((f"Heat map for {label}; red rings: where the {req.cls} is", f))
+            doc.figure(f, f"Heat map for {label}; red rings: where the {req.cls} is")
             if req.case not in stepped:  # the construction, once per case (thesis Figures 5.7-5.8)
                 stepped.add(req.case)
                 f = fdir / f"heat_steps_{stem}.png"
                 _heat_steps(task, world, _log(folder, loaded, req.case), req, LsosParams(**params), f)
-                figs.append((f"How the heat map for {label} is built (thesis Figures 5.7-5.8)", f))
+                doc.figure(f, f"How the heat map for {label} is built (thesis Figures 5.7-5.8)")
         paths = {}
         for _, r in med[med["goal"] == label].iterrows():
             p = folder / "paths" / f"{file_stem(r['planner'], label, int(r['seed']))}.npz"
@@ -139,14 +132,10 @@ def _figures(runs, table, folder: Path, out: Path, meta):
             f = fdir / f"paths_{stem}.png"
             plot_object_paths(world, {k: paths[k] for k in order if k in paths}, task.places, req.truth,
                               f"{req.case}: {req.cls} at {req.hour:g}:00, median run of each planner", f)
-            figs.append((f"Median runs for {label}", f))
-    return figs, notes
+            doc.figure(f, f"Median runs for {label}")
 
 
 def _heat_steps(task, world, log, req, p, out: Path) -> None:
-    from ..objects.heatmap import heat_map
-    from .plots import plot_heat_steps
-
     rows = list(zip(log["class"], log["x"], log["y"], log["hour"], log["robot_x"], log["robot_y"]))
     args = (req.hour, world.frame, p.radius, task.known)
     panels = [
@@ -161,25 +150,5 @@ def _heat_steps(task, world, log, req, p, out: Path) -> None:
 
 def _log(folder: Path, loaded, case: str) -> pd.DataFrame:
     """The detection log the runs used (``logs/<case>.csv`` beside runs.csv), else the scenario's."""
-    from ..objects.task import read_log
-
     f = folder / "logs" / f"{case}.csv"
-    return read_log(f) if f.is_file() else loaded.logs[case]
-
-
-def _loaded(meta, notes):
-    from ..experiment import Loaded
-    from .build import from_meta
-
-    return from_meta(meta, notes, "Heat maps and paths", Loaded.load)
-
-
-def _markdown(runs, wide, figs, notes, meta, folder: Path, out: Path) -> str:
-    from .build import head_lines, tail_lines
-
-    lines = head_lines(runs, meta, folder, " (object search)")
-    lines += ["## Distance until the object is seen (m): mean ± std (found / runs)", "",
-              "A run that does not find the object counts the distance until the planner gave up "
-              "(Last Seen after its one spot, Brute Force after its whole route).", "",
-              T.markdown(wide), ""]
-    return "\n".join(lines + tail_lines(figs, notes, out))
+    return read_log(f) if f.is_file() else loaded.task.logs[case]

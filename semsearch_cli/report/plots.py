@@ -12,6 +12,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 import numpy as np  # noqa: E402
 
 
@@ -136,7 +138,6 @@ def plot_paths_overlay(world, paths: dict, goal, title: str, out: Path) -> None:
 def animate_run(world, frames: list, title: str, out: Path, fps: int = 5) -> None:
     """A GIF replay: per frame the map the robot has built (free white, occupied black, unknown
     gray), its path so far, the candidates and the chosen one."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
 
     fr = world.frame
     fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * fr.height / fr.width)))
@@ -238,7 +239,6 @@ def plot_object_bars(table, order: list, out: Path) -> None:
         ax.axis("off")
     top = axes.flat[0].get_ylim()[1]
     axes.flat[0].set_ylim(0, top * 1.1)
-    from matplotlib.patches import Patch
 
     axes.flat[0].legend(handles=[Patch(color=f"C{k}", label=lab) for k, lab in enumerate(order)], fontsize=7)
     fig.suptitle("Distance until the object is seen or the search gave up (mean +- std; % = runs that found it, "

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import re
+
 import pandas as pd
+from scipy.stats import mannwhitneyu
 
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     """Per scenario x goal x planner variant: n, success rate, median, mean, std (ddof=1, as the
@@ -43,7 +46,6 @@ def goal_key(g):
 
 def planner_order(labels) -> list[str]:
     """greedy, bvp, geometric, other planners, then nsos variants by alpha."""
-    import re
 
     def key(lab):
         name = lab.split("[", 1)[0]
@@ -99,8 +101,6 @@ def significance(runs: pd.DataFrame, baseline: str = "greedy") -> pd.DataFrame:
     each other variant, with the rank-biserial effect size r = 1 - 2U / (n1 n2) (positive when
     the variant travels less than the baseline) and a note when either sample has fewer than
     ``MIN_N`` runs (too few for the test to mean much)."""
-    from scipy.stats import mannwhitneyu
-
     rows = []
     for (scen, goal), g in runs.groupby(["scenario", "goal"]):
         base = g[g["planner"] == baseline]["distance_m"].to_numpy()
@@ -119,28 +119,25 @@ def significance(runs: pd.DataFrame, baseline: str = "greedy") -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["scenario", "goal", "baseline", "planner", "n_baseline", "n", "U", "p_value", "effect_r", "note"])
 
 
-def markdown(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> str:
-    """A DataFrame as a Markdown table (index levels become leading columns). With ``mark_rows``
-    the smallest value of each row is **bold** and the largest _italic_ (the thesis' green and
-    red cells)."""
-    idx_names = [n or "" for n in (df.index.names if df.index.nlevels > 1 or df.index.name else [])]
-    cols = [str(c) for c in df.columns]
-    lines = ["| " + " | ".join(idx_names + cols) + " |", "|" + "---|" * (len(idx_names) + len(cols))]
+def cells(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> tuple[list[str], list[list[tuple]]]:
+    """A DataFrame as text cells: (header, rows of (text, mark)); index levels become leading
+    columns. With ``mark_rows`` the smallest value of each row is marked ``best`` and the largest
+    ``worst`` (the thesis' green and red cells); other marks are None."""
+    idx_names = [str(n or "") for n in (df.index.names if df.index.nlevels > 1 or df.index.name else [])]
+    head = idx_names + [str(c) for c in df.columns]
+    rows = []
     for key, row in df.iterrows():
         keys = list(key) if isinstance(key, tuple) else ([key] if idx_names else [])
         vals = row.to_numpy()
         num = pd.to_numeric(pd.Series(vals), errors="coerce")
         lo, hi = (num.min(), num.max()) if mark_rows and num.notna().sum() > 1 else (None, None)
-        cells = []
+        out = [(str(k), None) for k in keys]
         for v, nv in zip(vals, num):
             if isinstance(v, float) and pd.isna(v):
-                cells.append("")
+                out.append(("", None))
                 continue
             text = fmt.format(v) if isinstance(v, (float, int)) and not isinstance(v, bool) else str(v)
-            if lo is not None and nv == lo:
-                text = f"**{text}**"
-            elif hi is not None and nv == hi and hi != lo:
-                text = f"_{text}_"
-            cells.append(text)
-        lines.append("| " + " | ".join([str(k) for k in keys] + cells) + " |")
-    return "\n".join(lines)
+            mark = "best" if lo is not None and nv == lo else "worst" if hi is not None and nv == hi and hi != lo else None
+            out.append((text, mark))
+        rows.append(out)
+    return head, rows

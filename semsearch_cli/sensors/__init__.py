@@ -1,0 +1,6 @@
+"""Sensors over the ground-truth world: laser, door cameras, object camera (SPEC 2)."""
+
+from .devices import DoorCamera, Laser
+from .objects import ObjectCamera, PlaceCamera, detect_probability
+
+__all__ = ["DoorCamera", "Laser", "ObjectCamera", "PlaceCamera", "detect_probability"]

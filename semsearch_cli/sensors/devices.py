@@ -7,7 +7,7 @@ import numpy as np
 from ..config import DoorCameraSpec, LaserSpec
 from ..geometry import wrap_angle
 from ..world.scenario import World
-from .raycast import cast_rays, line_of_sight
+from ..kernels.raycast import cast_rays, line_of_sight
 
 
 class Laser:

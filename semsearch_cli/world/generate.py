@@ -33,7 +33,7 @@ import yaml
 
 from ..errors import ScenarioError
 from ..geometry import GridFrame
-from ..gridalg import dijkstra
+from ..kernels.grid import dijkstra
 from .files import map_image, scenario_dict, write_building
 from .mobilesim import spread_goals
 

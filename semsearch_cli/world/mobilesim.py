@@ -17,7 +17,7 @@ from scipy import ndimage
 
 from ..errors import ScenarioError
 from ..geometry import GridFrame
-from ..gridalg import dijkstra
+from ..kernels.grid import dijkstra
 from .files import map_image, scenario_dict, write_building
 
 MARGIN_M = 1.0

@@ -18,8 +18,8 @@ import yaml
 from ..config import DoorSpec, Scenario
 from ..errors import ScenarioError
 from ..geometry import GridFrame
-from ..gridalg import dijkstra
-from ..sensors.raycast import line_of_sight
+from ..kernels.grid import dijkstra
+from ..kernels.raycast import line_of_sight
 
 WALL_BELOW = 100
 FREE_FROM = 200
@@ -215,8 +215,6 @@ def build_world(sc: Scenario, base: Path, file: str) -> World:
 
     doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
     dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file
-    if not doors and not sc.is_objects:
-        raise ScenarioError(dfile, "doors", "no door signs given")
     labels = [d.number for d in doors]
     seen: set[str] = set()
     for lab in labels:
@@ -246,10 +244,6 @@ def build_world(sc: Scenario, base: Path, file: str) -> World:
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m lies outside the map")
     if not world.cspace[sr, scc]:
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m is inside a wall or closer than the robot radius ({sc.robot.radius} m) to one")
-    for k, g in enumerate(sc.goals):
-        i = signs.index_of(g)
-        if i < 0:
-            raise ScenarioError(file, f"goals[{k}]", f"no door sign carries the number {g}")
     return world
 
 

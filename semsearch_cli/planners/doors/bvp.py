@@ -19,8 +19,8 @@ import cv2
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from ..navigation.harmonic import FLAT, ascend, harmonic_field
-from .base import Decision, Planner, register_planner
+from ...kernels.harmonic import FLAT, ascend, harmonic_field
+from ..base import Decision, Planner, register_planner
 from .greedy import nearest_candidate
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Decision, Planner, register_planner
+from ..base import Decision, Planner, register_planner
 
 
 def nearest_candidate(ctx, cands) -> Decision | None:

@@ -1,5 +1,12 @@
-"""The object-search task (thesis ch. 5, SPEC 6): places, timelines, cases, requests, ground truth,
-the object camera, navigation on the recorded map and the recording mode.
+"""Object search over time (thesis ch. 5, SPEC 6): places, timelines, cases, requests, ground
+truth, the recording mode, and the requesting mode: the robot drives an object planner's targets on
+the recorded map until the object camera detects an instance of the requested class.
+
+An episode senses with the object camera at every step and at each quarter turn; its belief is
+the set of places the camera has had in view; the target is seen on the first detection of the
+class; a re-plan (the next target) happens when the path is used up, after looking around (three
+quarter turns, no distance). It ends ``found``, ``not_found`` when the planner has no target left
+(Last Seen after its one spot, Brute Force after its route), or ``budget``.
 
 Choices the seeds leave open (also in the README):
 
@@ -32,11 +39,15 @@ import cv2
 import numpy as np
 import pandas as pd
 
-from ..config import ObjectsSpec, Scenario
+from ..config import ObjectsSpec
 from ..errors import ScenarioError
 from ..geometry import wrap_angle
-from ..gridalg import GridSearch, dijkstra
-from ..sensors.raycast import line_of_sight
+from ..kernels.grid import dijkstra
+from ..navigation import KnownMap
+from ..planners import ObjectContext
+from ..sensors import PlaceCamera
+from .base import Outcome, RobotState, Task, register_task
+from .loop import run_loop
 
 LOG_COLUMNS = ["day", "hour", "class", "x", "y", "robot_x", "robot_y", "place"]
 
@@ -100,85 +111,96 @@ def timeline_at(timeline: dict, hour: float) -> dict[str, tuple]:
     return out
 
 
-class KnownMap:
-    """Planning on the recorded (complete) map: cells where the robot fits, reachable from the
-    start, with a cost that keeps paths off the walls (1 in the open, up to 3 against a wall)."""
+class ObjectSearch:
+    """One request answered by an object planner's targets (see the module docstring)."""
 
-    def __init__(self, world):
-        self.world = world
-        self.passable = world.reach
-        clear = np.minimum(world.clearance, 1.0)
-        self.cost = (3.0 - 2.0 * clear).astype(np.float32)
-        self.search = GridSearch(self.passable.shape)
-        self._paths: dict = {}  # (r, c, tr, tc) -> cells: patrol legs repeat across hours and runs
+    def __init__(self, task: "ObjectTask", targets, cls: str, instances: list, camera: PlaceCamera, ctx: ObjectContext,
+                 rng: np.random.Generator, trace: bool = False):
+        """``targets``: an iterator of (x, y, info); ``instances``: [(class, place)] in the world."""
+        self.task, self.targets, self.cls, self.instances = task, targets, cls, instances
+        self.camera, self.ctx, self.rng, self.keep_trace = camera, ctx, rng, trace
+        self.look = False  # look around on arriving at the current target
+        self.decisions = 0
+        self.trace: list = []
+        self.start_distance = 0.0
 
-    def snap(self, r: int, c: int) -> tuple[int, int]:
-        """The reachable cell nearest to (r, c)."""
-        H, W = self.passable.shape
-        for R in (4, 16, 64, max(H, W)):
-            r0, r1, c0, c1 = max(0, r - R), min(H, r + R + 1), max(0, c - R), min(W, c + R + 1)
-            rr, cc = np.nonzero(self.passable[r0:r1, c0:c1])
-            if rr.size:
-                k = int(np.argmin((rr + r0 - r) ** 2 + (cc + c0 - c) ** 2))
-                return int(rr[k] + r0), int(cc[k] + c0)
-        raise ValueError("no reachable cell")
+    def sense(self, st):
+        seen, detected = self.camera.look(st.x, st.y, st.heading, self.rng)
+        self.ctx.seen_places.update(seen)
+        return any(self.instances[i][0] == self.cls for i in detected), False
 
-    def path(self, r: int, c: int, tr: int, tc: int):
-        """Cells from (r, c) to (tr, tc) (both reachable), or None."""
-        if not self.passable[r, c]:
-            r, c = self.snap(r, c)
-        key = (r, c, tr, tc)
-        if key not in self._paths:
-            if len(self._paths) > 4096:
-                self._paths.clear()
-            ok = self.search.run(self.passable, self.cost, r, c, np.array([tr]), np.array([tc]), 1) >= 1
-            self._paths[key] = self.search.path(tr, tc) if ok else None
-        return self._paths[key]
+    def update(self, st):
+        pass  # the places in view went into ctx.seen_places as they were sensed
 
+    def replan_due(self, path_done, since_plan, event):
+        return path_done
 
-def detect_probability(p, distance: float, view_deg: float) -> float:
-    """p_detect of the camera spec: a constant, or a :class:`~semsearch_cli.config.DetectTable`
-    read at ``distance`` (m, linear, clamped) and ``view_deg`` (nearest tabulated angle)."""
-    if isinstance(p, (int, float)):
-        return float(p)
-    row = 0
-    if p.angles:
-        a = np.asarray(p.angles, float)
-        diff = np.abs((a - view_deg + 180.0) % 360.0 - 180.0)
-        row = int(np.argmin(diff))
-    return float(np.interp(distance, p.distances, p.p[row]))
+    def _look_around(self, st) -> bool:
+        for _ in range(3):
+            st.heading = float(wrap_angle(st.heading + np.pi / 2))
+            if self.sense(st)[0]:
+                return True
+        return False
 
-
-class ObjectCamera:
-    """Forward camera: points within ``range`` (m) and ``fov`` (degrees) around the heading, in
-    line of sight."""
-
-    def __init__(self, world, fov: float, range_m: float, xs, ys):
-        self.world, self.range = world, range_m
-        self.x, self.y = np.asarray(xs, float), np.asarray(ys, float)
-        self.v, self.u = world.frame.to_cell(self.x, self.y)
-        self.half = np.radians(fov) / 2
-
-    def visible(self, x: float, y: float, heading: float) -> np.ndarray:
-        """Indices of the points in view from pose (x, y, heading)."""
-        if self.x.size == 0:
-            return np.zeros(0, np.int64)
-        dx, dy = self.x - x, self.y - y
-        near = np.flatnonzero(dx * dx + dy * dy <= self.range**2)
-        if near.size and self.half < np.pi:
-            rel = np.abs(wrap_angle(np.arctan2(dy[near], dx[near]) - heading))
-            near = near[rel <= self.half]
-        v, u = self.world.frame.to_cell(x, y)
-        occ = self.world.occ
-        return np.array([i for i in near if line_of_sight(occ, float(v), float(u), self.v[i], self.u[i], 0.5)], np.int64)
+    def plan(self, st):
+        known = self.task.known_map
+        while True:
+            if self.look and self._look_around(st):
+                return "found"
+            self.look = False
+            nxt = next(self.targets, None)
+            if nxt is None:
+                return "not_found"
+            x, y, info = nxt
+            self.decisions += 1
+            if self.keep_trace:
+                self.trace.append({"distance_m": round(st.distance - self.start_distance, 3), "target": [round(x, 2), round(y, 2)], **info})
+            p = known.path_to(st.x, st.y, x, y)
+            if p is None:
+                continue
+            self.look = info.get("look", True)
+            if len(p[0]) >= 2:
+                return self.task.world.frame.to_world(p[0], p[1])
 
 
-class ObjectTask:
-    """Everything an object-search scenario asks, checked against the world."""
+class Patrol(ObjectSearch):
+    """Recording mode: drive the route, logging each instance at its first detection."""
 
-    def __init__(self, sc: Scenario, world, base: Path, file: str):
+    def __init__(self, task, targets, instances, hour, day, rng):
+        camera = PlaceCamera(task.world, task.spec.camera, task.places, task.facing, instances)
+        ctx = ObjectContext(task.world.frame, task.known, task.places, task.route, None, "", hour,
+                            pd.DataFrame(columns=LOG_COLUMNS), rng)
+        super().__init__(task, targets, "", instances, camera, ctx, rng)
+        self.hour, self.day = hour, day
+        self.rows: list[dict] = []
+        self.logged: set[int] = set()
+
+    def sense(self, st):
+        seen, detected = self.camera.look(st.x, st.y, st.heading, self.rng)
+        for i in detected:
+            if i not in self.logged:
+                self.logged.add(i)
+                cls, place = self.instances[i]
+                px, py = self.task.places[place]
+                self.rows.append({"day": self.day, "hour": float(self.hour), "class": cls, "x": px, "y": py,
+                                  "robot_x": round(st.x, 3), "robot_y": round(st.y, 3), "place": place})
+        return False, False
+
+
+@register_task
+class ObjectTask(Task):
+    """Everything an object-search scenario asks, checked against the world. Goals are request
+    labels (``Static.mug@12``); each case's detection log is recorded (or read) once, when the
+    task is built."""
+
+    kind = "objects"
+    planner_kind = "objects"
+
+    def __init__(self, sc, world, path):
+        super().__init__(sc, world, path)
         spec: ObjectsSpec = sc.objects
-        self.sc, self.spec, self.world, self.base, self.file = sc, spec, world, base, file
+        file = self.file
+        self.spec, self.base = spec, self.path.parent
         names = [p.name for p in spec.places]
         if len(set(names)) != len(names):
             raise ScenarioError(file, "objects.places", "place names must be unique")
@@ -212,6 +234,56 @@ class ObjectTask:
             raise ScenarioError(file, "objects.requests", "no requests: give at least one {class, hour}")
         if len(set(labels)) != len(labels):
             raise ScenarioError(file, "objects.requests", "a request (case, class, hour) appears twice")
+
+    @classmethod
+    def build(cls, sc, world, path):
+        task = cls(sc, world, path)
+        task.logs = {c.name: task.log(c) for c in task.cases}
+        task.shortest = {r.label: task.shortest_to(r) for r in task.requests}
+        task.variants()
+        return task
+
+    @property
+    def goals(self) -> list:
+        return [r.label for r in self.requests]
+
+    def episode(self, state, planner, goal, rng, trace=False, recorder=None):
+        """Answer the request labelled ``goal`` from ``state``."""
+        req = self.request(goal)
+        return self.search_episode(state, planner, req.cls, req.hour, self.request_instances(req), self.logs[req.case],
+                                   self.route, self.world.start_xy, rng, trace)
+
+    def search_episode(self, state, planner, cls, hour, instances, log, route, home, rng, trace=False):
+        """Search for ``cls`` among ``instances`` [(class, place)] with the places of ``route``."""
+        d0, s0 = state.distance, state.steps
+        camera = PlaceCamera(self.world, self.spec.camera, self.places, self.facing, instances)
+        ctx = ObjectContext(self.world.frame, self.known, self.places, list(route), home, cls, hour, log, rng)
+        search = ObjectSearch(self, planner.targets(ctx), cls, instances, camera, ctx, rng, trace)
+        search.start_distance = d0
+        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
+        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
+
+    def write_inputs(self, out: Path) -> None:
+        for case, log in self.logs.items():
+            write_log(log, out / "logs" / f"{case}.csv")
+
+    def describe(self):
+        w = self.world
+        return {"name": self.sc.name, "kind": self.kind, "places": len(self.places), "route": " ".join(self.route),
+                "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
+                "cases": {c.name: f"{len(self.logs[c.name])} detections recorded" for c in self.cases},
+                "planners": [v.label for v in self.variants()],
+                "requests (ground truth: shortest m)": {r.label: f"{','.join(r.truth) or 'absent'}: {self.shortest[r.label]:.2f}"
+                                                        for r in self.requests}}
+
+    def patrol_route(self) -> np.ndarray:
+        """(n, 2) m: the poses of one patrol (start, the route's places, back to the start), not looking."""
+        st = RobotState(*self.world.start_xy, self.world.start_heading or 0.0)
+        st.trail = [(st.x, st.y)]
+        targets = iter([(*self.places[n], {"look": False}) for n in self.route] + [(*self.world.start_xy, {"look": False})])
+        search = Patrol(self, targets, [], 0.0, 0, np.random.default_rng(0))
+        run_loop(search, st, self.sc.robot.step, np.inf, 10**9)
+        return np.asarray(st.trail)
 
     def _check_place(self, name, field):
         if name not in self.places:
@@ -294,7 +366,7 @@ class ObjectTask:
                                 np.zeros_like(self.world.reach), 0, np.inf)
         return length * self.world.frame.res
 
-    def shortest(self, req: Request) -> float:
+    def shortest_to(self, req: Request) -> float:
         """Geodesic from the start to the nearest pose that sees an instance of the target
         (heading free); inf when the request's ground truth holds none."""
         best = np.inf
@@ -359,26 +431,14 @@ def record(task: ObjectTask, timeline: str, hours, day: int = 0, base_seed: int 
     """Recording mode: one patrol (start, the route's places, back to the start) at each hour
     with the objects of ``timeline`` at that hour; each instance is logged at its first detection
     of the patrol. Seeded by (base_seed, timeline, hour), so the log is the same on every call."""
-    from .search import Drive
-
     rows = []
     for hour in hours:
         inst = task.instances(timeline, hour)
         rng = np.random.default_rng([base_seed, zlib.crc32(timeline.encode()), int(round(hour * 60))])
-        drive = Drive(task, inst, rng, heading=task.world.start_heading or 0.0)
-        logged: set[int] = set()
-
-        def on_detect(i, x, y, hour=hour, inst=inst, logged=logged):
-            if i not in logged:
-                logged.add(i)
-                cls, place = inst[i]
-                px, py = task.places[place]
-                rows.append({"day": day, "hour": float(hour), "class": cls, "x": px, "y": py,
-                             "robot_x": round(x, 3), "robot_y": round(y, 3), "place": place})
-            return False
-
-        drive.on_detect = on_detect
-        for name in task.route:
-            drive.go(*task.places[name])
-        drive.go(*task.world.start_xy, look=False)
+        st = RobotState(*task.world.start_xy, task.world.start_heading or 0.0)
+        st.trail = [(st.x, st.y)]
+        targets = iter([(*task.places[n], {"look": True}) for n in task.route] + [(*task.world.start_xy, {"look": False})])
+        search = Patrol(task, targets, inst, hour, day, rng)
+        run_loop(search, st, task.sc.robot.step, np.inf, 10**9)
+        rows += search.rows
     return pd.DataFrame(rows, columns=LOG_COLUMNS)

@@ -33,8 +33,8 @@ import math
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from ..geometry import wrap_angle
-from .base import Decision, Planner, register_planner
+from ...geometry import wrap_angle
+from ..base import Decision, Planner, register_planner
 
 
 # ---- the five factors, as pure functions ------------------------------------------------------

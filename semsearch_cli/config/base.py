@@ -1,0 +1,87 @@
+"""The sections every scenario shares: map, start, door signs, planners, robot, sensors, belief,
+navigation, experiment (SPEC 1). Lengths are metres, angles degrees; every model forbids unknown
+keys, so a misspelt key is an error naming the field."""
+
+from __future__ import annotations
+
+from typing import Any, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class MapSpec(Strict):
+    image: str = Field(description="PNG: dark (<100) wall, light (>=200) free, gray between = outside")
+    resolution: float = Field(0.1, gt=0.0, le=1.0, description="m/cell")
+    origin: tuple[float, float] = Field((0.0, 0.0), description="world (x, y) m of the image's bottom-left corner")
+
+
+class StartSpec(Strict):
+    x: float
+    y: float
+    heading: Union[float, Literal["random"]] = Field("random", description="degrees, or random")
+
+
+class DoorSpec(Strict):
+    number: Union[int, str]
+    x: float
+    y: float
+    facing: float = Field(description="degrees, the direction the sign faces")
+
+
+class PlannerSpec(BaseModel):
+    """``{name: ..., <parameter>: value | [values]}``; parameters are checked by the planner."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+    name: str
+    module: str | None = Field(None, description="a Python file (relative to the scenario) that registers this planner")
+
+    def params(self) -> dict[str, Any]:
+        return dict(self.model_extra or {})
+
+
+class RobotSpec(Strict):
+    radius: float = Field(0.25, gt=0.0, description="m, disk robot")
+    step: float = Field(0.1, gt=0.0, le=1.0, description="m travelled per simulation step")
+
+
+class LaserSpec(Strict):
+    fov: float = Field(180.0, gt=0.0, le=360.0, description="degrees")
+    beams: int = Field(181, ge=2, le=2000)
+    range: float = Field(10.0, gt=0.0, description="m")
+    noise_std: float = Field(0.0, ge=0.0, description="m, Gaussian range noise")
+
+
+class DoorCameraSpec(Strict):
+    fov: float = Field(60.0, gt=0.0, le=180.0, description="degrees, each of the left and right cameras")
+    range: float = Field(3.0, gt=0.0, description="m")
+    p_read: float = Field(0.95, ge=0.0, le=1.0, description="probability a visible sign is read")
+    p_misread: float = Field(0.0, ge=0.0, le=1.0, description="probability a read replaces one digit")
+
+
+class BeliefSpec(Strict):
+    visited_radius: float = Field(1.2, gt=0.0, description="m, kernel of the visited region")
+    density_radius: float = Field(2.4, gt=0.0, description="m, uniform kernel radius r of Eq. 4.2 (Manhattan)")
+    density_delta: float = Field(2.5, gt=0.0, description="m^2, delta of Eq. 4.4")
+    min_reads: int = Field(3, ge=1, description="reads before a sign feeds the planner's factors")
+    himm_inc: int = Field(3, ge=1, le=15)
+    himm_dec: int = Field(1, ge=1, le=15)
+    himm_max: int = Field(15, ge=1, le=255)
+    occupied_threshold: int = Field(3, ge=1, description="certainty at or above which a seen cell is occupied")
+
+
+class NavigationSpec(Strict):
+    navigator: Literal["geodesic", "harmonic"] = "geodesic"
+    replan_every: float = Field(1.0, gt=0.0, description="m travelled between periodic re-plans")
+
+
+class ExperimentSpec(Strict):
+    seeds: int = Field(10, ge=1)
+    base_seed: int = Field(0, ge=0)
+    max_distance: float = Field(2000.0, gt=0.0, description="m, budget per run")
+    max_steps: int | None = Field(None, ge=1)
+    out: str | None = Field(None, description="output folder (default results/<name>)")
+
+

@@ -1,0 +1,127 @@
+"""The scenario file: one model over the shared sections and each kind's own, YAML loading, and
+errors that name the file and the field (SPEC 1). Checks that need the map (start in a wall, goals
+reachable) belong to the world and the tasks.
+
+The kind of search is ``kind:`` when given, else the section present: ``objects`` (object search),
+``chains`` (chained searches), otherwise ``goals`` (door search).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any, Literal, Union
+
+import yaml
+from pydantic import Field, ValidationError, field_validator, model_validator
+
+from ..errors import ScenarioError
+from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
+                   PlannerSpec, RobotSpec, StartSpec, Strict)
+from .chain import ChainSpec
+from .objects import ObjectsSpec, DetectTable  # noqa: F401  (DetectTable names a union branch in errors)
+
+KINDS = ("doors", "objects", "chain")
+# the section each kind needs: (field, what to write when it is missing)
+NEEDS = {"doors": ("goals", "door numbers under goals"), "objects": ("objects", "an objects section"),
+         "chain": ("chains", "a chains section")}
+# the sections a kind takes from others
+USES = {"doors": {"goals"}, "objects": {"objects"}, "chain": {"chains", "objects"}}
+
+
+class Scenario(Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    map: MapSpec
+    start: StartSpec
+    doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
+    goals: list[Union[int, str]] = Field(default_factory=list)
+    objects: ObjectsSpec | None = None
+    chains: list[ChainSpec] | None = Field(None, description="chained searches (thesis ch. 6)")
+    kind: Literal["doors", "objects", "chain"] | None = Field(None, description="default: from the sections given")
+    planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
+    experiment: ExperimentSpec = ExperimentSpec()
+    robot: RobotSpec = RobotSpec()
+    laser: LaserSpec = LaserSpec()
+    door_camera: DoorCameraSpec = DoorCameraSpec()
+    belief: BeliefSpec = BeliefSpec()
+    navigation: NavigationSpec = NavigationSpec()
+
+    @field_validator("goals")
+    @classmethod
+    def _unique_goals(cls, v):
+        if len(set(map(str, v))) != len(v):
+            raise ValueError("goals must not repeat")
+        return v
+
+    @model_validator(mode="after")
+    def _task(self):
+        kind = self.search_kind
+        field, what = NEEDS[kind]
+        if not getattr(self, field):
+            raise ValueError(f"give {what} (door search: goals; object search: objects; chains: chains)")
+        extra = [f for f in ("goals", "objects", "chains") if getattr(self, f) and f not in USES[kind]]
+        if extra:
+            raise ValueError(f"a {kind} scenario does not take {' or '.join(extra)}; remove it")
+        return self
+
+    @property
+    def search_kind(self) -> str:
+        """doors, objects or chain: ``kind`` when given, else the section present."""
+        if self.kind is not None:
+            return self.kind
+        return "chain" if self.chains else "objects" if self.objects is not None else "doors"
+
+
+_TYPE_PART = re.compile(r"^(int|str|float|bool|none|constrained-\w+|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec|DetectTable)$")
+
+
+def _loc(loc: tuple) -> str:
+    """pydantic's error location as a dotted field path, without the union-branch type names."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif _TYPE_PART.match(str(part)):
+            continue
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def parse_scenario(data: Any, file: str | Path) -> Scenario:
+    """Validate a parsed YAML document; raise :class:`ScenarioError` on the first problem."""
+    if not isinstance(data, dict):
+        raise ScenarioError(str(file), "", "expected a YAML mapping (key: value) at the top level")
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        errs = exc.errors()
+        err = errs[0]
+        # a value matching no branch of a union gets one error per branch: report the deepest one
+        # under the same field (the branch the input was meant for, e.g. a table given as a mapping)
+        same = [e for e in errs if _loc(e["loc"]).startswith(_loc(err["loc"]))]
+        err = max(same, key=lambda e: (len(e["loc"]), not e["type"].endswith("_type")))
+        field = _loc(err["loc"])
+        msg = err["msg"]
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key (check its spelling; `semsearch validate --help` lists the scenario format)"
+        elif err["type"] == "missing":
+            msg = "required field is missing"
+        got = err.get("input")
+        if err["type"] not in ("extra_forbidden", "missing") and not isinstance(got, (dict, list)):
+            msg += f" (got {got!r})"
+        raise ScenarioError(str(file), field, msg) from None
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario YAML file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ScenarioError(str(path), "", "file not found")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise ScenarioError(str(path), "", f"not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    return parse_scenario(data, path)

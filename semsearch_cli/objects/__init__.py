@@ -1,1 +1,0 @@
-"""Object search over time (thesis chapter 5)."""

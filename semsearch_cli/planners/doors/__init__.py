@@ -1,0 +1,1 @@
+"""Door-search planners (thesis ch. 4): greedy, nsos and geometric, bvp."""

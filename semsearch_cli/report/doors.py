@@ -1,0 +1,127 @@
+"""The door-search section of a report: the thesis' Tables 4.2-4.10, success and SPL, significance
+against greedy, box plots, the alpha sweep, the median paths over the map and a replay."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..runner import file_stem, run_rows
+from . import tables as T
+from .document import Document, atomic_text, markdown_table, write_table
+from .plots import animate_run, plot_alpha_sweep, plot_boxes, plot_paths_overlay, plot_scenario
+from .tables import goal_key
+
+
+def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, notes: list) -> None:
+    runs = pd.concat([run_rows(p.runs) for p in parts], ignore_index=True)
+    tabs = {
+        "summary": T.summarise(runs),
+        "five_statistics": T.five_statistics(runs),
+        "mean_std": T.mean_std(runs),
+        "percent_of_optimal": T.percent_of_optimal(runs),
+        "success_spl": T.success_and_spl(runs),
+        "significance": T.significance(runs),
+    }
+    tdir = out / "tables"
+    for name, df in tabs.items():
+        write_table(tdir, name, df, formats)
+    if formats & {"md", "html"}:
+        for name in ("five_statistics", "mean_std", "percent_of_optimal"):
+            atomic_text(tdir / f"{name}.md", markdown_table(tabs[name], mark_rows=name != "mean_std"))
+    doc.heading(2, f"Door search ({len(runs)} runs)")
+    doc.heading(3, "Distance travelled (m): median, mean, std, min, max (thesis Tables 4.2-4.5)")
+    doc.para("Best of each row in bold, worst in italics.")
+    doc.table(tabs["five_statistics"], mark_rows=True)
+    doc.heading(3, "Mean ± std beside the shortest path (Tables 4.6-4.9)")
+    doc.table(tabs["mean_std"])
+    doc.heading(3, "Mean as percent of the shortest path (Table 4.10)")
+    doc.table(tabs["percent_of_optimal"], mark_rows=True)
+    doc.heading(3, "Success rate and SPL")
+    doc.table(tabs["success_spl"].set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
+    doc.heading(3, "Is the difference significant? (Mann-Whitney U against greedy, two-sided)")
+    doc.para("effect_r: rank-biserial correlation, positive when the planner travels less than greedy.")
+    doc.table(tabs["significance"].set_index(["scenario", "goal", "planner"]).drop(columns=["baseline"]), fmt="{:.3g}")
+    if formats & {"png", "html", "md"}:
+        doc.heading(3, "Figures")
+        _figures(doc, runs, parts, out / "figures", replay, notes)
+
+
+def _figures(doc, runs, parts, fdir: Path, replay: bool, notes: list) -> None:
+    order = T.planner_order(runs["planner"])
+    for scen in sorted(runs["scenario"].astype(str).unique()):
+        sub = runs[runs["scenario"].astype(str) == scen]
+        f = fdir / f"boxes_{scen}.png"
+        plot_boxes(runs.assign(scenario=runs["scenario"].astype(str)), scen, order, f)
+        doc.figure(f, f"Distance per goal and planner, {scen} (box: quartiles, line: median, triangle: mean; dashed: shortest path)")
+        if sub["planner"].str.startswith("nsos").any():
+            f = fdir / f"alpha_{scen}.png"
+            plot_alpha_sweep(sub, f)
+            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}")
+    for part in parts:
+        loaded = part.loaded(notes, "Path figures and the replay")
+        if loaded is None:
+            continue
+        rows = run_rows(part.runs)
+        med = T.median_run(rows)
+        for goal in sorted(med["goal"].unique(), key=goal_key):
+            paths = {}
+            for _, r in med[med["goal"] == goal].iterrows():
+                p = part.folder / "paths" / f"{file_stem(r['planner'], goal, int(r['seed']))}.npz"
+                if p.is_file():
+                    paths[r["planner"]] = (np.load(p)["path"], float(r["distance_m"]))
+            if paths:
+                f = fdir / f"paths_{loaded.sc.name}_goal{goal}.png"
+                plot_paths_overlay(loaded.world, {k: paths[k] for k in order if k in paths}, loaded.task.goal_value(goal),
+                                   f"{loaded.sc.name}: median runs, goal {goal}", f)
+                doc.figure(f, f"Median run of each planner for goal {goal} ({loaded.sc.name})")
+        if replay:
+            _replay(doc, loaded, rows, fdir, T.planner_order(rows["planner"]))
+
+
+def _replay(doc, loaded, runs, fdir, order) -> None:
+    """Re-simulate (runs are deterministic) the median run of the most semantic variant for the
+    first goal, recording the belief at each decision, and write it as an animated GIF."""
+    w = loaded.world
+    label = order[-1]
+    goal = sorted(runs["goal"].unique(), key=goal_key)[0]
+    med = T.median_run(runs[(runs["planner"] == label) & (runs["goal"] == goal)])
+    if med.empty:
+        return
+    variant = next((v for v in loaded.task.variants() if v.label == label), None)
+    if variant is None:
+        return
+    seed = int(med["seed"].iloc[0])
+    frames = []
+    step = max(1, int(med["decisions"].iloc[0]) // 60)
+    count = [0]
+
+    def rec(belief, trail, distance, cands, dec):
+        count[0] += 1
+        if count[0] % step:
+            return
+        m = np.where(belief.seen, np.where(belief.free, 2, 0), 1).astype(np.uint8)
+        cx, cy = w.frame.to_world(cands.rows, cands.cols)
+        frames.append({"map": m[::2, ::2], "path": np.asarray(trail, float), "distance": distance,
+                       "cands": np.stack([cx, cy], axis=1) if len(cands) else np.zeros((0, 2)),
+                       "target": w.frame.to_world(dec.row, dec.col)})
+
+    res = loaded.task.run(variant, goal, seed, recorder=rec)
+    if not frames:
+        return
+    f = fdir / f"replay_{loaded.sc.name}_{file_stem(label, goal, seed)}.gif"
+    animate_run(w, frames, f"{label}, goal {goal}, seed {seed}", f)
+    doc.figure(f, f"Replay of {label}, goal {goal}, seed {seed} ({res.outcome}, {res.distance_m:.1f} m): "
+               "the map as built (white free, black occupied, gray unknown), candidates and the chosen one")
+
+
+def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
+    cols = ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]
+    return [("distance travelled (m) per goal and planner", T.summarise(run_rows(runs))[cols])]
+
+
+def show(loaded, out: Path) -> None:
+    w, sc = loaded.world, loaded.sc
+    plot_scenario(w, sc.goals, f"{sc.name}: {len(w.signs)} signs, goals {', '.join(map(str, sc.goals))}", out)

@@ -1,0 +1,85 @@
+"""A loaded scenario and its runs: goals x planner variants x seeds (SPEC 9).
+
+A run's randomness comes only from its own seed (:func:`semsearch_cli.tasks.run_seed`), so rows
+do not depend on the number of workers or the executor.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..config import Scenario, load_scenario
+from ..planners import Variant
+from ..tasks import Task, build_task
+from ..world.scenario import World, build_world
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    goal: object
+    variant: Variant
+    seed: int
+
+    @property
+    def key(self) -> tuple:
+        return (self.variant.label, str(self.goal), int(self.seed))
+
+    @property
+    def stem(self) -> str:
+        return file_stem(self.variant.label, self.goal, self.seed)
+
+
+def file_stem(label: str, goal, seed=None) -> str:
+    """File-name stem of a run (or, without seed, of a goal x variant)."""
+    safe = label.replace("[", "_").replace("]", "").replace("=", "").replace(",", "_")
+    return f"{safe}__goal{goal}" + (f"__seed{seed}" if seed is not None else "")
+
+
+@dataclass
+class Loaded:
+    """A scenario with its task (world, goals, shortest paths, logs), built once per process."""
+
+    path: Path
+    sc: Scenario
+    task: Task
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Loaded":
+        path = Path(path)
+        sc = load_scenario(path)
+        world = build_world(sc, path.parent, str(path))
+        return cls(path, sc, build_task(sc, world, path))
+
+    @property
+    def world(self) -> World:
+        return self.task.world
+
+    @property
+    def kind(self) -> str:
+        return self.task.kind
+
+    @property
+    def goals(self) -> list:
+        return self.task.goals
+
+    @property
+    def shortest(self) -> dict:
+        return self.task.shortest
+
+    def with_planners(self, specs) -> "Loaded":
+        """The same scenario with other planner entries (checked for this kind of search)."""
+        sc = self.sc.model_copy(update={"planners": specs})
+        self.task.variants(specs)
+        self.task.sc = sc
+        return Loaded(self.path, sc, self.task)
+
+
+def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> list[RunSpec]:
+    """goals x planner variants x seeds, in that nesting order."""
+    variants = loaded.task.variants()
+    if planners:
+        variants = [v for v in variants if v.name in planners or v.label in planners]
+    gl = [g for g in loaded.goals if goals is None or str(g) in {str(x) for x in goals}]
+    n = seeds or loaded.sc.experiment.seeds
+    return [RunSpec(g, v, s) for g in gl for v in variants for s in range(n)]

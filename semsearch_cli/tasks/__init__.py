@@ -1,0 +1,8 @@
+"""Tasks: one module per kind of search over the shared core, behind one protocol
+(:class:`~semsearch_cli.tasks.base.Task`), driven by one step loop (:mod:`.loop`).
+Importing this package registers every kind."""
+
+from . import chain, doors, objects  # noqa: F401  (registration side effect)
+from .base import TASKS, Outcome, RobotState, RunResult, Task, build_task, register_task, run_seed
+
+__all__ = ["TASKS", "Outcome", "RobotState", "RunResult", "Task", "build_task", "register_task", "run_seed"]

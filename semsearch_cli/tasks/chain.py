@@ -1,0 +1,1 @@
+"""Chained searches (placeholder, written next)."""

@@ -1,0 +1,225 @@
+"""Door search (thesis ch. 4, SPEC 2-5): find the door sign with a given number on a map the
+robot builds as it goes.
+
+Sensing is the laser into HIMM and the two door cameras into sign reads; the belief update marks
+the visited kernel and density class; the target is seen when the goal sign is read. Re-plans
+happen when the path is used up, every ``replan_every`` metres, and, for planners that use signs,
+when a sign reaches ``min_reads``. When a re-plan finds no candidate the robot first turns on the
+spot in three quarter turns, sensing after each (its laser covers only 180 degrees ahead, so a
+start facing a dead end would otherwise see nowhere to go); only if there is still no candidate
+is the run ``stuck``. A goal whose sign the robot has already read (a later stage of a chain) is
+reached by path planning on the map built so far, to the mean pose of its reads.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..belief import Belief
+from ..errors import ScenarioError
+from ..geometry import wrap_angle
+from ..kernels.raycast import himm_update
+from ..navigation import NAVIGATORS
+from ..planners import PlanContext
+from ..sensors import DoorCamera, Laser
+from ..world.scenario import check_goals_reachable
+from .base import Outcome, RobotState, Task, register_task
+from .loop import run_loop
+
+MAX_RETRIES = 5
+
+
+class DoorSensing:
+    """Laser into HIMM and door cameras into reads, shared by the searches of this task."""
+
+    def __init__(self, task: "DoorTask", goal, rng: np.random.Generator):
+        self.task, self.goal, self.rng = task, goal, rng
+        self.goal_idx = task.world.signs.index_of(goal)
+        self.bbox = np.empty(4, np.int64)
+
+    def sense(self, st: RobotState) -> tuple[bool, bool]:
+        """(goal read, a sign reached min_reads)."""
+        t, b, fr = self.task, st.belief, self.task.world.frame
+        v, u = fr.to_cell(st.x, st.y)
+        r, c = int(np.floor(v)), int(np.floor(u))
+        thetas, dist, hit = t.laser.scan(float(v), float(u), st.heading, self.rng)
+        self.bbox[:] = (fr.height, -1, fr.width, -1)
+        spec = t.sc.belief
+        himm_update(b.cv, b.seen, float(v), float(u), thetas, dist, hit, spec.himm_inc, spec.himm_dec, spec.himm_max, self.bbox)
+        b.refresh_free(self.bbox)
+        found = event = False
+        for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
+            st.read_signs.add(i)
+            if i == self.goal_idx and label == self.goal:
+                found = True
+            if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == spec.min_reads:
+                event = True
+        return found, event
+
+    def update(self, st: RobotState) -> None:
+        r, c = (int(v) for v in self.task.world.frame.to_index(st.x, st.y))
+        st.belief.visit(r, c)
+        st.headings.append(st.heading)
+
+
+class DoorSearch(DoorSensing):
+    """Explore with a door planner until the goal sign is read."""
+
+    def __init__(self, task, planner, goal, rng, trace: bool, recorder):
+        super().__init__(task, goal, rng)
+        self.planner, self.keep_trace, self.recorder = planner, trace, recorder
+        self.navigator = NAVIGATORS[task.sc.navigation.navigator]()
+        self.uses_signs = getattr(planner, "replan_on_signs", False)
+        self.replan_every = task.sc.navigation.replan_every
+        self.looked_around = False
+        self.decisions = 0
+        self.trace: list = []
+        self.start_distance = 0.0
+
+    def replan_due(self, path_done, since_plan, event):
+        return path_done or since_plan >= self.replan_every or (event and self.uses_signs)
+
+    def plan(self, st):
+        b, fr = st.belief, self.task.world.frame
+        r, c = (int(v) for v in fr.to_index(st.x, st.y))
+        b.refresh_derived()
+        cands = b.candidates()
+        if len(cands) == 0 and not self.looked_around:
+            # nowhere to go with what the forward laser has seen: turn on the spot (three quarter
+            # turns, no distance travelled) and look again
+            self.looked_around = True
+            found = False
+            for _ in range(3):
+                st.heading = float(wrap_angle(st.heading + np.pi / 2))
+                f, _ = self.sense(st)
+                found = found or f
+            if found:
+                return "found"
+            b.refresh_derived()
+            cands = b.candidates()
+        ctx = PlanContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings)
+        for _ in range(MAX_RETRIES):
+            dec = self.planner.choose(ctx, cands)
+            if dec is None:
+                break
+            kept = dec.info.get("kept", False)
+            self.decisions += not kept
+            if self.recorder is not None and not kept:
+                self.recorder(b, st.trail, st.distance - self.start_distance, cands, dec)
+            if self.keep_trace and not kept:
+                tx, ty = fr.to_world(dec.row, dec.col)
+                self.trace.append({"step": st.steps, "distance_m": round(st.distance - self.start_distance, 3),
+                                   "x": round(float(st.x), 3), "y": round(float(st.y), 3),
+                                   "heading_deg": round(float(np.degrees(st.heading)), 1),
+                                   "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(cands), **dec.info})
+            p = self.navigator.plan(b, r, c, dec.row, dec.col)
+            if p is not None and len(p[0]) >= 2:
+                self.looked_around = False
+                return fr.to_world(p[0], p[1])
+            keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
+            if keep.all():
+                break
+            cands = cands.take(np.flatnonzero(keep))
+        return "stuck"
+
+
+class GoToRead(DoorSensing):
+    """Go to a sign already read, by the cheapest path on the map built so far: the target is
+    seen on arrival at the mean robot position of its reads."""
+
+    def __init__(self, task, goal, rng, target_xy):
+        super().__init__(task, goal, rng)
+        self.target = target_xy
+        self.path = None
+        self.decisions = 0
+        self.trace: list = []
+
+    def sense(self, st):
+        found, event = super().sense(st)
+        arrived = self.path is not None and np.hypot(st.x - self.target[0], st.y - self.target[1]) < 1e-6
+        return found or arrived, event
+
+    def replan_due(self, path_done, since_plan, event):
+        return path_done
+
+    def plan(self, st):
+        if self.path is not None:
+            return "stuck"
+        b, fr = st.belief, self.task.world.frame
+        b.refresh_derived()
+        r, c = (int(v) for v in fr.to_index(st.x, st.y))
+        tr, tc = (int(v) for v in fr.to_index(*self.target))
+        p = b.path(r, c, tr, tc)
+        if p is None or len(p[0]) < 2:
+            return "stuck"
+        self.decisions = 1
+        xs, ys = fr.to_world(p[0], p[1])
+        xs[-1], ys[-1] = self.target  # end exactly on the reading pose
+        self.path = (xs, ys)
+        return self.path
+
+
+def read_position(belief: Belief, goal) -> tuple[float, float] | None:
+    """Mean robot position (m) at the reads of sign ``goal``, or None when it was never read."""
+    reads = belief.reads
+    if goal not in reads._label_id:
+        return None
+    rows = np.flatnonzero(reads.label[: reads.n] == reads._label_id[goal])
+    n = reads.count[rows].sum()
+    return float(reads.sx[rows].sum() / n), float(reads.sy[rows].sum() / n)
+
+
+@register_task
+class DoorTask(Task):
+    """Door search: goals are door numbers; the shortest path of each is the ground-truth geodesic
+    to the nearest pose that reads its sign."""
+
+    kind = "doors"
+    planner_kind = "doors"
+
+    def __init__(self, sc, world, path):
+        super().__init__(sc, world, path)
+        self.laser = Laser(world, sc.laser)
+        self.camera = DoorCamera(world, sc.door_camera)
+
+    @classmethod
+    def build(cls, sc, world, path):
+        if len(world.signs) == 0:
+            raise ScenarioError(str(path), "doors", "no door signs given")
+        task = cls(sc, world, path)
+        task.check_goals(sc.goals, "goals")
+        task.shortest = check_goals_reachable(world, sc.goals, task.file)
+        task.variants()
+        return task
+
+    def check_goals(self, goals, field: str) -> None:
+        for k, g in enumerate(goals):
+            if self.world.signs.index_of(g) < 0:
+                raise ScenarioError(self.file, f"{field}[{k}]", f"no door sign carries the number {g}")
+
+    def new_belief(self) -> Belief:
+        return Belief(self.world.frame, self.sc.belief, self.sc.robot.radius)
+
+    def episode(self, state, planner, goal, rng, trace=False, recorder=None, reuse_reads: bool = False):
+        """Search for sign ``goal`` from ``state`` (a new belief when it has none). With
+        ``reuse_reads`` and the sign already read, go there on the map built so far."""
+        if state.belief is None:
+            state.belief = self.new_belief()
+        d0, s0 = state.distance, state.steps
+        target = read_position(state.belief, goal) if reuse_reads else None
+        search = GoToRead(self, goal, rng, target) if target is not None else DoorSearch(self, planner, goal, rng, trace, recorder)
+        search.start_distance = d0
+        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
+        if outcome == "stuck" and isinstance(search, GoToRead):  # the map built so far has no path: search again
+            search = DoorSearch(self, planner, goal, rng, trace, recorder)
+            search.start_distance = d0
+            outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
+        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
+
+    def describe(self):
+        w = self.world
+        readable = sum(1 for i in range(len(w.signs)) if w.readable_mask(i).any())
+        return {"name": self.sc.name, "kind": self.kind, "signs": len(w.signs), "readable_signs": readable,
+                "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
+                "planners": [v.label for v in self.variants()],
+                "shortest_m": {str(k): round(v, 2) for k, v in self.shortest.items()}}

@@ -1,0 +1,69 @@
+"""The one step loop of every episode (STYLE: one fixed, written step order).
+
+Each step: (1) sense, (2) update the belief, (3) stop if the target was seen, (4) re-plan if an
+event asks, (5) move one step along the path, (6) check the budget. What sensing, the belief, an
+event and a plan mean is the task's (:class:`Search`); the order, the motion and the budget are
+the same for every task. The budget is the scenario's ``max_distance`` (and ``max_steps``) over
+the robot's whole history, so a chain's stages share one budget.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from ..navigation import advance
+from .base import RobotState
+
+STALL_STEPS = 50  # steps without moving before a run is stuck
+
+
+class Search(Protocol):
+    """The task-specific part of one episode."""
+
+    decisions: int
+    trace: list
+
+    def sense(self, st: RobotState) -> tuple[bool, bool]:
+        """Read the sensors at the robot's pose; (target seen, an event that asks for a re-plan)."""
+
+    def update(self, st: RobotState) -> None:
+        """Fold what was sensed into the belief."""
+
+    def replan_due(self, path_done: bool, since_plan: float, event: bool) -> bool:
+        """Whether to re-plan now (the path is used up, ``since_plan`` m travelled since the last
+        plan, a sensing event)."""
+
+    def plan(self, st: RobotState):
+        """Waypoints ``(xs, ys)`` (m) from the robot's position, or the outcome that ends the
+        episode when there is nowhere to go (``found`` when looking around saw the target)."""
+
+
+def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int) -> str:
+    """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
+    :meth:`Search.plan` returns when there is nowhere to go."""
+    px = py = None
+    i = 0
+    since_plan = 0.0
+    stall = 0
+    while True:
+        found, event = search.sense(st)  # 1. sense
+        search.update(st)  # 2. belief
+        if found:  # 3. success
+            return "found"
+        if search.replan_due(px is None or i >= len(px), since_plan, event):  # 4. re-plan on events
+            plan = search.plan(st)
+            if isinstance(plan, str):
+                return plan
+            px, py = plan
+            i = 1
+            since_plan = 0.0
+        st.x, st.y, i, st.heading, moved = advance(px, py, i, st.x, st.y, st.heading, step)  # 5. move
+        st.distance += moved
+        since_plan += moved
+        st.steps += 1
+        st.trail.append((st.x, st.y))
+        stall = stall + 1 if moved < 1e-9 else 0
+        if stall >= STALL_STEPS:  # 6. budget
+            return "stuck"
+        if st.distance >= max_distance or st.steps >= max_steps:
+            return "budget"
