@@ -14,6 +14,7 @@ import yaml
 import cv2
 
 from semsearch_cli.world.generate import generate_building
+from semsearch_cli.world.hospital import hospital_image, hospital_scenario, hospital_signs
 from semsearch_cli.world.office import office_image, office_scenario
 
 PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
@@ -54,6 +55,19 @@ def main() -> None:
     scen = office_scenario(image="../maps/office/map.png")
     (root / "configs" / "office.yaml").write_text(header + yaml.safe_dump(scen, sort_keys=False, default_flow_style=None))
     print("configs/office.yaml")
+    folder = root / "maps" / "hospital"
+    folder.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(folder / "map.png"), hospital_image())
+    with (folder / "doors.csv").open("w") as fh:
+        fh.write("number,x,y,facing\n")
+        for n, x, y, f in hospital_signs():
+            fh.write(f"{n},{x},{y},{f}\n")
+    header = ("# hospital: chained searches (thesis ch. 6): twenty numbered rooms off two crossing corridors,\n"
+              "# objects with timelines in rooms 12 and 15, chains of 3-5 stages (door signs, then objects in\n"
+              "# the room behind a door). Regenerate with scripts/make_configs.py.\n")
+    scen = hospital_scenario(image="../maps/hospital/map.png", doors="../maps/hospital/doors.csv")
+    (root / "configs" / "hospital.yaml").write_text(header + yaml.safe_dump(scen, sort_keys=False, default_flow_style=None))
+    print("configs/hospital.yaml")
 
 
 if __name__ == "__main__":

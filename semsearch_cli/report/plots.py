@@ -271,3 +271,27 @@ def plot_heat_steps(world, panels: list, places: dict, title: str, out: Path) ->
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     _save(fig, out)
+
+
+def plot_chain_stages(stages, order: list, out: Path) -> None:
+    """Per chain (one panel each): mean distance of each stage with the map kept and from scratch,
+    per planner (bars side by side; scratch hatched)."""
+    chains = list(dict.fromkeys(stages["goal"]))
+    fig, axes = plt.subplots(len(chains), 1, figsize=(9, 2.8 * len(chains)), squeeze=False)
+    for ax, ch in zip(axes[:, 0], chains):
+        d = stages[stages["goal"] == ch]
+        labels = list(dict.fromkeys(d["stage"]))
+        x = np.arange(len(labels))
+        width = 0.8 / max(1, 2 * len(order))
+        for j, p in enumerate(order):
+            for m, mode in enumerate(("kept", "scratch")):
+                s = d[(d["planner"] == p) & (d["map"] == mode)].set_index("stage").reindex(labels)
+                ax.bar(x + (2 * j + m - len(order)) * width + width / 2, s["mean"].to_numpy(float), width,
+                       color=f"C{j}", alpha=1.0 if mode == "kept" else 0.45, hatch=None if mode == "kept" else "//",
+                       label=f"{p}, map {mode}")
+        ax.set_xticks(x, labels, fontsize=8)
+        ax.set_ylabel("mean distance (m)")
+        ax.set_title(f"chain {ch}: each stage with the map kept and from scratch")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    _save(fig, out)

@@ -1,1 +1,222 @@
-"""Chained searches (placeholder, written next)."""
+"""Chained searches (thesis ch. 6, SPEC 8): "disinfect room 12, then room 15"; "the computer in
+room 12 at 11:00".
+
+A chain is a list of stages. A stage finds a door sign (door search with the scenario's door
+planner) and, when it names an object class and an hour, then finds that object in the room
+behind the door: the places whose ``room`` is the door's number, searched by ``lsos`` on the
+chain's recorded log (only the detections at that room's places) or by ``brute_force`` over the
+room's places, on the recorded map as in object search. The robot keeps its pose, its map and its
+sign reads from stage to stage; a stage whose sign it has already read goes there by path planning
+on the map built so far. The budget (``max_distance``) is the whole chain's.
+
+Each run also runs every stage *from scratch*: from the pose where that stage began in the chain,
+with an empty map and no sign reads, and the same seed as the stage in the chain (so a first
+stage is the same run both ways); so per planner the report compares each
+stage with the map kept against the same stage without it. A run's rows: one for the chain (goal =
+the chain's name, distance in total, shortest = the sum of the shortest legs in order), one per
+stage with the map kept (``map = kept``) and one per stage from scratch (``map = scratch``);
+``stage`` is ``k:door`` or ``k:door/class@hour``. A chain stops at the first stage that fails.
+
+Shortest legs: leg 1 runs from the start to the nearest pose that reads the first door; each
+later leg from the end pose of the previous leg to the nearest pose that reads its door; an object
+leg from there to the nearest pose that sees an instance of the class in its room.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..errors import ScenarioError
+from ..metrics import spl
+from ..planners import Variant
+from .base import RobotState, RunResult, Task, register_task, run_seed
+from .doors import DoorTask
+from .objects import Case, ObjectTask
+
+
+@dataclass(frozen=True)
+class Stage:
+    door: object
+    cls: str | None = None
+    hour: float | None = None
+
+    @property
+    def label(self) -> str:
+        return f"{self.door}" + (f"/{self.cls}@{self.hour:g}" if self.cls is not None else "")
+
+
+@register_task
+class ChainTask(Task):
+    kind = "chain"
+    planner_kind = "doors"
+
+    def __init__(self, sc, world, path):
+        super().__init__(sc, world, path)
+        self.doors = DoorTask(sc, world, path)
+        self.objects = ObjectTask(sc, world, path) if sc.objects is not None else None
+        self.chains = {c.name: c for c in sc.chains}
+        if len(self.chains) != len(sc.chains):
+            raise ScenarioError(self.file, "chains", "chain names must be unique")
+        self.stages: dict[str, list[Stage]] = {}
+        self.logs: dict[str, pd.DataFrame] = {}
+        self.legs: dict[str, list[float]] = {}
+
+    @classmethod
+    def build(cls, sc, world, path):
+        if len(world.signs) == 0:
+            raise ScenarioError(str(path), "doors", "no door signs given")
+        task = cls(sc, world, path)
+        for k, ch in enumerate(sc.chains):
+            field = f"chains[{k}]"
+            stages = [Stage(s.door, s.object, s.hour) for s in ch.stages]
+            task.doors.check_goals([s.door for s in stages], f"{field}.stages")
+            if any(s.cls is not None for s in stages):
+                task._check_object_stages(ch, stages, field)
+            task.stages[ch.name] = stages
+            task.legs[ch.name] = task._shortest_legs(ch, stages, field)
+            task.shortest[ch.name] = float(sum(task.legs[ch.name]))
+        task.variants()
+        return task
+
+    def _check_object_stages(self, ch, stages, field) -> None:
+        ot = self.objects
+        if ot is None:
+            raise ScenarioError(self.file, field, "an object stage needs an objects section (places with their room)")
+        if ch.record is None or ch.truth is None:
+            raise ScenarioError(self.file, field, "a chain with object stages gives record (timelines or a log) and truth")
+        if ch.truth not in ot.spec.timelines:
+            raise ScenarioError(self.file, f"{field}.truth", f"unknown timeline {ch.truth!r}")
+        rec = [ch.record] if isinstance(ch.record, str) else list(ch.record)
+        log_file = rec[0] if len(rec) == 1 and rec[0].lower().endswith(".csv") else None
+        if log_file is None:
+            for n in rec:
+                if n not in ot.spec.timelines:
+                    raise ScenarioError(self.file, f"{field}.record", f"unknown timeline {n!r}")
+        elif not (ot.base / log_file).is_file():
+            raise ScenarioError(self.file, f"{field}.record", f"detection log {ot.base / log_file} not found")
+        self.logs[ch.name] = ot.log(Case(ch.name, tuple(rec), log_file, ch.truth, ()))
+        for j, s in enumerate(stages):
+            if s.cls is not None and not self.room_places(s.door):
+                raise ScenarioError(self.file, f"{field}.stages[{j}]", f"no place has room: {s.door}; give the places "
+                                    "in that room a room field")
+
+    def room_places(self, door) -> list[str]:
+        """The places of the room behind door ``door``, in route order."""
+        ot = self.objects
+        room = {p.name for p in ot.spec.places if p.room is not None and str(p.room) == str(door)}
+        return [n for n in ot.route if n in room] + sorted(room - set(ot.route))
+
+    def _instances(self, ch, s: Stage) -> list[tuple[str, str]]:
+        return self.objects.instances(ch.truth, s.hour)
+
+    def _shortest_legs(self, ch, stages, field) -> list[float]:
+        w = self.world
+        cell = w.start_cell
+        legs = []
+        for j, s in enumerate(stages):
+            d, end = w.geodesic(cell, w.reading_cells(s.door))
+            if end is None:
+                raise ScenarioError(self.file, f"{field}.stages[{j}].door", f"sign {s.door} cannot be read from any pose "
+                                    "reachable from the start")
+            legs.append(d)
+            cell = end
+            if s.cls is not None:
+                ot = self.objects
+                rng = ot.spec.camera.for_class(s.cls)[1]
+                target = np.zeros_like(w.reach)
+                room = set(self.room_places(s.door))
+                for cl, p in self._instances(ch, s):
+                    if cl == s.cls and p in room:
+                        target |= ot.view_mask(*ot.places[p], rng)
+                d, end = w.geodesic(cell, target)
+                if end is None:
+                    raise ScenarioError(self.file, f"{field}.stages[{j}]", f"at {s.hour:g}:00 no {s.cls} stands in the room "
+                                        f"behind door {s.door} (timeline {ch.truth}) where the camera could see it")
+                legs.append(d)
+                cell = end
+        return legs
+
+    @property
+    def goals(self) -> list:
+        return list(self.chains)
+
+    # ---- running ----------------------------------------------------------------------
+    def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, trace: bool):
+        """One stage from ``st``: (outcome, decisions, trace)."""
+        out, st = self.doors.episode(st, variant.build(), s.door, rng, trace, reuse_reads=reuse)
+        decisions, tr = out.decisions, list(out.trace)
+        if out.outcome != "found" or s.cls is None:
+            return out.outcome, decisions, tr
+        room = self.room_places(s.door)
+        log = self.logs[ch.name]
+        near = _nearest_place(log, self.objects.places)
+        planner = Variant(ch.object_planner, ()).build()
+        out, st = self.objects.search_episode(st, planner, s.cls, s.hour, self._instances(ch, s), log[near.isin(room)],
+                                              room, None, rng, trace)
+        return out.outcome, decisions + out.decisions, tr + out.trace
+
+    def run(self, variant: Variant, goal, seed: int, trace: bool = False, recorder=None) -> RunResult:
+        t0 = time.perf_counter()
+        ch = self.chains[str(goal)]
+        base = self.sc.experiment.base_seed
+        st = self.start_state(np.random.default_rng(run_seed(self.sc.name, ch.name, seed, base)))
+        st.belief = self.doors.new_belief()
+        stages, decisions, trace_all = [], 0, []
+        outcome = "found"
+        leg = iter(self.legs[ch.name])
+        for k, s in enumerate(self.stages[ch.name], 1):
+            pose = (st.x, st.y, st.heading)
+            d0, s0, t_stage = st.distance, st.steps, time.perf_counter()
+            stage_seed = run_seed(self.sc.name, f"{ch.name}#{k}", seed, base)  # the same draws kept and from scratch
+            outcome, dec, tr = self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True, trace)
+            shortest = next(leg) + (next(leg) if s.cls is not None else 0.0)
+            decisions += dec
+            trace_all += [{**d, "stage": k} for d in tr]
+            stages.append(_stage_row(k, s, "kept", outcome, st.distance - d0, st.steps - s0, shortest, dec, time.perf_counter() - t_stage))
+            # the same stage from scratch: same pose, empty map, same seed
+            fresh = RobotState(*pose, trail=[pose[:2]])
+            t_s = time.perf_counter()
+            o2, d2, _ = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, False)
+            stages.append(_stage_row(k, s, "scratch", o2, fresh.distance, fresh.steps, shortest, d2, time.perf_counter() - t_s))
+            if outcome != "found":
+                break
+        res = RunResult(outcome, st.distance, st.steps, decisions, time.perf_counter() - t0,
+                        np.asarray(st.trail, np.float32), sorted(st.read_signs), trace_all, stages)
+        return res
+
+    def rows(self, variant, goal, seed, res):
+        rows = super().rows(variant, goal, seed, res)
+        rows[0]["map"] = "kept"
+        return rows
+
+    def describe(self):
+        w = self.world
+        return {"name": self.sc.name, "kind": self.kind, "signs": len(w.signs),
+                "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
+                "planners": [v.label for v in self.variants()],
+                "chains (shortest m)": {n: f"{' -> '.join(s.label for s in st)}: {self.shortest[n]:.2f}"
+                                        for n, st in self.stages.items()}}
+
+
+def _stage_row(k: int, s: Stage, mode: str, outcome: str, distance: float, steps: int, shortest: float, decisions: int,
+               wall: float) -> dict:
+    """The columns of a stage row that differ from its chain's row."""
+    success = outcome == "found"
+    return {"stage": f"{k}:{s.label}", "map": mode, "outcome": outcome, "success": int(success),
+            "distance_m": round(distance, 3), "shortest_m": round(shortest, 3),
+            "ratio": round(distance / shortest, 4) if shortest > 0 else float("nan"),
+            "spl": round(spl(success, shortest, distance), 4), "steps": steps, "decisions": decisions, "wall_s": round(wall, 3)}
+
+
+def _nearest_place(log: pd.DataFrame, places: dict) -> pd.Series:
+    """The place nearest each detection of a log (its ``place`` column may be empty)."""
+    if log.empty:
+        return pd.Series([], dtype=object)
+    names = list(places)
+    xy = np.array([places[n] for n in names])
+    d = np.hypot(log["x"].to_numpy(float)[:, None] - xy[:, 0], log["y"].to_numpy(float)[:, None] - xy[:, 1])
+    return pd.Series([names[i] for i in d.argmin(axis=1)], index=log.index)

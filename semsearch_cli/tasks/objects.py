@@ -230,14 +230,14 @@ class ObjectTask(Task):
         self._recorded: dict[str, pd.DataFrame] = {}  # timeline -> its log (the same in every case)
         self.requests = [r for c in self.cases for r in c.requests]
         labels = [r.label for r in self.requests]
-        if not labels:
-            raise ScenarioError(file, "objects.requests", "no requests: give at least one {class, hour}")
         if len(set(labels)) != len(labels):
             raise ScenarioError(file, "objects.requests", "a request (case, class, hour) appears twice")
 
     @classmethod
     def build(cls, sc, world, path):
         task = cls(sc, world, path)
+        if not task.requests:
+            raise ScenarioError(task.file, "objects.requests", "no requests: give at least one {class, hour}")
         task.logs = {c.name: task.log(c) for c in task.cases}
         task.shortest = {r.label: task.shortest_to(r) for r in task.requests}
         task.variants()

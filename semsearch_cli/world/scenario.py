@@ -191,19 +191,36 @@ class World:
         of the three reference maps, whereas the distance to the edge of the 3 m read disk is
         5-30% shorter than the published values).
         """
+        target = self.reading_cells(label)
+        if not target.any():
+            return float("inf")
+        return self.geodesic(self.start_cell, target)[0]
+
+    def reading_cells(self, label) -> np.ndarray:
+        """(H, W) bool: the reachable cells nearest to sign ``label`` among those that read it
+        (the robot abreast of the door); empty when no reachable pose reads it."""
         i = self.signs.index_of(label)
         disk = self.readable_mask(i)
+        target = np.zeros_like(disk)
         if not disk.any():
-            return float("inf")
+            return target
         rr, cc = np.nonzero(disk)
         x, y = self.frame.to_world(rr, cc)
         d = np.hypot(x - self.signs.x[i], y - self.signs.y[i])
         near = d <= d.min() + 0.5 * self.frame.res
-        target = np.zeros_like(disk)
         target[rr[near], cc[near]] = True
-        r, c = self.start_cell
+        return target
+
+    def geodesic(self, cell: tuple[int, int], target: np.ndarray) -> tuple[float, tuple[int, int] | None]:
+        """Ground-truth geodesic (m), with the robot's clearance, from ``cell`` to the nearest cell
+        of ``target``, and that cell; (inf, None) when none is reachable."""
+        r, c = cell
         _, length, _ = dijkstra(self.reach, np.ones((1, 1), np.float32), np.array([r]), np.array([c]), target, 1, np.inf)
-        return float(length[target].min() * self.frame.res)
+        masked = np.where(target, length, np.inf)
+        k = int(np.argmin(masked))
+        if not np.isfinite(masked.flat[k]):
+            return float("inf"), None
+        return float(masked.flat[k] * self.frame.res), (k // masked.shape[1], k % masked.shape[1])
 
 
 def build_world(sc: Scenario, base: Path, file: str) -> World:
