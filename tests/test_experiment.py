@@ -22,7 +22,6 @@ def test_every_planner_finds_the_goal_on_the_demo(demo_loaded, name):
         assert res.outcome == "found"
         assert res.distance_m >= L.shortest[goal] - 0.5  # never better than the ground-truth optimum
         assert res.decisions >= 1
-        assert res.path.shape == (res.steps + 1, 2)
 
 
 def test_same_seed_same_run(demo_loaded):
