@@ -13,6 +13,7 @@ import yaml
 
 import cv2
 
+from semsearch_cli.world.files import write_doors
 from semsearch_cli.world.generate import generate_building
 from semsearch_cli.world.hospital import hospital_image, hospital_scenario, hospital_signs
 from semsearch_cli.world.office import office_image, office_scenario
@@ -58,10 +59,7 @@ def main() -> None:
     folder = root / "maps" / "hospital"
     folder.mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(folder / "map.png"), hospital_image())
-    with (folder / "doors.csv").open("w") as fh:
-        fh.write("number,x,y,facing\n")
-        for n, x, y, f in hospital_signs():
-            fh.write(f"{n},{x},{y},{f}\n")
+    write_doors(folder / "doors.csv", hospital_signs())
     header = ("# hospital: chained searches (thesis ch. 6): twenty numbered rooms off two crossing corridors,\n"
               "# objects with timelines in rooms 12 and 15, chains of 3-5 stages (door signs, then objects in\n"
               "# the room behind a door). Regenerate with scripts/make_configs.py.\n")

@@ -90,15 +90,8 @@ class ChainTask(Task):
             raise ScenarioError(self.file, field, "a chain with object stages gives record (timelines or a log) and truth")
         if ch.truth not in ot.spec.timelines:
             raise ScenarioError(self.file, f"{field}.truth", f"unknown timeline {ch.truth!r}")
-        rec = [ch.record] if isinstance(ch.record, str) else list(ch.record)
-        log_file = rec[0] if len(rec) == 1 and rec[0].lower().endswith(".csv") else None
-        if log_file is None:
-            for n in rec:
-                if n not in ot.spec.timelines:
-                    raise ScenarioError(self.file, f"{field}.record", f"unknown timeline {n!r}")
-        elif not (ot.base / log_file).is_file():
-            raise ScenarioError(self.file, f"{field}.record", f"detection log {ot.base / log_file} not found")
-        self.logs[ch.name] = ot.log(Case(ch.name, tuple(rec), log_file, ch.truth, ()))
+        rec, log_file = ot.record_source(ch.record, f"{field}.record")
+        self.logs[ch.name] = ot.log(Case(ch.name, rec, log_file, ch.truth, ()))
         for j, s in enumerate(stages):
             if s.cls is not None and not self.room_places(s.door):
                 raise ScenarioError(self.file, f"{field}.stages[{j}]", f"no place has room: {s.door}; give the places "

@@ -276,14 +276,32 @@ class ObjectTask(Task):
                 "requests (ground truth: shortest m)": {r.label: f"{','.join(r.truth) or 'absent'}: {self.shortest[r.label]:.2f}"
                                                         for r in self.requests}}
 
-    def patrol_route(self) -> np.ndarray:
-        """(n, 2) m: the poses of one patrol (start, the route's places, back to the start), not looking."""
+    def patrol(self, instances, hour: float, day: int, rng: np.random.Generator, look: bool = True):
+        """One patrol (start, the route's places, back to the start) among ``instances``:
+        (the final robot state, the :class:`Patrol` with its log rows). With ``look`` the robot
+        looks around at each place."""
         st = RobotState(*self.world.start_xy, self.world.start_heading or 0.0)
         st.trail = [(st.x, st.y)]
-        targets = iter([(*self.places[n], {"look": False}) for n in self.route] + [(*self.world.start_xy, {"look": False})])
-        search = Patrol(self, targets, [], 0.0, 0, np.random.default_rng(0))
+        targets = iter([(*self.places[n], {"look": look}) for n in self.route] + [(*self.world.start_xy, {"look": False})])
+        search = Patrol(self, targets, instances, hour, day, rng)
         run_loop(search, st, self.sc.robot.step, np.inf, 10**9)
-        return np.asarray(st.trail)
+        return st, search
+
+    def patrol_route(self) -> np.ndarray:
+        """(n, 2) m: the poses of one patrol, not looking."""
+        return np.asarray(self.patrol([], 0.0, 0, np.random.default_rng(0), look=False)[0].trail)
+
+    def record_source(self, record, field: str) -> tuple[tuple, str | None]:
+        """A ``record`` entry (timeline names, or a detection-log CSV path), checked:
+        (timeline names or (csv path,), csv path or None)."""
+        if isinstance(record, str):
+            if not (self.base / record).is_file():
+                raise ScenarioError(self.file, field, f"detection log {self.base / record} not found")
+            return (record,), record
+        for n in record:
+            if n not in self.spec.timelines:
+                raise ScenarioError(self.file, field, f"unknown timeline {n!r}; timelines are {', '.join(self.spec.timelines)}")
+        return tuple(record), None
 
     def _check_place(self, name, field):
         if name not in self.places:
@@ -298,16 +316,7 @@ class ObjectTask(Task):
         out = []
         for k, c in enumerate(raw):
             c = c if isinstance(c, dict) else c.model_dump(by_alias=True)
-            rec = c["record"]
-            log_file = None
-            if isinstance(rec, str):
-                log_file, rec = rec, [rec]
-                if not (self.base / log_file).is_file():
-                    raise ScenarioError(file, f"objects.cases[{k}].record", f"detection log {self.base / log_file} not found")
-            else:
-                for n in rec:
-                    if n not in spec.timelines:
-                        raise ScenarioError(file, f"objects.cases[{k}].record", f"unknown timeline {n!r}; timelines are {', '.join(spec.timelines)}")
+            rec, log_file = self.record_source(c["record"], f"objects.cases[{k}].record")
             truth = c.get("truth")
             if truth is not None and truth not in spec.timelines:
                 raise ScenarioError(file, f"objects.cases[{k}].truth", f"unknown timeline {truth!r}")
@@ -324,7 +333,7 @@ class ObjectTask(Task):
                 else:
                     raise ScenarioError(file, f"objects.cases[{k}]", "give truth (a timeline) or requests with at: the ground truth")
                 reqs.append(Request(c["name"], r["class"], float(r["hour"]), at))
-            out.append(Case(c["name"], tuple(rec), log_file, truth, tuple(reqs)))
+            out.append(Case(c["name"], rec, log_file, truth, tuple(reqs)))
         return out
 
     def _fixed(self) -> list[tuple[str, str]]:
@@ -433,12 +442,6 @@ def record(task: ObjectTask, timeline: str, hours, day: int = 0, base_seed: int 
     of the patrol. Seeded by (base_seed, timeline, hour), so the log is the same on every call."""
     rows = []
     for hour in hours:
-        inst = task.instances(timeline, hour)
         rng = np.random.default_rng([base_seed, zlib.crc32(timeline.encode()), int(round(hour * 60))])
-        st = RobotState(*task.world.start_xy, task.world.start_heading or 0.0)
-        st.trail = [(st.x, st.y)]
-        targets = iter([(*task.places[n], {"look": True}) for n in task.route] + [(*task.world.start_xy, {"look": False})])
-        search = Patrol(task, targets, inst, hour, day, rng)
-        run_loop(search, st, task.sc.robot.step, np.inf, 10**9)
-        rows += search.rows
+        rows += task.patrol(task.instances(timeline, hour), hour, day, rng)[1].rows
     return pd.DataFrame(rows, columns=LOG_COLUMNS)

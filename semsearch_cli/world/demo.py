@@ -13,6 +13,8 @@ import cv2
 import numpy as np
 import yaml
 
+from .files import write_doors
+
 RES = 0.1
 SIZE = (30.0, 20.0)  # m
 # corridors as (x0, y0, x1, y1) rectangles, metres
@@ -61,10 +63,7 @@ def write_demo(out: Path, goals=(304, 452), planners=None, seeds: int = 3) -> Pa
     """Write map.png, doors.csv and scenario.yaml for the demo building into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(out / "map.png"), demo_image())
-    with (out / "doors.csv").open("w") as fh:
-        fh.write("number,x,y,facing\n")
-        for n, x, y, f in demo_signs():
-            fh.write(f"{n},{x},{y},{f}\n")
+    write_doors(out / "doors.csv", demo_signs())
     scen = {
         "name": "demo",
         "map": {"image": "map.png", "resolution": RES},

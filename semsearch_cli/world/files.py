@@ -41,15 +41,29 @@ def scenario_dict(name: str, res: float, start, goals, planners=None, density_de
     }
 
 
+def fill_box(img: np.ndarray, res: float, x0: float, x1: float, y0: float, y1: float, value: int) -> None:
+    """Paint the world rectangle [x0, x1] x [y0, y1] (m, origin at the image's bottom-left) of a
+    map image (in place) with ``value``."""
+    H = img.shape[0]
+    c0, c1 = int(round(x0 / res)), int(round(x1 / res))
+    r0, r1 = H - int(round(y1 / res)), H - int(round(y0 / res))
+    img[max(0, r0) : r1, max(0, c0) : c1] = value
+
+
+def write_doors(path: Path, signs) -> None:
+    """A doors CSV (number,x,y,facing) from (label, x m, y m, facing degrees) tuples."""
+    with path.open("w") as fh:
+        fh.write("number,x,y,facing\n")
+        for label, x, y, f in signs:
+            fh.write(f"{label},{x},{y},{f}\n")
+
+
 def write_building(out: Path, img: np.ndarray, signs, scen: dict, header: str) -> Path:
     """Write ``out/map.png``, ``out/doors.csv`` (signs: (label, x, y, facing_deg)) and
     ``out/scenario.yaml`` (prefixed by the comment ``header``); returns the YAML path."""
     out.mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(out / "map.png"), img)
-    with (out / "doors.csv").open("w") as fh:
-        fh.write("number,x,y,facing\n")
-        for label, x, y, f in signs:
-            fh.write(f"{label},{x},{y},{f}\n")
+    write_doors(out / "doors.csv", signs)
     path = out / "scenario.yaml"
     path.write_text(f"# {header}\n" + yaml.safe_dump(scen, sort_keys=False))
     return path

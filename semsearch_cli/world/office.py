@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .files import fill_box
+
 WIDTH_M, HEIGHT_M = 20.5, 14.5
 WALL_M = 0.15
 CORRIDOR = (6.0, 8.0)  # y range, m
@@ -42,9 +44,7 @@ def office_image(res: float = 0.05) -> np.ndarray:
     img = np.zeros((H, W), np.uint8)
 
     def box(x0, x1, y0, y1, v):
-        c0, c1 = int(round(x0 / res)), int(round(x1 / res))
-        r0, r1 = H - int(round(y1 / res)), H - int(round(y0 / res))
-        img[max(0, r0) : r1, max(0, c0) : c1] = v
+        fill_box(img, res, x0, x1, y0, y1, v)
 
     box(WALL_M, WIDTH_M - WALL_M, WALL_M, HEIGHT_M - WALL_M, 255)
     lo, hi = CORRIDOR
