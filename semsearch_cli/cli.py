@@ -113,7 +113,7 @@ def _print_table(title: str, df) -> None:
     t = Table(title=escape(title))
     for col in df.columns:
         t.add_column(escape(str(col)), justify="left" if df[col].dtype == object else "right")
-    for _, r in df.iterrows():
+    for r in df.itertuples(index=False):  # not iterrows: it upcasts a row of ints and floats to floats
         t.add_row(*[escape(str(v)) for v in r])
     out.print(t)
 

@@ -1,8 +1,13 @@
 """Every registered task and planner through one test; planners from the user's own files and
 from entry points; chains (thesis ch. 6); one report over folders of several kinds."""
 
+import html as html_lib
+import json
+import os
 import pickle
+import re
 import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -18,6 +23,7 @@ from semsearch_cli.tasks import TASKS
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"
+CHROMIUM = next((p for p in map(shutil.which, ("chromium", "chromium-browser", "google-chrome")) if p), None)
 
 
 def write_scenario(tmp_path: Path, data: dict, name: str = "scenario.yaml") -> Path:
@@ -79,13 +85,15 @@ def test_every_task_and_planner(kind, planner, tmp_path):
 
 
 def test_decisions_count_new_targets_only(demo_loaded):
-    """bvp keeps its target between re-plans (info kept); a kept target is not a decision, so a
-    run's decisions equal the decisions in its trace, for every door planner."""
+    """A decision is a new target, for every door planner: bvp marks a kept target (info kept),
+    greedy and nsos choose the same cell again at periodic re-plans; neither counts."""
     for name in ("greedy", "bvp", "nsos"):
         v = planner_base.Variant(name, ())
         res = demo_loaded.task.run(v, 452, 2, trace=True)
         assert res.decisions == len(res.trace) > 0
         assert not any(d.get("kept") for d in res.trace)
+        targets = [tuple(d["target"]) for d in res.trace]
+        assert all(a != b for a, b in zip(targets, targets[1:])), name
 
 
 # ---- planners from the user's own files -------------------------------------------------
@@ -122,6 +130,19 @@ def test_the_example_planner_runs_from_its_own_file_with_two_workers(tmp_path):
     runs = pd.read_csv(tmp_path / "out" / "runs.csv")
     assert set(runs["planner"]) == {"greedy", "straight_on[turn_weight=0.0]", "straight_on[turn_weight=2.0]"}
     assert len(runs) == 12 and (runs["outcome"] == "found").all()
+
+
+def test_a_planner_from_the_users_file_runs_in_spawned_workers(tmp_path):
+    """A spawned worker starts a fresh interpreter that has never seen the user's file: it must
+    load it again from the pickled scenario, and give the rows of the serial run."""
+    p = user_scenario(tmp_path, "spawned", body="pass")
+    loaded = Loaded.load(p)
+    specs = expand(loaded)
+    a = run_batch(loaded, specs, tmp_path / "serial", workers=1)
+    b = run_batch(loaded, specs, tmp_path / "spawn", workers=2, start_method="spawn")
+    assert set(b["planner"]) == {"greedy", "spawned"} and (b["outcome"] != "error").all(), b["message"].tolist()
+    key, cols = ["planner", "goal", "seed"], [c for c in a.columns if c != "wall_s"]
+    pd.testing.assert_frame_equal(a.sort_values(key)[cols].reset_index(drop=True), b.sort_values(key)[cols].reset_index(drop=True))
 
 
 @pytest.mark.parametrize("text,needle", [
@@ -219,13 +240,57 @@ def test_bad_chains_name_the_field(tmp_path, edit, field, needle):
     assert res.exit_code == 2 and field in res.output and needle in res.output.replace("\n", " "), res.output
 
 
-def test_one_report_over_folders_of_several_kinds(hospital_runs, demo_dir, tmp_path):
+@pytest.fixture(scope="module")
+def mixed_report(hospital_runs, demo_dir, tmp_path_factory):
+    """One report over a chain folder and a door-search folder."""
     out, _ = hospital_runs
-    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "1", "--goal", "304", "--out", str(tmp_path / "d")])
+    tmp = tmp_path_factory.mktemp("mixed")
+    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "1", "--goal", "304", "--out", str(tmp / "d")])
     assert res.exit_code == 0, res.output
-    res = CliRunner().invoke(app, ["report", str(out), str(tmp_path / "d"), "--out", str(tmp_path / "both"), "--no-replay"])
+    res = CliRunner().invoke(app, ["report", str(out), str(tmp / "d"), "--out", str(tmp / "both"), "--no-replay"])
     assert res.exit_code == 0, res.output
-    md = (tmp_path / "both" / "report.md").read_text()
+    return tmp / "both"
+
+
+def test_one_report_over_folders_of_several_kinds(mixed_report):
+    md = (mixed_report / "report.md").read_text()
     assert "## Chained searches" in md and "## Door search (2 runs)" in md
-    html = (tmp_path / "both" / "report.html").read_text()
+    html = (mixed_report / "report.html").read_text()
     assert "**" not in html and "<span class=best>" in html  # marks rendered, not raw Markdown
+
+
+# Appended to a copy of the report (never to the report itself): once the page has loaded, write
+# what a reader would see wrong into an attribute that --dump-dom prints.
+PROBE = """<script>addEventListener("load", () => {
+  const marks = /[*][*]|(^|\\s)_[^_\\s]+_(\\s|$)|^\\s*#+ /;
+  const walk = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+  const raw = [];
+  for (let n = walk.nextNode(); n; n = walk.nextNode())
+    if (!n.parentElement.closest("pre, code, script") && marks.test(n.data)) raw.push(n.data.slice(0, 80));
+  document.body.dataset.probe = JSON.stringify({
+    overflow: document.documentElement.scrollWidth - window.innerWidth,
+    raw_marks: raw,
+    images: document.images.length,
+    broken_images: [...document.images].filter(i => !(i.complete && i.naturalWidth > 0)).length,
+    tables: document.querySelectorAll("table").length,
+    headings: [...document.querySelectorAll("h2")].map(h => h.innerText)});
+});</script>"""
+
+
+@pytest.mark.skipif(CHROMIUM is None and not os.environ.get("CI"),
+                    reason="no chromium on PATH (.ci/run installs it from Debian's packages, and there it must run)")
+def test_the_html_report_reads_well_in_a_browser(mixed_report, tmp_path):
+    """Headless Chromium, a 900 px wide window: no raw Markdown marks in the text a reader sees, no
+    line wider than the page, every figure decoded, every kind's section present."""
+    page = tmp_path / "probe.html"
+    page.write_text((mixed_report / "report.html").read_text().replace("</body>", PROBE + "</body>"))
+    res = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--window-size=900,1200",
+                          "--virtual-time-budget=10000", "--dump-dom", page.as_uri()],
+                         capture_output=True, text=True, timeout=120)
+    found = re.search(r'data-probe="([^"]*)"', res.stdout)
+    assert found, res.stderr[-2000:]
+    probe = json.loads(html_lib.unescape(found.group(1)))
+    assert probe["overflow"] <= 0 and probe["raw_marks"] == [], probe
+    assert probe["images"] > 0 and probe["broken_images"] == 0 and probe["tables"] > 0, probe
+    assert any(h.startswith("Chained searches") for h in probe["headings"]), probe
+    assert any(h.startswith("Door search") for h in probe["headings"]), probe

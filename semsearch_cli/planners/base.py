@@ -8,9 +8,9 @@ simulator changes. The class may live in this package, in a file of the user's n
 scenario (``{name: mine, module: my_planner.py}``), or in an installed package that declares it
 under the entry-point group ``semsearch.planners``.
 
-A :class:`Decision` is a new target. A planner that keeps its previous target returns it with
-``info["kept"] = True``: that is not a decision, and ``decisions`` in the rows counts only new
-targets, for every planner alike.
+``decisions`` in the rows counts new targets, for every planner alike: a re-plan that returns
+the cell the robot is already heading for is not a decision, whether the planner chose it again
+or marked it ``info["kept"] = True``.
 """
 
 from __future__ import annotations

@@ -6,11 +6,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
+from ..runner import file_stem
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import plot_chain_stages, plot_scenario
+from .plots import plot_chain_paths, plot_chain_stages, plot_scenario
 
 
 def chain_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -92,6 +94,40 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
         f = out / "figures" / "chain_stages.png"
         plot_chain_stages(stages, T.planner_order(stages["planner"]), f)
         doc.figure(f, "Each stage's mean distance with the map kept (solid) and from scratch (hatched), per planner")
+        _path_figures(doc, parts, out / "figures", notes)
+
+
+def _path_figures(doc: Document, parts: list, fdir: Path, notes: list) -> None:
+    """Per chain, the whole path of each planner's median run (by total distance), with the stage
+    doors numbered in order."""
+    for part in parts:
+        loaded = part.loaded(notes, "Chain path figures")
+        if loaded is None:
+            continue
+        w, chains = loaded.world, part.runs[part.runs["stage"] == ""]
+        order = T.planner_order(chains["planner"])
+        med = T.median_run(chains)
+        for goal in dict.fromkeys(chains["goal"]):
+            paths = {}
+            for r in med[med["goal"] == goal].itertuples(index=False):
+                p = part.folder / "paths" / f"{file_stem(r.planner, goal, int(r.seed))}.npz"
+                if p.is_file():
+                    paths[r.planner] = (np.load(p)["path"], float(r.distance_m))
+            stages = loaded.task.stages.get(str(goal), [])
+            if not paths or not stages:
+                continue
+            at: dict = {}  # door -> the stages there ("1, 4: 7" when a chain comes back)
+            for k, s in enumerate(stages, 1):
+                at.setdefault(s.door, []).append((k, s.label))
+            stops = []
+            for door, ks in at.items():
+                i = w.signs.index_of(door)
+                label = ", ".join(str(k) for k, _ in ks) + ": " + " / ".join(dict.fromkeys(lab for _, lab in ks))
+                stops.append((label, float(w.signs.x[i]), float(w.signs.y[i])))
+            f = fdir / f"chain_paths_{loaded.sc.name}_{goal}.png"
+            plot_chain_paths(w, {k: paths[k] for k in order if k in paths}, stops,
+                             f"{loaded.sc.name}: chain {goal}, median runs", f)
+            doc.figure(f, f"Chain {goal} ({loaded.sc.name}): the median run of each planner, stages numbered in order")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:

@@ -135,6 +135,21 @@ def plot_paths_overlay(world, paths: dict, goal, title: str, out: Path) -> None:
     _finish_map(fig, ax, title, out)
 
 
+def plot_chain_paths(world, paths: dict, stops: list, title: str, out: Path) -> None:
+    """The median run of each planner over one whole chain, with the stage doors numbered in the
+    order the chain visits them (``stops``: (label, x, y))."""
+    fig, ax = _map_figure(world)
+    ax.scatter(world.signs.x, world.signs.y, s=5, c="#9999cc")
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, (lab, (path, dist)) in enumerate(paths.items()):
+        ax.plot(path[:, 0], path[:, 1], "-", lw=1.3, c=colors[k % len(colors)], label=f"{lab}: {dist:.1f} m", alpha=0.85)
+    ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start")
+    for lab, x, y in stops:
+        ax.plot(x, y, "*", c="tab:red", ms=13)
+        ax.annotate(lab, (x, y), xytext=(5, 5), textcoords="offset points", fontsize=9, weight="bold", color="tab:red")
+    _finish_map(fig, ax, title, out)
+
+
 def animate_run(world, frames: list, title: str, out: Path, fps: int = 5) -> None:
     """A GIF replay: per frame the map the robot has built (free white, occupied black, unknown
     gray), its path so far, the candidates and the chosen one."""

@@ -14,14 +14,16 @@ from .store import RowWriter, read_runs, run_rows
 
 
 def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
-              progress: Callable[[dict], None] | None = None, trace: bool = False) -> pd.DataFrame:
+              progress: Callable[[dict], None] | None = None, trace: bool = False,
+              start_method: str | None = None) -> pd.DataFrame:
     """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
-    With ``trace``, each run it runs also writes its decision trace to ``out/traces/``."""
+    With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
+    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`)."""
     runs_csv = out / "runs.csv"
     done = run_rows(read_runs(runs_csv))
     have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
     todo = [s for s in specs if s.key not in have]
-    executor = make_executor(workers) if len(todo) > 1 else SerialExecutor()
+    executor = make_executor(workers, start_method) if len(todo) > 1 else SerialExecutor()
     writer = RowWriter(runs_csv)
     try:
         for rows in executor.rows(loaded, todo, out, trace):

@@ -5,6 +5,7 @@ worker processes that each receive the loaded scenario once."""
 from __future__ import annotations
 
 import math
+import multiprocessing
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -60,13 +61,18 @@ def _worker_run(spec: RunSpec, out: str, trace: bool) -> list[dict]:
 
 
 class ProcessExecutor:
-    """A pool of ``workers`` processes; the loaded scenario is sent to each once."""
+    """A pool of ``workers`` processes; the loaded scenario is sent to each once. ``start_method``
+    (``fork``, ``spawn``, ``forkserver``; default: Python's for the platform) is how they start: a
+    spawned worker unpickles the scenario in a fresh interpreter, and a planner from the user's
+    own file is loaded there again by its path when its variant is built."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, start_method: str | None = None):
         self.workers = workers
+        self.context = multiprocessing.get_context(start_method)
 
     def rows(self, loaded: Loaded, specs: list[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
-        with ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init, initargs=(loaded,)) as pool:
+        with ProcessPoolExecutor(max_workers=self.workers, mp_context=self.context, initializer=_worker_init,
+                                 initargs=(loaded,)) as pool:
             futs = [pool.submit(_worker_run, spec, str(out), trace) for spec in specs]
             try:
                 for f in as_completed(futs):
@@ -77,6 +83,6 @@ class ProcessExecutor:
                 raise
 
 
-def make_executor(workers: int):
+def make_executor(workers: int, start_method: str | None = None):
     """The process pool for more than one worker, else the serial executor."""
-    return ProcessExecutor(workers) if workers > 1 else SerialExecutor()
+    return ProcessExecutor(workers, start_method) if workers > 1 else SerialExecutor()

@@ -73,6 +73,7 @@ class DoorSearch(DoorSensing):
         self.replan_every = task.sc.navigation.replan_every
         self.looked_around = False
         self.decisions = 0
+        self.target: tuple[int, int] | None = None  # the cell the robot is heading for
         self.trace: list = []
         self.start_distance = 0.0
 
@@ -102,7 +103,9 @@ class DoorSearch(DoorSensing):
             dec = self.planner.choose(ctx, cands)
             if dec is None:
                 break
-            kept = dec.info.get("kept", False)
+            # a decision is a new target: the one the robot heads for already, chosen again at a
+            # re-plan or kept by the planner (info["kept"]), is not one, for every planner alike
+            kept = dec.info.get("kept", False) or (dec.row, dec.col) == self.target
             self.decisions += not kept
             if self.recorder is not None and not kept:
                 self.recorder(b, st.trail, st.distance - self.start_distance, cands, dec)
@@ -115,6 +118,7 @@ class DoorSearch(DoorSensing):
             p = self.navigator.plan(b, r, c, dec.row, dec.col)
             if p is not None and len(p[0]) >= 2:
                 self.looked_around = False
+                self.target = (dec.row, dec.col)
                 return fr.to_world(p[0], p[1])
             keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
             if keep.all():
