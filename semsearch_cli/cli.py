@@ -14,10 +14,13 @@ from rich.table import Table
 
 from . import __version__, api
 from .belief.presence import presence_scores, read_counts
+from .config.indirect import IndirectSpec
 from .errors import ScenarioError
 from .report.build import console_tables
 from .world.generate import generate_batch as gen_batch
 from .world.generate import generate_building as gen_building
+from .world.rooms import generate_rooms as gen_rooms
+from .world.rooms import write_rooms
 from .world.kth import import_kth as imp_kth
 from .world.mobilesim import import_mobilesim as imp_mobilesim
 
@@ -214,7 +217,7 @@ def show(
     out.print(f"wrote {path}")
 
 
-generate_app = typer.Typer(no_args_is_help=True, help="Generate numbered buildings of your own.")
+generate_app = typer.Typer(no_args_is_help=True, help="Generate numbered buildings, and rooms for indirect search, of your own.")
 app.add_typer(generate_app, name="generate")
 
 
@@ -250,6 +253,29 @@ def generate_batch(
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {len(paths)} scenarios under {out_dir} (listed in {out_dir / 'index.txt'})")
+
+
+@generate_app.command("rooms")
+def generate_rooms(
+    n: int = typer.Option(20, "--n", min=1, max=10000, help="How many rooms."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Seed (room k is the same whatever --n)."),
+    out_dir: Path = typer.Option(..., "--out", help="Folder for rooms.yaml."),
+    size: str = typer.Option("6,6", "--size", help="W,D: the room's width and depth in metres."),
+    obstacles: int = typer.Option(0, "--obstacles", min=0, max=20, help="Boxes per room (the paper's rooms have none)."),
+):
+    """Rooms for indirect search as the paper's (Loncomilla et al. 2018, Section 4.5): the monitor
+    uniform, each secondary object in a ring drawn from its co-occurrences (Table 2)."""
+    try:
+        w, d = (float(v) for v in size.split(","))
+    except ValueError:
+        _fail(ScenarioError("--size", "", f"expected W,D in metres (got {size!r})"))
+    spec = IndirectSpec()
+    try:
+        rooms = gen_rooms(n, seed, spec.relations, spec.masks, spec.target, (w, d), obstacles)
+    except ValueError as exc:
+        _fail(ScenarioError("--obstacles", "", str(exc)))
+    path = write_rooms(out_dir / "rooms.yaml", rooms)
+    out.print(f"wrote {len(rooms)} rooms of {w:g} x {d:g} m to {path}")
 
 
 @import_app.command("mobilesim")

@@ -1,0 +1,232 @@
+"""Indirect search (Loncomilla et al. 2018): masks, the Bayes update with the outside cell, the
+semantic camera and the room generator, against values worked out by hand."""
+
+import math
+
+import numpy as np
+import pytest
+
+from semsearch_cli.belief.indirect import (IndirectBelief, basic_masks, basic_profiles, mixed_mask, offsets,
+                                           relation_mask)
+from semsearch_cli.config.indirect import TABLE2, MasksSpec, SemanticCameraSpec
+from semsearch_cli.sensors.semantic import SemanticCamera
+from semsearch_cli.world.rooms import Room, Thing, generate_rooms, read_rooms, ring, write_rooms
+
+PAPER = MasksSpec()
+
+
+# ---- masks ------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kind", ["hard", "soft"])
+def test_each_basic_mask_sums_to_one(kind):
+    for q, m in basic_masks(kind, PAPER, 0.06, 100, 100).items():
+        assert m.sum() == pytest.approx(1.0, abs=1e-12), q
+        assert (m >= 0).all()
+
+
+def test_the_soft_near_mask_is_a_triangle_peaking_at_0_8_m():
+    d = np.round(np.arange(0.0, 2.0, 0.01), 2)
+    n = basic_profiles("soft", PAPER, d)["N"]
+    assert d[n.argmax()] == 0.8 and n.max() == 1.0
+    assert n[d == 0.6][0] == pytest.approx(0.5) and n[d == 1.0][0] == pytest.approx(0.5)
+    assert (n[(d <= 0.4) | (d >= 1.2)] < 1e-12).all()
+
+
+def test_hard_masks_are_rings_at_u1_u2_u3():
+    d = np.array([0.0, 0.59, 0.6, 0.99, 1.0, 1.49, 1.5, 3.0])
+    p = basic_profiles("hard", PAPER, d)
+    assert p["VN"].tolist() == [1, 1, 0, 0, 0, 0, 0, 0]
+    assert p["N"].tolist() == [0, 0, 1, 1, 0, 0, 0, 0]
+    assert p["F"].tolist() == [0, 0, 0, 0, 1, 1, 0, 0]
+    assert p["VF"].tolist() == [0, 0, 0, 0, 0, 0, 1, 1]
+
+
+def test_a_mixed_mask_weights_the_basic_masks_by_co_occurrences():
+    m = mixed_mask("soft", PAPER, TABLE2["keyboard"], 0.06, 100, 100)
+    assert m.sum() == pytest.approx(1.0)
+    d = offsets(0.06, 100, 100)
+    assert m[d < 0.4].mean() > 50 * m[d > 1.8].mean()  # a keyboard is very near the monitor
+
+
+# ---- the Bayes update with the outside cell ---------------------------------------------------
+def three_by_three(co=(1.0, 0.0, 0.0, 0.0)):
+    """A 3 x 3 map of 1 m cells; thresholds 1.2, 2.0, 2.5 m: the hard VN mask holds the zero
+    offset and the four at 1 m (1/5 each), N the four diagonals at 1.41 m (1/4 each)."""
+    spec = MasksSpec(u1=1.2, u2=2.0, u3=2.5, gap=0.2)
+    masks = {"keyboard": relation_mask("hard", spec, co, 1.0, 3, 3)}
+    return IndirectBelief((3, 3), masks, np.ones((3, 3)), p_outside=0.1)
+
+
+def test_a_not_seen_by_hand():
+    """Prior 0.1 in each cell and outside. A not seen with detection 0.5 in the centre:
+    unnormalised 0.05 there, 0.1 elsewhere and outside, z = 0.95."""
+    b = three_by_three()
+    D = np.zeros((3, 3))
+    D[1, 1] = 0.5
+    b.not_seen_main(D)
+    p, p0 = b.probability()
+    assert p[1, 1] == pytest.approx(0.05 / 0.95)
+    assert p[0, 0] == pytest.approx(0.1 / 0.95) and p0 == pytest.approx(0.1 / 0.95)
+    assert p.sum() + p0 == pytest.approx(1.0)
+
+
+def test_b_seen_by_hand():
+    """A keyboard (all very near) seen in the centre. The mask's mass on the map, S, is 1 from the
+    centre, 4/5 from an edge cell, 3/5 from a corner; the cross-likelihood R(ij - c) / S(ij) is
+    1/5 in the centre, (1/5) / (4/5) = 1/4 on its four neighbours, 0 on the corners; the outside
+    cell gets 1/9 (Eq. 13). Unnormalised: 0.02, 0.025 x 4, 0.1 / 9 outside."""
+    b = three_by_three()
+    np.testing.assert_allclose(b.masks["keyboard"].S, [[0.6, 0.8, 0.6], [0.8, 1.0, 0.8], [0.6, 0.8, 0.6]], atol=1e-12)
+    b.seen_secondary("keyboard", 1, 1)
+    p, p0 = b.probability()
+    z = 0.02 + 4 * 0.025 + 0.1 / 9
+    np.testing.assert_allclose(p, np.array([[0, 0.025, 0], [0.025, 0.02, 0.025], [0, 0.025, 0]]) / z, atol=1e-12)
+    assert p0 == pytest.approx(0.1 / 9 / z)
+
+
+def test_b_not_seen_by_hand():
+    """Keyboard not seen, detection 1 in the top-left corner only: the likelihood at a_ij is
+    1 - R(ij - corner) / S(ij): 1 - (1/5) / (3/5) = 2/3 on the corner, 1 - (1/5) / (4/5) = 3/4 on
+    its two neighbours, 1 elsewhere; outside, the mean of 1 - D, 8/9."""
+    b = three_by_three()
+    D = np.zeros((3, 3))
+    D[0, 0] = 1.0
+    b.not_seen_secondary("keyboard", D)
+    p, p0 = b.probability()
+    un = np.full((3, 3), 0.1)
+    un[0, 0] = 0.1 * 2 / 3
+    un[0, 1] = un[1, 0] = 0.1 * 3 / 4
+    z = un.sum() + 0.1 * 8 / 9
+    np.testing.assert_allclose(p, un / z, atol=1e-12)
+    assert p0 == pytest.approx(0.1 * 8 / 9 / z)
+
+
+@pytest.mark.parametrize("kind", ["hard", "soft"])
+def test_the_fft_split_matches_the_convolution_with_the_whole_mask(kind):
+    """The local part plus a constant, by FFT, equals sum_uv (1 - D(uv)) R(ij - uv) computed over
+    the whole mask, on a 24 x 30 map of 0.1 m cells."""
+    H, W, res = 24, 30, 0.1
+    rng = np.random.default_rng(3)
+    D = rng.random((H, W)) * (rng.random((H, W)) < 0.3)
+    co = TABLE2["system_unit"]
+    b = IndirectBelief((H, W), {"s": relation_mask(kind, PAPER, co, res, H, W)}, np.ones((H, W)), 0.0)
+    b.not_seen_secondary("s", D)
+    p, _ = b.probability()
+    full = mixed_mask(kind, PAPER, co, res, H, W)
+    i, j = np.meshgrid(np.arange(H), np.arange(W), indexing="ij")
+    like, S = np.zeros((H, W)), np.zeros((H, W))
+    for u in range(H):
+        for v in range(W):
+            like += (1 - D[u, v]) * full[H - 1 + i - u, W - 1 + j - v]
+            S += full[H - 1 + i - u, W - 1 + j - v]
+    like /= S
+    np.testing.assert_allclose(p, like / like.sum(), rtol=1e-9)
+
+
+def test_batched_frames_give_the_map_of_frame_by_frame_updates():
+    H, W, res = 20, 20, 0.1
+    rng = np.random.default_rng(5)
+    masks = {"k": relation_mask("soft", PAPER, TABLE2["keyboard"], res, H, W)}
+    frames = [(rng.random((H, W)) * 0.5, rng.random((H, W)) * 0.5) for _ in range(6)]
+    a = IndirectBelief((H, W), masks, np.ones((H, W)), 0.05)
+    b = IndirectBelief((H, W), masks, np.ones((H, W)), 0.05)
+    for DA, DB in frames:
+        a.not_seen_main(DA)
+        a.not_seen_secondary("k", DB)
+        a.flush()
+        b.not_seen_main(DA)
+        b.not_seen_secondary("k", DB)
+    b.seen_secondary("k", 4, 7)
+    a.seen_secondary("k", 4, 7)
+    pa, a0 = a.probability()
+    pb, b0 = b.probability()
+    np.testing.assert_allclose(pa, pb, rtol=1e-10)
+    assert a0 == pytest.approx(b0, rel=1e-10)
+
+
+# ---- the semantic camera ----------------------------------------------------------------------
+def one_object_room(x, y, cls="monitor", yaw=180.0, obstacles=()):
+    return Room("r", (6.0, 6.0), {cls: Thing(cls, x, y, 0.5, yaw)}, (1.0, 3.0, 0.0), list(obstacles))
+
+
+def test_the_camera_field_of_view_and_depth_limits():
+    cam = SemanticCamera(SemanticCameraSpec())
+    ranges = {"monitor": 2.0}
+
+    def seen(x, y, heading=0.0):
+        return [s.cls for s in cam.visible(one_object_room(x, y), 1.0, 3.0, heading, ranges)]
+
+    # straight ahead at 1.5 m horizontal: r = sqrt(1.5^2 + 0.5^2) = 1.58 m
+    assert seen(2.5, 3.0) == ["monitor"]
+    # 3D distance beyond the view scale: 1.9 m horizontal -> r = 1.96 (in), 2.0 -> 2.06 (out)
+    assert seen(2.9, 3.0) == ["monitor"] and seen(3.0, 3.0) == []
+    # horizontal half field 37.5 degrees, in the pitched camera's frame (Eq. 37): 1.2 m ahead and
+    # 0.5 m below, x_cam = 1.2 cos 30 + 0.5 sin 30 = 1.289 m, so the edge is 1.289 tan 37.5 = 0.989 m aside
+    assert seen(2.2, 3.0 + 0.95) == ["monitor"] and seen(2.2, 3.0 + 1.03) == []
+    # behind the robot
+    assert seen(0.0, 3.0) == [] and seen(0.0, 3.0, heading=math.pi) == ["monitor"]
+    # right below the camera: 0.2 m ahead is 68 degrees down, outside 30 +- 22.8
+    assert seen(1.2, 3.0) == []
+    # a box between the robot and the object hides it
+    room = one_object_room(2.5, 3.0, obstacles=[(1.6, 2.8, 1.8, 3.2)])
+    assert cam.visible(room, 1.0, 3.0, 0.0, ranges) == []
+
+
+def test_occlusion_hides_the_farther_of_two_overlapping_spheres():
+    cam = SemanticCamera(SemanticCameraSpec())
+    near, far = Thing("keyboard", 2.2, 3.0, 0.5, 180.0), Thing("monitor", 2.9, 3.05, 0.5, 180.0)
+    room = Room("r", (6.0, 6.0), {"monitor": far, "keyboard": near}, (1.0, 3.0, 0.0))
+    assert [s.cls for s in cam.visible(room, 1.0, 3.0, 0.0, {"monitor": 2.5})] == ["keyboard"]
+    apart = Room("r", (6.0, 6.0), {"monitor": Thing("monitor", 2.9, 3.9, 0.5, 180.0), "keyboard": near}, (1.0, 3.0, 0.0))
+    assert sorted(s.cls for s in cam.visible(apart, 1.0, 3.0, 0.0, {"monitor": 2.5})) == ["keyboard", "monitor"]
+
+
+def test_detection_probability_comes_from_the_table_by_yaw_and_distance():
+    cam = SemanticCamera(SemanticCameraSpec(detection={"monitor": [[80, 60, 40, 20, 10]] + [[0] * 5] * 7}))
+    assert cam.probability("monitor", 1.2, 0.0) == pytest.approx(0.6)
+    assert cam.probability("monitor", 1.4, 10.0) == pytest.approx(0.5)  # nearest yaw 0, halfway 1.2-1.6
+    assert cam.probability("monitor", 0.5, 0.0) == pytest.approx(0.8)  # clamped at 0.8 m
+    assert cam.probability("monitor", 1.2, 90.0) == 0.0
+    # the object faces the robot (yaw 180, robot to its west): seen from the front
+    s = cam.visible(one_object_room(2.2, 3.0), 1.0, 3.0, 0.0, {"monitor": 2.5})[0]
+    assert s.p == pytest.approx(float(np.interp(s.r, [0.8, 1.2, 1.6, 2.0, 2.5], [0.8, 0.6, 0.4, 0.2, 0.1])))
+
+
+def test_the_models_detection_image_matches_the_view_test():
+    """The robot's model sees a cell exactly when the ground-truth camera would see an object
+    standing there, with the table's mean over yaws; a box hides the cells behind it in both."""
+    cam = SemanticCamera(SemanticCameraSpec())
+    box = [(2.0, 2.6, 2.3, 2.9)]
+    room = one_object_room(3.0, 3.0, obstacles=box)
+    fr = room.frame(0.1)
+    cx, cy = fr.to_world(np.arange(fr.height)[:, None], np.arange(fr.width)[None, :])
+    cx, cy = np.broadcast_to(cx, (fr.height, fr.width)), np.broadcast_to(cy, (fr.height, fr.width))
+    D = cam.detect_image(fr, 1.0, 3.0, 0.3, "monitor", 1.8, cx, cy, room.blocked(fr))
+    truth = np.zeros_like(D, bool)
+    for r in range(fr.height):
+        for c in range(fr.width):
+            if room.blocked(fr)[r, c]:
+                continue
+            seen = cam.visible(one_object_room(cx[r, c], cy[r, c], obstacles=box), 1.0, 3.0, 0.3, {"monitor": 1.8})
+            truth[r, c] = bool(seen)
+    # the model's rays are half a degree apart: cells grazing a box's corner may differ
+    assert truth.sum() > 100 and (truth != (D > 0)).sum() <= 3
+    r = np.sqrt(np.hypot(cx - 1.0, cy - 3.0) ** 2 + 0.25)
+    np.testing.assert_allclose(D[D > 0], cam.mean_probability("monitor", r[D > 0]))
+
+
+# ---- rooms ------------------------------------------------------------------------------------
+def test_generated_rooms_follow_the_co_occurrences(tmp_path):
+    rooms = generate_rooms(300, 7, TABLE2, PAPER)
+    assert rooms[3].objects == generate_rooms(5, 7, TABLE2, PAPER)[3].objects  # room k does not depend on n
+    share = {}
+    for cls, co in TABLE2.items():
+        d = np.array([math.hypot(r.objects[cls].x - r.objects["monitor"].x, r.objects[cls].y - r.objects["monitor"].y)
+                      for r in rooms])
+        share[cls] = (d < PAPER.u1).mean()
+        assert abs(share[cls] - co[0]) < 0.07, (cls, share[cls])
+    for r in rooms:
+        for t in r.objects.values():
+            assert 0.25 <= t.x <= 5.75 and 0.25 <= t.y <= 5.75 and t.yaw % 45 == 0
+    back = read_rooms(write_rooms(tmp_path / "rooms.yaml", rooms[:4]), "monitor", list(TABLE2))
+    assert [r.objects["router"].x for r in back] == [round(r.objects["router"].x, 3) for r in rooms[:4]]
+    assert ring("VF", PAPER, 8.5) == (1.5, 8.5)
