@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 COLUMNS = ["kind", "scenario", "planner", "params", "goal", "seed", "stage", "map", "outcome", "success", "distance_m",
-           "shortest_m", "ratio", "spl", "steps", "decisions", "navigator", "wall_s", "message"]
+           "shortest_m", "ratio", "spl", "time_s", "steps", "decisions", "navigator", "wall_s", "message"]
 
 
 def spl(success: bool, shortest: float, distance: float) -> float:
@@ -17,7 +17,8 @@ def spl(success: bool, shortest: float, distance: float) -> float:
 def run_row(kind: str, scenario: str, variant, goal, seed: int, result, shortest: float, navigator: str) -> dict:
     """One row: the run's identity (kind, scenario, planner label and parameters, goal, seed), its
     outcome and distance beside the shortest path, SPL and counts. ``stage`` and ``map`` are
-    empty here; per-stage rows of chains fill them."""
+    empty here; per-stage rows of chains fill them. ``time_s`` is the simulated time of a task
+    with a clock (indirect search), empty for the others."""
     success = result.outcome == "found"
     d = result.distance_m
     return {
@@ -35,6 +36,7 @@ def run_row(kind: str, scenario: str, variant, goal, seed: int, result, shortest
         "shortest_m": round(shortest, 3),
         "ratio": round(d / shortest, 4) if shortest > 0 else float("nan"),
         "spl": round(spl(success, shortest, d), 4),
+        "time_s": round(result.time_s, 2) if result.time_s == result.time_s else "",
         "steps": result.steps,
         "decisions": result.decisions,
         "navigator": navigator,

@@ -51,6 +51,10 @@ def small_scenario(kind: str, planner: str, tmp_path: Path) -> Path:
         d["planners"] = [{"name": planner}]
         d["experiment"] = {"seeds": 1, "max_distance": 300}
         return write_scenario(tmp_path, d)
+    if kind == "indirect":
+        return write_scenario(tmp_path, {"name": "rooms", "indirect": {"rooms": {"count": 2, "seed": 1}, "view_scales": [1.5],
+                                                                       "time_limit": 60.0},
+                                         "planners": [{"name": planner}], "experiment": {"seeds": 2}})
     d = demo_data(planners=[{"name": planner}], experiment={"seeds": 1, "max_distance": 600})
     del d["goals"]
     d["chains"] = [{"name": "two", "stages": [{"door": 452}, {"door": 304}, {"door": 452}]}]

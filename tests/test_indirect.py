@@ -119,7 +119,7 @@ def test_the_fft_split_matches_the_convolution_with_the_whole_mask(kind):
             like += (1 - D[u, v]) * full[H - 1 + i - u, W - 1 + j - v]
             S += full[H - 1 + i - u, W - 1 + j - v]
     like /= S
-    np.testing.assert_allclose(p, like / like.sum(), rtol=1e-9)
+    np.testing.assert_allclose(p, like / like.sum(), rtol=1e-5)  # the convolution runs in single precision
 
 
 def test_batched_frames_give_the_map_of_frame_by_frame_updates():
@@ -200,7 +200,7 @@ def test_the_models_detection_image_matches_the_view_test():
     fr = room.frame(0.1)
     cx, cy = fr.to_world(np.arange(fr.height)[:, None], np.arange(fr.width)[None, :])
     cx, cy = np.broadcast_to(cx, (fr.height, fr.width)), np.broadcast_to(cy, (fr.height, fr.width))
-    D = cam.detect_image(fr, 1.0, 3.0, 0.3, "monitor", 1.8, cx, cy, room.blocked(fr))
+    D = cam.detect_image(fr, 1.0, 3.0, 0.3, "monitor", 1.8, room.blocked(fr))
     truth = np.zeros_like(D, bool)
     for r in range(fr.height):
         for c in range(fr.width):

@@ -27,7 +27,8 @@ map, so a convolution with it would cost a map-sized kernel: we write each mixed
 part (within u3 + delta) plus a constant, R = l + kappa, so that D * R = D * l + kappa sum(D), and
 only the local part is convolved.
 
-Observations are kept and folded in batches (:meth:`IndirectBelief.flush`): products commute, and
+The convolutions run in single precision (they are the cost of PN search); S and the map are
+double. Observations are kept and folded in batches (:meth:`IndirectBelief.flush`): products commute, and
 renormalising once per batch gives the same map as renormalising at every frame, up to rounding.
 The planners read the map only when they re-plan, which flushes; the batch turns a frame's three
 small FFTs into one stacked FFT per batch.
@@ -107,7 +108,7 @@ class RelationMask:
     full_centre: tuple[int, int]
     full: np.ndarray  # the whole mixed mask, for positive detections
     S: np.ndarray  # (H, W) the mask's mass on the map from each cell
-    fft: np.ndarray  # rfft2 of the local kernel, wrapped, at the padded size
+    fft: np.ndarray  # rfft2 of the local kernel, wrapped, at the padded size (single precision)
     shape: tuple[int, int]  # padded size
 
 
@@ -133,17 +134,17 @@ def relation_mask(kind: str, m: MasksSpec, co: tuple, res: float, H: int, W: int
     k = np.zeros(shape)
     ii, jj = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1), indexing="ij")
     k[ii % shape[0], jj % shape[1]] = local
-    fft = sfft.rfft2(k)
     ones = np.zeros(shape)
     ones[:H, :W] = 1.0
-    S = sfft.irfft2(sfft.rfft2(ones) * fft, s=shape)[:H, :W] + kappa * H * W
-    return RelationMask(local, float(kappa), (ci, cj), full, S, fft, shape)
+    S = sfft.irfft2(sfft.rfft2(ones) * sfft.rfft2(k), s=shape)[:H, :W] + kappa * H * W
+    return RelationMask(local, float(kappa), (ci, cj), full, S, sfft.rfft2(k.astype(np.float32)), shape)
 
 
 def convolve_local(images: np.ndarray, mask: RelationMask) -> np.ndarray:
-    """(k, H, W) images convolved with the mask's local part ('same' size), by one stacked FFT."""
+    """(k, H, W) images convolved with the mask's local part ('same' size), by one stacked FFT in
+    single precision (relative error about 1e-7; the map itself stays in double precision)."""
     k, H, W = images.shape
-    pad = np.zeros((k, *mask.shape))
+    pad = np.zeros((k, *mask.shape), np.float32)
     pad[:, :H, :W] = images
     return sfft.irfft2(sfft.rfft2(pad, axes=(-2, -1)) * mask.fft, s=mask.shape, axes=(-2, -1))[:, :H, :W]
 

@@ -118,7 +118,8 @@ class IndirectSpec(Strict):
                               "for 6 m)")
     time_limit: float = Field(300.0, gt=0.0, description="s of simulated time per search")
     replan_every: float = Field(6.0, gt=0.0, description="s between re-plans")
-    p_outside: float = Field(0.0, ge=0.0, lt=1.0, description="prior that A is outside the room (the outside cell)")
+    p_outside: float | None = Field(None, ge=0.0, lt=1.0, description="prior that A is outside the room (the outside "
+                                    "cell); default one cell's share: uniform over the room's cells and the outside cell")
     count_once: bool = Field(False, description="count a secondary object once per new detection, not at every "
                              "frame it is seen")
     camera: SemanticCameraSpec = SemanticCameraSpec()

@@ -3,7 +3,9 @@ errors that name the file and the field (SPEC 1). Checks that need the map (star
 reachable) belong to the world and the tasks.
 
 The kind of search is ``kind:`` when given, else the section present: ``objects`` (object search),
-``chains`` (chained searches), otherwise ``goals`` (door search).
+``chains`` (chained searches), ``indirect`` (indirect search in rooms), otherwise ``goals`` (door
+search). Indirect search brings its own rooms, so it takes no ``map`` or ``start``; the others
+need both.
 """
 
 from __future__ import annotations
@@ -19,25 +21,28 @@ from ..errors import ScenarioError
 from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
 from .chain import ChainSpec
+from .indirect import IndirectSpec
 from .objects import ObjectsSpec, DetectTable  # noqa: F401  (DetectTable names a union branch in errors)
 
-KINDS = ("doors", "objects", "chain")
+KINDS = ("doors", "objects", "chain", "indirect")
 # the section each kind needs: (field, what to write when it is missing)
 NEEDS = {"doors": ("goals", "door numbers under goals"), "objects": ("objects", "an objects section"),
-         "chain": ("chains", "a chains section")}
+         "chain": ("chains", "a chains section"), "indirect": ("indirect", "an indirect section")}
 # the sections a kind takes from others
-USES = {"doors": {"goals"}, "objects": {"objects"}, "chain": {"chains", "objects"}}
+USES = {"doors": {"goals"}, "objects": {"objects"}, "chain": {"chains", "objects"}, "indirect": {"indirect"}}
+ROOMS_OF_THEIR_OWN = {"indirect"}  # kinds that bring their own rooms instead of map and start
 
 
 class Scenario(Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
-    map: MapSpec
-    start: StartSpec
+    map: MapSpec | None = None
+    start: StartSpec | None = None
     doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
     goals: list[Union[int, str]] = Field(default_factory=list)
     objects: ObjectsSpec | None = None
     chains: list[ChainSpec] | None = Field(None, description="chained searches (thesis ch. 6)")
-    kind: Literal["doors", "objects", "chain"] | None = Field(None, description="default: from the sections given")
+    indirect: IndirectSpec | None = Field(None, description="indirect search with secondary objects (Loncomilla et al. 2018)")
+    kind: Literal["doors", "objects", "chain", "indirect"] | None = Field(None, description="default: from the sections given")
     planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
     experiment: ExperimentSpec = ExperimentSpec()
     robot: RobotSpec = RobotSpec()
@@ -58,8 +63,15 @@ class Scenario(Strict):
         kind = self.search_kind
         field, what = NEEDS[kind]
         if not getattr(self, field):
-            raise ValueError(f"give {what} (door search: goals; object search: objects; chains: chains)")
-        extra = [f for f in ("goals", "objects", "chains") if getattr(self, f) and f not in USES[kind]]
+            raise ValueError(f"give {what} (door search: goals; object search: objects; chains: chains; "
+                             "indirect search: indirect)")
+        extra = [f for f in ("goals", "objects", "chains", "indirect") if getattr(self, f) and f not in USES[kind]]
+        if kind in ROOMS_OF_THEIR_OWN:
+            extra += [f for f in ("map", "start") if getattr(self, f) is not None]
+        else:
+            missing = [f for f in ("map", "start") if getattr(self, f) is None]
+            if missing:
+                raise ValueError(f"a {kind} scenario needs {' and '.join(missing)}")
         if extra:
             raise ValueError(f"a {kind} scenario does not take {' or '.join(extra)}; remove it")
         return self
@@ -69,7 +81,11 @@ class Scenario(Strict):
         """doors, objects or chain: ``kind`` when given, else the section present."""
         if self.kind is not None:
             return self.kind
-        return "chain" if self.chains else "objects" if self.objects is not None else "doors"
+        if self.chains:
+            return "chain"
+        if self.indirect is not None:
+            return "indirect"
+        return "objects" if self.objects is not None else "doors"
 
 
 _TYPE_PART = re.compile(r"^(int|str|float|bool|none|constrained-\w+|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec|DetectTable)$")

@@ -3,13 +3,15 @@ registers them).
 
 The public API for planner authors: :class:`Planner`, :class:`Decision`, :class:`PlanContext`
 and :func:`register_planner` (door search), :class:`ObjectPlanner` and :class:`ObjectContext`
-(object search).
+(object search), :class:`IndirectPlanner`, :class:`IndirectContext` and :class:`Goal` (indirect
+search).
 """
 
 from .base import (PLANNERS, Decision, NoParams, PlanContext, Planner, Variant, expand_variants, load_entry_points,
                    load_planner_file, register_planner)
 from .doors import bvp, greedy, nsos  # noqa: F401  (registration side effect)
+from .indirect import Goal, IndirectContext, IndirectPlanner
 from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 
-__all__ = ["PLANNERS", "Decision", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "PlanContext", "Planner",
+__all__ = ["PLANNERS", "Decision", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "PlanContext", "Planner",
            "Variant", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "register_planner"]

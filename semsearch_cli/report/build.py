@@ -19,11 +19,11 @@ import pandas as pd
 from .. import __version__
 from ..errors import ScenarioError
 from ..runner import Loaded, read_runs
-from . import chain, doors, objects
+from . import chain, doors, indirect, objects
 from .document import Code, Document, atomic_text
 
 ALL_FORMATS = ("md", "csv", "png", "html")
-SECTIONS = {"doors": doors, "objects": objects, "chain": chain}  # kind -> its report section
+SECTIONS = {"doors": doors, "objects": objects, "chain": chain, "indirect": indirect}  # kind -> its report section
 
 
 def write_meta(out_dir: Path, scenario: Path) -> None:

@@ -310,3 +310,60 @@ def plot_chain_stages(stages, order: list, out: Path) -> None:
         ax.legend(fontsize=7)
     fig.tight_layout()
     _save(fig, out)
+
+
+# ---- indirect search (Loncomilla et al. 2018) ---------------------------------------------------
+def plot_success_by_scale(table, order: list, paper: dict, paper_scales, out: Path) -> None:
+    """Success rate against the view scale, one line per method: ours solid with Wilson 95%
+    intervals, the paper's Table 3 dotted in the same colour."""
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    for k, m in enumerate(order):
+        d = table[table["planner"] == m].sort_values("view_scale")
+        c = f"C{k % 10}"
+        ls = "-" if k < 10 else "-."
+        ax.errorbar(d["view_scale"], 100 * d["success"], yerr=[100 * (d["success"] - d["ci_low"]), 100 * (d["ci_high"] - d["success"])],
+                    fmt="o", ls=ls, c=c, ms=4, capsize=2, lw=1.4, label=m)
+        ref = paper.get(m.split("[", 1)[0])
+        if ref is not None:
+            ax.plot(paper_scales, ref, ":", c=c, lw=1.0)
+    ax.set_xlabel("view scale (m): how far the main object can be detected")
+    ax.set_ylabel("success rate (%)")
+    ax.set_ylim(0, 100)
+    ax.grid(alpha=0.3)
+    ax.plot([], [], ":", c="gray", label="paper (Table 3)")
+    ax.legend(fontsize=7, ncol=2, loc="lower right")
+    fig.tight_layout()
+    _save(fig, out)
+
+
+def plot_rooms(rooms: list, title: str, out: Path) -> None:
+    """Rooms of indirect search, small multiples: obstacles, the objects (A red), the start."""
+    n = len(rooms)
+    cols = min(5, n)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(2.4 * cols, 2.4 * rows + 0.4), squeeze=False)
+    colors = ["tab:red", "tab:orange", "tab:blue", "tab:purple", "tab:brown"]
+    for ax, room in zip(axes.ravel(), rooms):
+        w, h = room.size
+        ax.add_patch(plt.Rectangle((0, 0), w, h, fill=False, lw=1.5))
+        for x0, y0, x1, y1 in room.obstacles:
+            ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="0.4"))
+        for k, (cls, t) in enumerate(room.objects.items()):
+            ax.plot(t.x, t.y, "o", c=colors[k % len(colors)], ms=6, label=cls)
+            a = np.radians(t.yaw)
+            ax.plot([t.x, t.x + 0.35 * np.cos(a)], [t.y, t.y + 0.35 * np.sin(a)], "-", c=colors[k % len(colors)], lw=1)
+        x, y, hd = room.start
+        ax.plot(x, y, "s", c="tab:green", ms=6)
+        ax.arrow(x, y, 0.4 * np.cos(np.radians(hd)), 0.4 * np.sin(np.radians(hd)), color="tab:green", width=0.03)
+        ax.set_xlim(-0.1, w + 0.1)
+        ax.set_ylim(-0.1, h + 0.1)
+        ax.set_aspect("equal")
+        ax.set_title(room.name, fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    for ax in axes.ravel()[n:]:
+        ax.axis("off")
+    axes.ravel()[0].legend(fontsize=6, loc="upper left")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    _save(fig, out)

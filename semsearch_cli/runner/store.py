@@ -39,13 +39,16 @@ class RowWriter:
     def __init__(self, path: Path):
         path.parent.mkdir(parents=True, exist_ok=True)
         new = not path.is_file() or path.stat().st_size == 0
-        if not new:  # repair a file cut mid-line by an interruption
+        fields = COLUMNS
+        if not new:  # repair a file cut mid-line by an interruption; keep its columns
             with open(path, "rb+") as fh:
                 fh.seek(-1, os.SEEK_END)
                 if fh.read(1) != b"\n":
                     fh.write(b"\n")
+            with open(path, newline="") as fh:
+                fields = next(csv.reader(fh))
         self.fh = open(path, "a", newline="")
-        self.w = csv.DictWriter(self.fh, fieldnames=COLUMNS)
+        self.w = csv.DictWriter(self.fh, fieldnames=fields, extrasaction="ignore")
         if new:
             self.w.writeheader()
             self.fh.flush()

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..config.indirect import LUT_DISTANCES, LUT_YAWS, SemanticCameraSpec
 from ..geometry import GridFrame, wrap_angle
+from ..kernels.cone import cone_image, cone_mass
 from ..kernels.raycast import cast_rays
 
 
@@ -50,6 +51,8 @@ class SemanticCamera:
         self.spec = spec
         self.half_h = math.radians(spec.hfov) / 2
         self.half_v = math.radians(spec.vfov) / 2
+        self.tan_h, self.tan_v = math.tan(self.half_h), math.tan(self.half_v)
+        self.lut_d = np.asarray(LUT_DISTANCES, float)
         self.pitch = math.radians(spec.pitch)
         self.object_height = object_height
         self._lut: dict[str, np.ndarray] = {}
@@ -82,6 +85,21 @@ class SemanticCamera:
         """Eqs. 38-40 against the field of view and the depth limits."""
         return ((x_cam > 0) & (r >= self.spec.min_depth) & (r <= max_range)
                 & (np.abs(theta) <= self.half_h) & (np.abs(phi) <= self.half_v))
+
+    def sees(self, poses: np.ndarray, xs: np.ndarray, ys: np.ndarray, max_range: float) -> np.ndarray:
+        """(n, m) whether each of ``n`` poses (x, y, heading) has each of ``m`` points (at the
+        objects' height) in view, ignoring obstacles."""
+        poses = np.asarray(poses, float).reshape(-1, 3)
+        dx = np.asarray(xs, float)[None, :] - poses[:, :1]
+        dy = np.asarray(ys, float)[None, :] - poses[:, 1:2]
+        c, s = np.cos(poses[:, 2:3]), np.sin(poses[:, 2:3])
+        xr, yr = c * dx + s * dy, -s * dx + c * dy
+        dz = self.object_height - self.spec.height
+        cp, sp = math.cos(self.pitch), math.sin(self.pitch)
+        xc, zc = cp * xr - sp * dz, sp * xr + cp * dz
+        r = np.sqrt(xc * xc + yr * yr + zc * zc)
+        return ((xc > 0) & (np.abs(yr) <= self.tan_h * xc) & (np.abs(zc) <= self.tan_v * xc)
+                & (r >= self.spec.min_depth) & (r <= max_range))
 
     # ---- ground truth -----------------------------------------------------------------------
     def visible(self, room, x: float, y: float, heading: float, ranges: dict[str, float]) -> list[Seen]:
@@ -124,30 +142,78 @@ class SemanticCamera:
 
     # ---- the robot's model ------------------------------------------------------------------
     def detect_image(self, frame: GridFrame, x: float, y: float, heading: float, cls: str, max_range: float,
-                     cx: np.ndarray, cy: np.ndarray, occ: np.ndarray | None = None) -> np.ndarray:
+                     occ: np.ndarray | None = None, out: np.ndarray | None = None) -> np.ndarray:
         """(H, W) probability that an object of ``cls`` standing in each cell would be detected
-        from (x, y, heading); ``cx``, ``cy`` are the cells' centres (m), ``occ`` the obstacle map."""
-        dz = self.object_height - self.spec.height
-        dx, dy = cx - x, cy - y
-        xc, yc, zc = self.to_camera(dx, dy, dz, heading)
-        r = np.sqrt(xc * xc + yc * yc + zc * zc)
-        ok = self.in_view(r, np.arctan2(yc, xc), np.arctan2(zc, xc), xc, max_range)
-        if occ is not None and occ.any():
-            ok &= self.line_of_sight(frame, x, y, heading, occ, np.hypot(dx, dy), np.arctan2(dy, dx))
-        out = np.zeros(cx.shape)
-        out[ok] = self.mean_probability(cls, r[ok])
+        from (x, y, heading); ``occ`` is the obstacle map (True blocks the view). Written into
+        ``out`` (zeroed first) when given."""
+        if out is None:
+            out = np.zeros((frame.height, frame.width))
+        else:
+            out[:] = 0.0
+        table = self.table(cls).mean(axis=0)
+        r0, r1, c0, c1 = cone_image(out, frame.origin_x, frame.origin_y, frame.res, x, y, heading, self.pitch,
+                                    self.tan_h, self.tan_v, self.spec.min_depth, max_range,
+                                    self.object_height - self.spec.height, self.lut_d, table)
+        if occ is not None and r1 > r0 and c1 > c0 and occ[r0:r1, c0:c1].any():
+            cx, cy = frame.to_world(np.arange(r0, r1)[:, None], np.arange(c0, c1)[None, :])
+            dx, dy = cx - x, cy - y
+            win = out[r0:r1, c0:c1]
+            win[~self.line_of_sight(frame, x, y, heading, occ, np.hypot(dx, dy), np.arctan2(dy, dx))] = 0.0
         return out
 
     def line_of_sight(self, frame: GridFrame, x: float, y: float, heading: float, occ: np.ndarray,
                       dist: np.ndarray, bearing: np.ndarray) -> np.ndarray:
-        """Cells not hidden by obstacles: rays every half degree across the field of view; a cell
-        is seen when it is nearer than the ray of its bearing."""
-        n = int(math.ceil(math.degrees(2 * self.half_h) * 2)) + 1
-        thetas = heading + np.linspace(-self.half_h, self.half_h, n)
+        """Cells not hidden by obstacles: rays every half degree over a field wide enough for the
+        pitched camera (which sees wider than hfov near its feet); a cell is seen when it is nearer
+        than the ray of its bearing."""
+        half = min(math.pi, 2 * self.half_h)
+        n = int(math.ceil(math.degrees(2 * half) * 2)) + 1
+        thetas = heading + np.linspace(-half, half, n)
         v, u = frame.to_cell(x, y)
         free_m = cast_rays(occ, float(v), float(u), thetas, 1e6)[0] * frame.res
-        k = np.clip(np.round((wrap_angle(bearing - heading) + self.half_h) / (2 * self.half_h) * (n - 1)), 0, n - 1)
+        k = np.clip(np.round((wrap_angle(bearing - heading) + half) / (2 * half) * (n - 1)), 0, n - 1)
         return dist <= free_m[k.astype(np.int64)]
+
+    def templates(self, max_range: float, res: float, bins: int = 64) -> "ConeTemplates":
+        """The cells in view (Eq. 34's V) from a cell centre, for ``bins`` headings: offsets
+        (rows, cols) per heading, for summing a map over the view cones of many poses at once."""
+        reach = math.sqrt(max(max_range ** 2 - (self.object_height - self.spec.height) ** 2, 0.0))
+        R = int(math.ceil(reach / res)) + 1
+        fr = GridFrame(res, -(R + 0.5) * res, -(R + 0.5) * res, 2 * R + 1, 2 * R + 1)
+        img = np.zeros((2 * R + 1, 2 * R + 1))
+        offs = []
+        for b in range(bins):
+            img[:] = 0.0
+            cone_image(img, fr.origin_x, fr.origin_y, res, 0.0, 0.0, 2 * math.pi * b / bins, self.pitch, self.tan_h,
+                       self.tan_v, self.spec.min_depth, max_range, self.object_height - self.spec.height,
+                       np.array([0.0, 1.0]), np.array([1.0, 1.0]))
+            rr, cc = np.nonzero(img)
+            offs.append((rr - R, cc - R))
+        L = max(1, max(len(o[0]) for o in offs))
+        offs_r = np.zeros((bins, L), np.int64)
+        offs_c = np.zeros((bins, L), np.int64)
+        counts = np.zeros(bins, np.int64)
+        for b, (rr, cc) in enumerate(offs):
+            offs_r[b, :len(rr)], offs_c[b, :len(cc)], counts[b] = rr, cc, len(rr)
+        return ConeTemplates(R, offs_r, offs_c, counts, bins)
+
+
+@dataclass(frozen=True)
+class ConeTemplates:
+    """View-cone offsets per heading bin (see :meth:`SemanticCamera.templates`)."""
+
+    pad: int
+    offs_r: np.ndarray
+    offs_c: np.ndarray
+    counts: np.ndarray
+    bins: int
+
+    def mass(self, p: np.ndarray, rows, cols, headings) -> np.ndarray:
+        """Sum of ``p`` in the view cone of each pose (cells, heading in radians)."""
+        p_pad = np.pad(p, self.pad)
+        b = np.round(np.asarray(headings) / (2 * math.pi) * self.bins).astype(np.int64) % self.bins
+        return cone_mass(p_pad, self.pad, np.asarray(rows, np.int64), np.asarray(cols, np.int64), b,
+                         self.offs_r, self.offs_c, self.counts)
 
 
 def _segment_blocked(boxes, x0: float, y0: float, x1: float, y1: float) -> bool:

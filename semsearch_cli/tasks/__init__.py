@@ -2,7 +2,7 @@
 (:class:`~semsearch_cli.tasks.base.Task`), driven by one step loop (:mod:`.loop`).
 Importing this package registers every kind."""
 
-from . import chain, doors, objects  # noqa: F401  (registration side effect)
+from . import chain, doors, indirect, objects  # noqa: F401  (registration side effect)
 from .base import TASKS, Outcome, RobotState, RunResult, Task, build_task, register_task, run_seed
 
 __all__ = ["TASKS", "Outcome", "RobotState", "RunResult", "Task", "build_task", "register_task", "run_seed"]

@@ -79,6 +79,7 @@ class RunResult:
     trace: list = field(default_factory=list)  # one dict per decision
     stages: list = field(default_factory=list)  # extra rows of a run (chains: one per stage and mode)
     message: str = ""
+    time_s: float = float("nan")  # simulated seconds, for tasks with a clock
 
 
 TASKS: dict[str, type["Task"]] = {}

@@ -38,9 +38,12 @@ class Search(Protocol):
         episode when there is nowhere to go (``found`` when looking around saw the target)."""
 
 
-def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int) -> str:
+def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None) -> str:
     """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
-    :meth:`Search.plan` returns when there is nowhere to go."""
+    :meth:`Search.plan` returns when there is nowhere to go. ``move(st, px, py, i) -> (i, moved)``
+    replaces the default motion (``step`` metres along the path, the heading following it), e.g.
+    for a robot that turns at a finite rate; a step in which the pose does not change at all
+    counts towards ``stuck``."""
     px = py = None
     i = 0
     since_plan = 0.0
@@ -57,12 +60,16 @@ def run_loop(search: Search, st: RobotState, step: float, max_distance: float, m
             px, py = plan
             i = 1
             since_plan = 0.0
-        st.x, st.y, i, st.heading, moved = advance(px, py, i, st.x, st.y, st.heading, step)  # 5. move
+        h0 = st.heading
+        if move is None:  # 5. move
+            st.x, st.y, i, st.heading, moved = advance(px, py, i, st.x, st.y, st.heading, step)
+        else:
+            i, moved = move(st, px, py, i)
         st.distance += moved
         since_plan += moved
         st.steps += 1
         st.trail.append((st.x, st.y))
-        stall = stall + 1 if moved < 1e-9 else 0
+        stall = stall + 1 if moved < 1e-9 and st.heading == h0 else 0
         if stall >= STALL_STEPS:  # 6. budget
             return "stuck"
         if st.distance >= max_distance or st.steps >= max_steps:

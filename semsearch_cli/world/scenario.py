@@ -223,8 +223,11 @@ class World:
         return float(masked.flat[k] * self.frame.res), (k // masked.shape[1], k % masked.shape[1])
 
 
-def build_world(sc: Scenario, base: Path, file: str) -> World:
-    """Build and check the world of a scenario (paths relative to ``base``)."""
+def build_world(sc: Scenario, base: Path, file: str) -> World | None:
+    """Build and check the world of a scenario (paths relative to ``base``); None for a scenario
+    without a map (one that brings rooms of its own)."""
+    if sc.map is None:
+        return None
     img = load_map(base / sc.map.image, owner=file)
     free = img >= FREE_FROM
     H, W = free.shape

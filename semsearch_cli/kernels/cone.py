@@ -1,0 +1,73 @@
+"""The view cone of a pitched camera on a grid (numba): the robot's model of the semantic camera
+(see :mod:`semsearch_cli.sensors.semantic` for the geometry, Eqs. 37-40)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def cone_image(out, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_depth, max_range, dz, lut_d, lut_p):
+    """Write into ``out`` (H, W), for every cell whose centre (at height offset ``dz`` from the
+    camera) is in view from (x, y, heading), the detection probability interpolated in
+    (``lut_d``, ``lut_p``) at its distance; cells out of view are left as they are. In view:
+    x_cam > 0, |y_cam| <= tan_h x_cam, |z_cam| <= tan_v x_cam, min_depth <= r <= max_range.
+    ``ox, oy`` is the grid's bottom-left corner (m), row 0 at the top. Returns the bounding box
+    (r0, r1, c0, c1) of the cells visited (half-open)."""
+    H, W = out.shape
+    reach = math.sqrt(max(max_range * max_range - dz * dz, 0.0))
+    c0 = max(0, int(math.floor((x - reach - ox) / res)))
+    c1 = min(W, int(math.ceil((x + reach - ox) / res)) + 1)
+    r0 = max(0, int(math.floor(H - (y + reach - oy) / res)))
+    r1 = min(H, int(math.ceil(H - (y - reach - oy) / res)) + 1)
+    ch, sh = math.cos(heading), math.sin(heading)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    n = lut_d.shape[0]
+    for r in range(r0, r1):
+        cy = oy + (H - r - 0.5) * res - y
+        for c in range(c0, c1):
+            cx = ox + (c + 0.5) * res - x
+            xr = ch * cx + sh * cy
+            yr = -sh * cx + ch * cy
+            xc = cp * xr - sp * dz
+            if xc <= 0.0:
+                continue
+            zc = sp * xr + cp * dz
+            if abs(yr) > tan_h * xc or abs(zc) > tan_v * xc:
+                continue
+            d = math.sqrt(xc * xc + yr * yr + zc * zc)
+            if d < min_depth or d > max_range:
+                continue
+            if d <= lut_d[0]:
+                p = lut_p[0]
+            elif d >= lut_d[n - 1]:
+                p = lut_p[n - 1]
+            else:
+                k = 1
+                while lut_d[k] < d:
+                    k += 1
+                t = (d - lut_d[k - 1]) / (lut_d[k] - lut_d[k - 1])
+                p = lut_p[k - 1] + t * (lut_p[k] - lut_p[k - 1])
+            out[r, c] = p
+    return r0, r1, c0, c1
+
+
+@njit(cache=True)
+def cone_mass(p_pad, pad, rows, cols, bins, offs_r, offs_c, counts):
+    """Sum of ``p_pad`` over a view-cone template at each pose: pose k at cell (rows[k], cols[k])
+    with heading bin bins[k]; the template of bin b is the first counts[b] offsets of
+    offs_r[b], offs_c[b]; ``p_pad`` is the map padded by ``pad`` zero cells on each side."""
+    n = rows.shape[0]
+    out = np.zeros(n)
+    for k in range(n):
+        b = bins[k]
+        r = rows[k] + pad
+        c = cols[k] + pad
+        s = 0.0
+        for j in range(counts[b]):
+            s += p_pad[r + offs_r[b, j], c + offs_c[b, j]]
+        out[k] = s
+    return out

@@ -1,0 +1,120 @@
+"""The indirect-search section of a report (Loncomilla et al. 2018, Table 3): the success rate per
+method and view scale with Wilson 95% intervals beside the paper's, the time to find and SPL, and
+success against the view scale. Tables come from runs.csv alone."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.stats import binomtest
+
+from ..runner import run_rows
+from .document import Document, atomic_text, markdown_table, write_table
+from .plots import plot_rooms, plot_success_by_scale
+
+# The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each
+PAPER_SCALES = (1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
+PAPER_TABLE3 = {
+    "UIS": (28, 26, 38, 50, 58, 65, 65),
+    "ISUP": (31, 38, 46, 53, 67, 70, 70),
+    "AOSEOOR": (51, 63, 71, 76, 73, 78, 83),
+    "ISC-PN-HM": (49, 60, 63, 64, 77, 79, 85),
+    "ISC-OP-HM": (41, 42, 44, 44, 59, 65, 67),
+    "ISC-PN-SM": (53, 64, 68, 71, 77, 80, 88),
+    "ISC-OP-SM": (42, 42, 48, 55, 62, 67, 69),
+    "ISCG-PN-HM": (77, 75, 77, 87, 89, 90, 93),
+    "ISCG-OP-HM": (70, 70, 76, 84, 84, 87, 89),
+    "ISCG-PN-SM": (79, 74, 86, 87, 88, 94, 95),
+    "ISCG-OP-SM": (74, 76, 82, 82, 87, 88, 91),
+}
+ORDER = list(PAPER_TABLE3)
+
+
+def method_order(labels) -> list[str]:
+    """The paper's order, then any other planner."""
+    def key(lab):
+        name = lab.split("[", 1)[0]
+        return (ORDER.index(name) if name in ORDER else len(ORDER), lab)
+    return sorted(set(labels), key=key)
+
+
+def success_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Per scenario x method x view scale: n, found, success rate with its Wilson 95% interval,
+    mean time to find (s, over the searches that found A), mean distance, mean SPL."""
+    rows = []
+    for (scen, planner, scale), g in runs.groupby(["scenario", "planner", "goal"], sort=False):
+        n, k = len(g), int(g["success"].sum())
+        ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+        found = g[g["success"] == 1]
+        rows.append({"scenario": scen, "planner": planner, "view_scale": float(scale), "n": n, "found": k,
+                     "success": k / n, "ci_low": ci.low, "ci_high": ci.high,
+                     "time_to_find_s": found["time_s"].astype(float).mean() if k else np.nan,
+                     "distance_m": g["distance_m"].mean(), "spl": g["spl"].mean()})
+    out = pd.DataFrame(rows)
+    if out.empty:
+        return out
+    order = method_order(out["planner"])
+    out["_p"] = out["planner"].map(order.index)
+    return out.sort_values(["scenario", "_p", "view_scale"]).drop(columns="_p").round(4).reset_index(drop=True)
+
+
+def wide(table: pd.DataFrame) -> pd.DataFrame:
+    """Rows method, columns view scale; cells ``ours% [low-high] (paper%)``."""
+    return _pivot(table.assign(cell=[_cell(r) for r in table.itertuples(index=False)]))
+
+
+def _cell(r) -> str:
+    paper = PAPER_TABLE3.get(r.planner.split("[", 1)[0])
+    ref = ""
+    if paper is not None and r.view_scale in PAPER_SCALES:
+        ref = f" ({paper[PAPER_SCALES.index(r.view_scale)]})"
+    return f"{100 * r.success:.0f} [{100 * r.ci_low:.0f}-{100 * r.ci_high:.0f}]{ref}"
+
+
+def time_spl(table: pd.DataFrame) -> pd.DataFrame:
+    """Rows method, columns view scale; cells ``time to find (s) / SPL``."""
+    return _pivot(table.assign(cell=[f"{t:.0f} s / {s:.2f}" if t == t else f"- / {s:.2f}"
+                                     for t, s in zip(table["time_to_find_s"], table["spl"])]))
+
+
+def _pivot(t: pd.DataFrame) -> pd.DataFrame:
+    w = t.pivot_table(index="planner", columns="view_scale", values="cell", aggfunc="first", sort=False)
+    w = w.loc[[m for m in method_order(t["planner"]) if m in w.index]]
+    w.columns = [f"{c:g} m" for c in w.columns]
+    w.index.name = "method"
+    return w
+
+
+def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, notes: list) -> None:
+    runs = pd.concat([run_rows(p.runs) for p in parts], ignore_index=True)
+    table = success_table(runs)
+    tdir = out / "tables"
+    write_table(tdir, "indirect", table, formats)
+    tab3 = wide(table)
+    if formats & {"md", "html"}:
+        atomic_text(tdir / "indirect_table3.md", markdown_table(tab3))
+    doc.heading(2, f"Indirect search with secondary objects ({len(runs)} searches)")
+    doc.para("Success rate (%) per method and view scale (the farthest the main object can be detected), with its "
+             "Wilson 95% interval; in brackets the paper's Table 3 (Loncomilla et al. 2018; their rooms, simulator "
+             "and detection table, so compare shapes, not values).")
+    doc.table(tab3)
+    doc.heading(3, "Time to find (s, over the searches that found it) / SPL")
+    doc.table(time_spl(table))
+    if formats & {"png", "html", "md"}:
+        f = out / "figures" / "indirect_success.png"
+        plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f)
+        doc.figure(f, "Success rate against the view scale, one line per method (ours solid with Wilson 95% "
+                      "intervals; the paper's dotted)")
+
+
+def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
+    table = success_table(run_rows(runs))
+    return [("success rate (%) [Wilson 95%] (paper's Table 3)", wide(table).reset_index())]
+
+
+def show(loaded, out: Path) -> None:
+    t = loaded.task
+    plot_rooms([g.room for g in t.grids[:20]], f"{loaded.sc.name}: {len(t.grids)} rooms (first 20); A ({t.spec.target}) "
+               f"red, secondary objects coloured, start green", out)

@@ -1,0 +1,372 @@
+"""Indirect search with secondary objects (Loncomilla et al. 2018, SPEC 7): find the main object A
+in a room, helped by the secondary objects the semantic camera sees.
+
+Goals are view scales (m): how far A can be detected (the secondary objects always at
+``camera.secondary_range``). Run k of a goal searches room ``k mod n`` from the room's start, so
+the rooms are used equally often, as in the paper. One step of the loop is one camera frame
+(``camera.fps``): (1) the camera detects (Section 4.2-4.3), (2) the map of A takes the frame in
+(Section 3.1: A not seen; each secondary object seen or, for PN planners, not seen; a planner
+without masks folds in A's non-detections only), (3) A detected ends the search, (4) the planner
+re-plans every ``replan_every`` s, when its goal is reached, and (ISUP) on a frame that detects a
+secondary object, (5) the robot turns at ``turn_rate`` and drives at ``speed`` (turning on the spot
+until it faces its next waypoint), (6) the search ends at ``time_limit``.
+
+The shortest path of a run (for SPL): the geodesic, on the cells the robot can stand on, from the
+start to the nearest cell from which A is in view at the goal's scale for some heading.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from ..belief.indirect import IndirectBelief, relation_mask
+from ..config.indirect import CATEGORIES
+from ..errors import ScenarioError
+from ..geometry import GridFrame, wrap_angle
+from ..kernels.grid import GridSearch
+from ..kernels.raycast import line_of_sight
+from ..planners import Goal, IndirectContext, Variant
+from ..sensors.semantic import SemanticCamera
+from ..world.rooms import Room, generate_rooms, read_rooms
+from .base import Outcome, RobotState, RunResult, Task, register_task, run_seed
+from .loop import run_loop
+
+
+@dataclass
+class RoomGrid:
+    """A room on the probability map's grid: its frame, obstacle cells, the cells the robot's
+    centre may stand on, and a reusable path search."""
+
+    room: Room
+    frame: GridFrame
+    blocked: np.ndarray
+    stand: np.ndarray
+    cost: np.ndarray
+    search: GridSearch
+
+    @classmethod
+    def of(cls, room: Room, res: float, radius: float) -> "RoomGrid":
+        fr = room.frame(res)
+        blocked = room.blocked(fr)
+        walls = np.pad(blocked, 1, constant_values=True)
+        clear = ndimage.distance_transform_edt(~walls)[1:-1, 1:-1] * res
+        stand = clear >= radius
+        r, c = fr.to_index(*room.start[:2])
+        if not (0 <= r < fr.height and 0 <= c < fr.width):
+            raise ValueError(f"{room.name}: the start lies outside the room")
+        stand[r, c] = True  # the robot stands where it starts
+        return cls(room, fr, blocked, stand, np.ones(stand.shape, np.float32), GridSearch(stand.shape))
+
+    def lengths_from(self, x: float, y: float) -> np.ndarray:
+        """(H, W) path length (m) over the standing cells from (x, y); inf where unreachable."""
+        r, c = (int(v) for v in self.frame.to_index(x, y))
+        r, c = min(max(r, 0), self.frame.height - 1), min(max(c, 0), self.frame.width - 1)
+        self.search.run(self.stand, self.cost, r, c, np.zeros(0, np.int64), np.zeros(0, np.int64), 0)
+        done = self.search.closed == self.search.gen
+        return np.where(done, self.search.length_ * self.frame.res, np.inf)
+
+    def path(self, x: float, y: float, tx: float, ty: float):
+        """Waypoints (xs, ys) m from (x, y) to (tx, ty) over the standing cells, pulled taut by
+        line of sight (any-angle, as the paper's theta*); None when unreachable."""
+        fr = self.frame
+        r, c = (int(v) for v in fr.to_index(x, y))
+        tr, tc = (int(v) for v in fr.to_index(tx, ty))
+        H, W = self.stand.shape
+        if not (0 <= tr < H and 0 <= tc < W and self.stand[tr, tc]):
+            return None
+        r, c = min(max(r, 0), H - 1), min(max(c, 0), W - 1)
+        if self.search.run(self.stand, self.cost, r, c, np.array([tr]), np.array([tc]), 1) < 1:
+            return None
+        rows, cols = self.search.path(tr, tc)
+        occ = ~self.stand
+        keep = [0]
+        k = 0
+        while k < len(rows) - 1:
+            j = len(rows) - 1
+            while j > k + 1 and not line_of_sight(occ, rows[k] + 0.5, cols[k] + 0.5, rows[j] + 0.5, cols[j] + 0.5, 0.0):
+                j -= 1
+            keep.append(j)
+            k = j
+        xs, ys = fr.to_world(rows[keep], cols[keep])
+        xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+        xs[0], ys[0], xs[-1], ys[-1] = x, y, tx, ty
+        return xs, ys
+
+
+class IndirectSearch:
+    """One search (a :class:`~semsearch_cli.tasks.loop.Search`)."""
+
+    def __init__(self, task: "IndirectTask", grid: RoomGrid, planner, scale: float, rng, trace: bool):
+        self.task, self.grid, self.planner, self.scale, self.rng = task, grid, planner, scale, rng
+        spec = task.spec
+        self.dt = 1.0 / spec.camera.fps
+        self.replan_frames = max(1, int(round(spec.replan_every * spec.camera.fps)))
+        self.ranges = {spec.target: scale, **{c: spec.camera.secondary_range for c in spec.secondary}}
+        self.masks = task.masks_for(planner.masks) if planner.masks and planner.uses_map else {}
+        self.negative = planner.negative and bool(self.masks)
+        self.seen: dict[str, tuple[float, float]] = {}
+        self.latest: set[str] = set()
+        self.in_view_before: set[str] = set()
+        self.frames_since_plan = 0
+        self.since_plan: list = []
+        self.final_heading: float | None = None
+        self.goal: Goal | None = None
+        self.decisions = 0
+        self.keep_trace = trace
+        self.trace: list = []
+        self.D = np.zeros((grid.frame.height, grid.frame.width))
+        self.occ = grid.blocked if grid.blocked.any() else None
+
+    def new_belief(self) -> IndirectBelief:
+        g, spec = self.grid, self.task.spec
+        prior = (~g.blocked).astype(float)
+        p_out = spec.p_outside if spec.p_outside is not None else 1.0 / (prior.sum() + 1.0)
+        return IndirectBelief(g.blocked.shape, self.masks, prior, p_out)
+
+    # ---- the loop's steps -------------------------------------------------------------------
+    def sense(self, st: RobotState):
+        spec = self.task.spec
+        got = self.task.camera.frame(self.grid.room, st.x, st.y, st.heading, self.ranges, self.rng)
+        self.latest = got - {spec.target}
+        for cls in self.latest:
+            t = self.grid.room.objects[cls]
+            self.seen[cls] = (t.x, t.y)  # the camera gives the object's position
+        return spec.target in got, bool(self.latest)
+
+    def update(self, st: RobotState) -> None:
+        spec, b, fr, cam = self.task.spec, st.belief, self.grid.frame, self.task.camera
+        b.not_seen_main(cam.detect_image(fr, st.x, st.y, st.heading, spec.target, self.scale, self.occ, self.D))
+        for cls in self.masks:
+            if cls in self.latest:
+                if not (spec.count_once and cls in self.in_view_before):
+                    r, c = (int(v) for v in fr.to_index(*self.seen[cls]))
+                    b.seen_secondary(cls, r, c)
+            elif self.negative:
+                b.not_seen_secondary(cls, cam.detect_image(fr, st.x, st.y, st.heading, cls, self.ranges[cls], self.occ))
+        self.in_view_before = set(self.latest)
+        self.frames_since_plan += 1
+        self.since_plan.append((st.x, st.y, st.heading))
+
+    def sees(self, poses, xs, ys) -> np.ndarray:
+        return self.task.camera.sees(poses, xs, ys, self.scale)
+
+    def replan_due(self, path_done: bool, since_plan: float, event: bool) -> bool:
+        return path_done or self.frames_since_plan >= self.replan_frames or (event and self.planner.replan_on_detection)
+
+    def plan(self, st: RobotState):
+        g, spec = self.grid, self.task.spec
+        st.belief.flush()
+        lengths = None
+
+        def path_length(xs, ys):
+            nonlocal lengths
+            if lengths is None:
+                lengths = g.lengths_from(st.x, st.y)
+            r, c = g.frame.to_index(np.asarray(xs), np.asarray(ys))
+            H, W = lengths.shape
+            ok = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+            out = np.full(np.shape(r), np.inf)
+            out[ok] = lengths[r[ok], c[ok]]
+            return out
+
+        ctx = IndirectContext(st.belief, g.frame, g.stand, st.x, st.y, st.heading, st.steps * self.dt, self.scale,
+                              self.task.cones(self.scale), spec.robot.speed, math.radians(spec.robot.turn_rate),
+                              spec.replan_every, self.rng, dict(self.seen), set(self.latest),
+                              np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
+                              self.task.cooccurrence)
+        goal = self.planner.plan(ctx)
+        self.frames_since_plan = 0
+        self.since_plan = []
+        new = self.goal is None or (goal.x, goal.y, goal.heading) != (self.goal.x, self.goal.y, self.goal.heading)
+        self.decisions += new
+        self.goal = goal
+        if self.keep_trace and new:
+            self.trace.append({"step": st.steps, "t_s": round(st.steps * self.dt, 2), "x": round(st.x, 3), "y": round(st.y, 3),
+                               "heading_deg": round(math.degrees(st.heading), 1),
+                               "target": [round(goal.x, 3), round(goal.y, 3)], **goal.info})
+        if math.hypot(goal.x - st.x, goal.y - st.y) < 1e-9:
+            xs, ys = np.array([st.x, st.x]), np.array([st.y, st.y])
+        else:
+            p = g.path(st.x, st.y, goal.x, goal.y)
+            xs, ys = p if p is not None else (np.array([st.x, st.x]), np.array([st.y, st.y]))
+        self.final_heading = goal.heading
+        self._turned = False
+        return xs, ys
+
+    def move(self, st: RobotState, px, py, i: int):
+        """One frame of motion: turn toward the next waypoint at the turn rate, drive at the
+        speed once facing it; at the last waypoint, turn to the goal's heading. Returns (i, moved)."""
+        spec = self.task.spec
+        w, v = math.radians(spec.robot.turn_rate), spec.robot.speed
+        t_left, moved = self.dt, 0.0
+        n = len(px)
+        while t_left > 1e-12 and i < n:
+            dx, dy = px[i] - st.x, py[i] - st.y
+            d = math.hypot(dx, dy)
+            if d < 1e-9:
+                if i == n - 1 and self.final_heading is not None:
+                    err = float(wrap_angle(self.final_heading - st.heading))
+                    if abs(err) > 1e-9:
+                        rot = min(abs(err), w * t_left)
+                        st.heading = float(wrap_angle(st.heading + math.copysign(rot, err)))
+                        t_left -= rot / w
+                        continue
+                i += 1
+                continue
+            err = float(wrap_angle(math.atan2(dy, dx) - st.heading))
+            if abs(err) > 1e-6:
+                rot = min(abs(err), w * t_left)
+                st.heading = float(wrap_angle(st.heading + math.copysign(rot, err)))
+                t_left -= rot / w
+                continue
+            step = min(d, v * t_left)
+            st.x += dx / d * step
+            st.y += dy / d * step
+            moved += step
+            t_left -= step / v
+            if step >= d - 1e-12:
+                st.x, st.y = float(px[i]), float(py[i])
+        return i, moved
+
+
+@register_task
+class IndirectTask(Task):
+    """Indirect search: goals are view scales; seed k searches room k mod n."""
+
+    kind = "indirect"
+    planner_kind = "indirect"
+
+    def __init__(self, sc, world, path):
+        super().__init__(sc, world, path)
+        self.spec = sc.indirect
+        self.camera = SemanticCamera(self.spec.camera)
+        self.grids: list[RoomGrid] = []
+        self._masks: dict = {}
+        self._cones: dict = {}
+        self._shortest: dict = {}
+        self.relations: dict = {}
+        self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in self.spec.relations.items()}
+
+    @classmethod
+    def build(cls, sc, world, path):
+        task = cls(sc, world, path)
+        spec = task.spec
+        field = "indirect.rooms"
+        if isinstance(spec.rooms, str):
+            rooms = read_rooms(task.path.parent / spec.rooms, spec.target, spec.secondary)
+        else:
+            g = spec.rooms
+            try:
+                rooms = generate_rooms(g.count, g.seed, spec.relations, spec.masks, spec.target, g.size, g.obstacles)
+            except ValueError as exc:
+                raise ScenarioError(task.file, field, str(exc)) from None
+        for cls_name in [spec.target, *spec.secondary]:
+            try:
+                task.camera.table(cls_name)
+            except KeyError:
+                raise ScenarioError(task.file, "indirect.camera.detection", f"no detection table for {cls_name!r}; give "
+                                    "one (rows yaw 0..315, columns 0.8..2.5 m)") from None
+        try:
+            task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius) for r in rooms]
+        except ValueError as exc:
+            raise ScenarioError(task.file, field, str(exc)) from None
+        task.relations = {c: task.masks_for("soft")[c].full for c in spec.secondary}
+        for k, g in enumerate(task.grids):
+            for s in spec.view_scales:
+                if not np.isfinite(task.shortest_of(k, s)):
+                    raise ScenarioError(task.file, field, f"{g.room.name}: from the start no reachable pose sees "
+                                        f"{spec.target} at view scale {s:g} m")
+        task.variants()
+        return task
+
+    # ---- built once per process ---------------------------------------------------------
+    def masks_for(self, kind: str) -> dict:
+        """class -> RelationMask of ``kind`` (hard or soft), on the rooms' grid."""
+        if kind not in self._masks:
+            spec, g = self.spec, self.grids[0]
+            H, W = g.stand.shape
+            self._masks[kind] = {c: relation_mask(kind, spec.masks, co, spec.resolution, H, W)
+                                 for c, co in spec.relations.items()}
+        return self._masks[kind]
+
+    def cones(self, scale: float):
+        if scale not in self._cones:
+            self._cones[scale] = self.camera.templates(scale, self.spec.resolution)
+        return self._cones[scale]
+
+    def shortest_of(self, k: int, scale: float) -> float:
+        """Shortest path (m) of room ``k`` at ``scale``: to the nearest standing cell that sees A."""
+        key = (k, scale)
+        if key not in self._shortest:
+            g = self.grids[k]
+            t = g.room.objects[self.spec.target]
+            fr = g.frame
+            cx, cy = fr.to_world(np.arange(fr.height)[:, None], np.arange(fr.width)[None, :])
+            cx, cy = np.broadcast_to(cx, g.stand.shape), np.broadcast_to(cy, g.stand.shape)
+            h = np.hypot(cx - t.x, cy - t.y)
+            dz = t.height - self.spec.camera.height
+            r = np.hypot(h, dz)
+            cam = self.camera
+            # in view for the heading that faces A: the vertical angle and the depth decide
+            down = np.arctan2(-dz, h)  # angle below the horizon
+            ok = (r >= self.spec.camera.min_depth) & (r <= scale) & (np.abs(down - cam.pitch) <= cam.half_v) & g.stand
+            if self.occ_any(g):
+                occ = g.blocked
+                v0, u0 = fr.to_cell(t.x, t.y)
+                rr, cc = np.nonzero(ok)
+                for a, b in zip(rr, cc):
+                    if not line_of_sight(occ, float(v0), float(u0), a + 0.5, b + 0.5, 0.0):
+                        ok[a, b] = False
+            lengths = g.lengths_from(*g.room.start[:2])
+            self._shortest[key] = float(lengths[ok].min()) if ok.any() else float("inf")
+        return self._shortest[key]
+
+    @staticmethod
+    def occ_any(g: RoomGrid) -> bool:
+        return bool(g.blocked.any())
+
+    @property
+    def goals(self) -> list:
+        return list(self.spec.view_scales)
+
+    def goal_value(self, label):
+        for g in self.goals:
+            if str(g) == str(label) or (isinstance(label, (int, float)) and float(label) == g):
+                return g
+        return label
+
+    # ---- running ----------------------------------------------------------------------------
+    def run(self, variant: Variant, goal, seed: int, trace: bool = False, recorder=None) -> RunResult:
+        t0 = time.perf_counter()
+        scale = float(self.goal_value(goal))
+        k = seed % len(self.grids)
+        g = self.grids[k]
+        rng = np.random.default_rng(run_seed(self.sc.name, scale, seed, self.sc.experiment.base_seed))
+        x, y, h = g.room.start
+        st = RobotState(x, y, math.radians(h), trail=[(x, y)])
+        search = IndirectSearch(self, g, variant.build(), scale, rng, trace)
+        st.belief = search.new_belief()
+        spec = self.spec
+        max_steps = int(round(spec.time_limit * spec.camera.fps))
+        outcome = run_loop(search, st, 0.0, math.inf, max_steps, move=search.move)
+        res = RunResult(outcome, st.distance, st.steps, search.decisions, time.perf_counter() - t0,
+                        np.asarray(st.trail, np.float32), [], search.trace, message="" if outcome != "stuck" else
+                        "the robot could not move", time_s=st.steps * search.dt)
+        return res
+
+    def rows(self, variant, goal, seed, res):
+        scale = float(self.goal_value(goal))
+        self.shortest[scale] = self.shortest_of(seed % len(self.grids), scale)
+        return super().rows(variant, scale, seed, res)
+
+    def describe(self):
+        spec = self.spec
+        return {"name": self.sc.name, "kind": self.kind, "rooms": len(self.grids),
+                "grid": f"{self.grids[0].frame.height} x {self.grids[0].frame.width} cells at {spec.resolution} m",
+                "view scales (m)": spec.view_scales, "target": spec.target, "secondary": spec.secondary,
+                "planners": [v.label for v in self.variants()]}
