@@ -160,11 +160,21 @@ class IndirectBelief:
     prior : (H, W) p(a_ij) before any observation (zeros where A cannot be, e.g. obstacles);
         normalised with ``p_outside`` so that the map and the outside cell sum to 1
     p_outside : float, the outside cell's prior
+    coarse : the secondary objects' non-detections are taken on a grid ``coarse`` times coarser
+        (``coarse_masks`` are built at that grid): their detection images are given at the coarse
+        cells' centres, convolved there, and the likelihood is spread back over each block's
+        cells; 1 is exact. The relation masks are rings 0.4 m wide and more, so at 2 the
+        likelihood moves by little (tests/test_indirect.py bounds it) and the work is a quarter.
     """
 
-    def __init__(self, shape, masks: dict[str, RelationMask], prior: np.ndarray, p_outside: float):
+    def __init__(self, shape, masks: dict[str, RelationMask], prior: np.ndarray, p_outside: float,
+                 coarse: int = 1, coarse_masks: dict[str, RelationMask] | None = None):
         self.H, self.W = shape
         self.masks = masks
+        self.coarse = int(coarse)
+        self.neg_masks = masks if self.coarse == 1 else coarse_masks
+        if self.coarse > 1 and (self.H % self.coarse or self.W % self.coarse or coarse_masks is None):
+            raise ValueError("coarse needs masks at the coarse grid and a map whose sides it divides")
         prior = np.asarray(prior, float)
         self.p = prior / prior.sum() * (1.0 - p_outside)
         self.p0 = float(p_outside)
@@ -186,9 +196,14 @@ class IndirectBelief:
         self._factor *= m.full[ci - row:ci - row + self.H, cj - col:cj - col + self.W] / m.S
         self._factor0 *= 1.0 / self.n
 
+    @property
+    def negative_shape(self) -> tuple[int, int]:
+        """The grid of :meth:`not_seen_secondary`'s images: the map's, or ``coarse`` times coarser."""
+        return self.H // self.coarse, self.W // self.coarse
+
     def not_seen_secondary(self, cls: str, D: np.ndarray) -> None:
         """B not seen (Eqs. 8-9, 12-13): the convolution of ``1 - D`` with the mask (folded at
-        :meth:`flush`); outside, the mean of ``1 - D``."""
+        :meth:`flush`); outside, the mean of ``1 - D``. ``D`` is on :attr:`negative_shape`."""
         self._negatives[cls].append(D)
 
     def flush(self) -> None:
@@ -198,13 +213,16 @@ class IndirectBelief:
         for cls, Ds in self._negatives.items():
             if not Ds:
                 continue
-            m = self.masks[cls]
+            m = self.neg_masks[cls]
+            q = self.coarse
             stack = np.stack(Ds)
             conv = convolve_local(stack, m)
             sums = stack.sum(axis=(1, 2))
-            like = 1.0 - (conv + m.kappa * sums[:, None, None]) / m.S[None]
-            f = f * np.clip(like, 0.0, None).prod(axis=0)
-            f0 *= float(np.prod(1.0 - sums / self.n))
+            like = np.clip(1.0 - (conv + m.kappa * sums[:, None, None]) / m.S[None], 0.0, None).prod(axis=0)
+            if q > 1:
+                like = np.repeat(np.repeat(like, q, axis=0), q, axis=1)
+            f = f * like
+            f0 *= float(np.prod(1.0 - sums * (q * q) / self.n))
             Ds.clear()
         p = self.p * f
         p0 = self.p0 * f0

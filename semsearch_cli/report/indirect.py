@@ -12,7 +12,7 @@ from scipy.stats import binomtest
 
 from ..runner import run_rows
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import plot_rooms, plot_success_by_scale
+from .plots import animate_probability, plot_rooms, plot_success_by_scale
 
 # The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each
 PAPER_SCALES = (1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -107,6 +107,39 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
         plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f)
         doc.figure(f, "Success rate against the view scale, one line per method (ours solid with Wilson 95% "
                       "intervals; the paper's dotted)")
+        if replay:
+            for part in parts:
+                _replay(doc, part, run_rows(part.runs), out / "figures", notes)
+
+
+def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list) -> None:
+    """Re-simulate (runs are deterministic) the first search of ISCG-PN-SM (the paper's best; else
+    the last method) at the smallest view scale, recording the probability map at every re-plan, as a GIF."""
+    loaded = part.loaded(notes, "The replay")
+    if loaded is None or runs.empty:
+        return
+    order = method_order(runs["planner"])
+    label = "ISCG-PN-SM" if "ISCG-PN-SM" in order else order[-1]
+    scale = float(runs["goal"].astype(float).min())
+    sub = runs[(runs["planner"] == label) & (runs["goal"].astype(float) == scale)].sort_values("seed")
+    variant = next((v for v in loaded.task.variants() if v.label == label), None)
+    if variant is None or sub.empty:
+        return
+    seed = int(sub["seed"].iloc[0])
+    frames = []
+
+    def rec(p, p0, trail, t, goal, seen):
+        frames.append({"p": p.copy(), "p0": p0, "trail": trail, "t": t, "goal": (goal.x, goal.y), "seen": seen})
+
+    res = loaded.task.run(variant, scale, seed, recorder=rec)
+    if not frames:
+        return
+    grid = loaded.task.grids[seed % len(loaded.task.grids)]
+    f = fdir / f"replay_{loaded.sc.name}_{label}_{scale:g}m_seed{seed}.gif"
+    animate_probability(grid.room, loaded.task.spec.target, frames, f"{label}, view scale {scale:g} m, {grid.room.name}", f)
+    doc.figure(f, f"Replay of {label} at view scale {scale:g} m, seed {seed} ({res.outcome} after {res.time_s:.0f} s): "
+               "the robot's probability map of A at each re-plan, its path, the secondary objects seen (squares), the "
+               "goal (cross); A ringed in red")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:

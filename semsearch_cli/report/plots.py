@@ -363,7 +363,41 @@ def plot_rooms(rooms: list, title: str, out: Path) -> None:
         ax.set_yticks([])
     for ax in axes.ravel()[n:]:
         ax.axis("off")
-    axes.ravel()[0].legend(fontsize=6, loc="upper left")
+    handles, labels = axes.ravel()[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=len(labels), frameon=False)
     fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
     _save(fig, out)
+
+
+def animate_probability(room, target: str, frames: list, title: str, out: Path, fps: int = 4) -> None:
+    """A GIF of one indirect search: per re-plan, the probability map of A (the robot's belief,
+    each frame scaled to its own maximum), the path so far, the secondary objects seen, the goal;
+    A itself ringed."""
+    w, h = room.size
+    fig, ax = plt.subplots(figsize=(5.2, 5.6))
+    target = room.objects[target]
+
+    def draw(k):
+        ax.clear()
+        f = frames[k]
+        ax.imshow(f["p"], cmap="magma", vmin=0.0, vmax=float(f["p"].max()) or 1.0, extent=(0, w, 0, h),
+                  interpolation="nearest")
+        for x0, y0, x1, y1 in room.obstacles:
+            ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, color="0.6"))
+        ax.plot(f["trail"][:, 0], f["trail"][:, 1], "-", c="tab:cyan", lw=1)
+        ax.plot(*f["trail"][-1], "o", c="tab:green", ms=6)
+        for cls, (x, y) in f["seen"].items():
+            ax.plot(x, y, "s", c="tab:orange", ms=6)
+            ax.annotate(cls, (x, y), xytext=(3, 3), textcoords="offset points", fontsize=7, color="white")
+        ax.plot(target.x, target.y, "o", mfc="none", mec="tab:red", ms=12, mew=2)
+        ax.plot(*f["goal"], "x", c="white", ms=8, mew=2)
+        ax.set_title(f"{title}\nt = {f['t']:.0f} s, p(outside) = {f['p0']:.2f}", fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+
+    anim = FuncAnimation(fig, draw, frames=len(frames))
+    tmp = out.with_suffix(".tmp.gif")
+    anim.save(tmp, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    os.replace(tmp, out)

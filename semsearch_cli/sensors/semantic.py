@@ -69,9 +69,16 @@ class SemanticCamera:
         row = int(round((seen_yaw_deg % 360.0) / 45.0)) % len(LUT_YAWS)
         return float(np.interp(r, LUT_DISTANCES, self.table(cls)[row]))
 
+    def mean_table(self, cls: str) -> np.ndarray:
+        """The table's mean over the eight yaws, per distance column."""
+        key = cls + "/mean"
+        if key not in self._lut:
+            self._lut[key] = self.table(cls).mean(axis=0)
+        return self._lut[key]
+
     def mean_probability(self, cls: str, r: np.ndarray) -> np.ndarray:
         """The table's mean over the eight yaws, at distances ``r`` (m)."""
-        return np.interp(r, LUT_DISTANCES, self.table(cls).mean(axis=0))
+        return np.interp(r, LUT_DISTANCES, self.mean_table(cls))
 
     # ---- geometry ---------------------------------------------------------------------------
     def to_camera(self, dx, dy, dz, heading: float):
@@ -150,7 +157,7 @@ class SemanticCamera:
             out = np.zeros((frame.height, frame.width))
         else:
             out[:] = 0.0
-        table = self.table(cls).mean(axis=0)
+        table = self.mean_table(cls)
         r0, r1, c0, c1 = cone_image(out, frame.origin_x, frame.origin_y, frame.res, x, y, heading, self.pitch,
                                     self.tan_h, self.tan_v, self.spec.min_depth, max_range,
                                     self.object_height - self.spec.height, self.lut_d, table)

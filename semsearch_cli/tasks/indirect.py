@@ -101,13 +101,15 @@ class RoomGrid:
 class IndirectSearch:
     """One search (a :class:`~semsearch_cli.tasks.loop.Search`)."""
 
-    def __init__(self, task: "IndirectTask", grid: RoomGrid, planner, scale: float, rng, trace: bool):
+    def __init__(self, task: "IndirectTask", grid: RoomGrid, planner, scale: float, rng, trace: bool, recorder=None):
         self.task, self.grid, self.planner, self.scale, self.rng = task, grid, planner, scale, rng
+        self.recorder = recorder  # recorder(p, p0, trail, t_s, goal, seen) at every plan
         spec = task.spec
         self.dt = 1.0 / spec.camera.fps
         self.replan_frames = max(1, int(round(spec.replan_every * spec.camera.fps)))
         self.ranges = {spec.target: scale, **{c: spec.camera.secondary_range for c in spec.secondary}}
         self.masks = task.masks_for(planner.masks) if planner.masks and planner.uses_map else {}
+        self.coarse_masks = task.masks_for(planner.masks, task.spec.coarse) if self.masks else None
         self.negative = planner.negative and bool(self.masks)
         self.seen: dict[str, tuple[float, float]] = {}
         self.latest: set[str] = set()
@@ -121,12 +123,19 @@ class IndirectSearch:
         self.trace: list = []
         self.D = np.zeros((grid.frame.height, grid.frame.width))
         self.occ = grid.blocked if grid.blocked.any() else None
+        # the grid of the secondary objects' non-detections (coarser by spec.coarse)
+        q = spec.coarse if self.masks else 1
+        fr = grid.frame
+        self.neg_frame = GridFrame(fr.res * q, fr.origin_x, fr.origin_y, fr.height // q, fr.width // q)
+        blocked_q = grid.blocked.reshape(fr.height // q, q, fr.width // q, q).any(axis=(1, 3))
+        self.neg_occ = blocked_q if blocked_q.any() else None
 
     def new_belief(self) -> IndirectBelief:
         g, spec = self.grid, self.task.spec
         prior = (~g.blocked).astype(float)
         p_out = spec.p_outside if spec.p_outside is not None else 1.0 / (prior.sum() + 1.0)
-        return IndirectBelief(g.blocked.shape, self.masks, prior, p_out)
+        coarse = spec.coarse if self.masks else 1
+        return IndirectBelief(g.blocked.shape, self.masks, prior, p_out, coarse, self.coarse_masks)
 
     # ---- the loop's steps -------------------------------------------------------------------
     def sense(self, st: RobotState):
@@ -147,7 +156,8 @@ class IndirectSearch:
                     r, c = (int(v) for v in fr.to_index(*self.seen[cls]))
                     b.seen_secondary(cls, r, c)
             elif self.negative:
-                b.not_seen_secondary(cls, cam.detect_image(fr, st.x, st.y, st.heading, cls, self.ranges[cls], self.occ))
+                b.not_seen_secondary(cls, cam.detect_image(self.neg_frame, st.x, st.y, st.heading, cls, self.ranges[cls],
+                                                           self.neg_occ))
         self.in_view_before = set(self.latest)
         self.frames_since_plan += 1
         self.since_plan.append((st.x, st.y, st.heading))
@@ -180,6 +190,8 @@ class IndirectSearch:
                               np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
                               self.task.cooccurrence)
         goal = self.planner.plan(ctx)
+        if self.recorder is not None:
+            self.recorder(st.belief.p, st.belief.p0, np.asarray(st.trail), st.steps * self.dt, goal, dict(self.seen))
         self.frames_since_plan = 0
         self.since_plan = []
         new = self.goal is None or (goal.x, goal.y, goal.heading) != (self.goal.x, self.goal.y, self.goal.heading)
@@ -250,7 +262,8 @@ class IndirectTask(Task):
         self._cones: dict = {}
         self._shortest: dict = {}
         self.relations: dict = {}
-        self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in self.spec.relations.items()}
+        self.believed = self.spec.model_relations()
+        self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in self.believed.items()}
 
     @classmethod
     def build(cls, sc, world, path):
@@ -265,6 +278,9 @@ class IndirectTask(Task):
                 rooms = generate_rooms(g.count, g.seed, spec.relations, spec.masks, spec.target, g.size, g.obstacles)
             except ValueError as exc:
                 raise ScenarioError(task.file, field, str(exc)) from None
+        if spec.ablation == "no_secondary":
+            for r in rooms:
+                r.objects = {spec.target: r.objects[spec.target]}
         for cls_name in [spec.target, *spec.secondary]:
             try:
                 task.camera.table(cls_name)
@@ -275,6 +291,12 @@ class IndirectTask(Task):
             task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius) for r in rooms]
         except ValueError as exc:
             raise ScenarioError(task.file, field, str(exc)) from None
+        if len({g.stand.shape for g in task.grids}) > 1:
+            raise ScenarioError(task.file, field, "the rooms differ in size; give rooms of one size")
+        H, W = task.grids[0].stand.shape
+        if H % spec.coarse or W % spec.coarse:
+            raise ScenarioError(task.file, "indirect.coarse", f"the map ({H} x {W} cells) must divide by coarse = "
+                                f"{spec.coarse}; change the resolution or set coarse: 1")
         task.relations = {c: task.masks_for("soft")[c].full for c in spec.secondary}
         for k, g in enumerate(task.grids):
             for s in spec.view_scales:
@@ -285,14 +307,16 @@ class IndirectTask(Task):
         return task
 
     # ---- built once per process ---------------------------------------------------------
-    def masks_for(self, kind: str) -> dict:
-        """class -> RelationMask of ``kind`` (hard or soft), on the rooms' grid."""
-        if kind not in self._masks:
+    def masks_for(self, kind: str, coarse: int = 1) -> dict:
+        """class -> RelationMask of ``kind`` (hard or soft), on the rooms' grid (or one
+        ``coarse`` times coarser)."""
+        key = (kind, coarse)
+        if key not in self._masks:
             spec, g = self.spec, self.grids[0]
             H, W = g.stand.shape
-            self._masks[kind] = {c: relation_mask(kind, spec.masks, co, spec.resolution, H, W)
-                                 for c, co in spec.relations.items()}
-        return self._masks[kind]
+            self._masks[key] = {c: relation_mask(kind, spec.masks, co, spec.resolution * coarse, H // coarse, W // coarse)
+                                for c, co in self.believed.items()}
+        return self._masks[key]
 
     def cones(self, scale: float):
         if scale not in self._cones:
@@ -349,7 +373,7 @@ class IndirectTask(Task):
         rng = np.random.default_rng(run_seed(self.sc.name, scale, seed, self.sc.experiment.base_seed))
         x, y, h = g.room.start
         st = RobotState(x, y, math.radians(h), trail=[(x, y)])
-        search = IndirectSearch(self, g, variant.build(), scale, rng, trace)
+        search = IndirectSearch(self, g, variant.build(), scale, rng, trace, recorder)
         st.belief = search.new_belief()
         spec = self.spec
         max_steps = int(round(spec.time_limit * spec.camera.fps))
