@@ -47,7 +47,7 @@ def main() -> None:
     print("| method | searches | frames | ms per frame (median) | ratio to UIS | wall s (sum) |")
     print("|---|---|---|---|---|---|")
     for name, r in per.sort_values("ms_per_frame").iterrows():
-        print(f"| {name} | {r.searches} | {r.frames} | {r.ms_per_frame:.3f} | {r.ratio_to_UIS:.1f} | {r.wall_s:.0f} |")
+        print(f"| {name} | {r.searches:.0f} | {r.frames:.0f} | {r.ms_per_frame:.3f} | {r.ratio_to_UIS:.1f} | {r.wall_s:.0f} |")
 
 
 if __name__ == "__main__":

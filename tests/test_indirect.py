@@ -2,6 +2,7 @@
 semantic camera and the room generator, against values worked out by hand."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +19,7 @@ from semsearch_cli.sensors.semantic import SemanticCamera
 from semsearch_cli.world.rooms import Room, Thing, generate_rooms, read_rooms, ring, write_rooms
 
 PAPER = MasksSpec()
+ROOT = Path(__file__).resolve().parents[1]
 
 
 # ---- masks ------------------------------------------------------------------------------------
@@ -290,13 +292,20 @@ def scenario(tmp_path, **indirect):
 
 
 def test_informed_global_search_finds_the_monitor_more_often_than_uninformed(tmp_path):
-    """10 rooms, view scale 1 m, 2 minutes, the same 20 seeds: ISCG-PN-SM (the paper's best) finds
-    A more often than UIS (the baseline), as in Table 3."""
-    loaded = Loaded.load(scenario(tmp_path))
-    rows = run_batch(loaded, expand(loaded), tmp_path / "out")
+    """configs/indirect.yaml at view scale 1 m, its first 30 trials (rooms 0-19, then 0-9): ISCG-PN-SM
+    (the paper's best) finds A in 21, UIS (the baseline) in 15, as in the full experiment's first
+    30 seeds (200 trials: 70% against 48%)."""
+    d = yaml.safe_load((ROOT / "configs" / "indirect.yaml").read_text())
+    d["indirect"]["view_scales"] = [1.0]
+    d["planners"] = [{"name": "UIS"}, {"name": "ISCG-PN-SM"}]
+    d["experiment"]["seeds"] = 30
+    p = tmp_path / "indirect.yaml"
+    p.write_text(yaml.safe_dump(d))
+    loaded = Loaded.load(p)
+    rows = run_batch(loaded, expand(loaded), tmp_path / "out", workers=2)
     found = rows.groupby("planner")["success"].sum()
-    assert found["ISCG-PN-SM"] > found["UIS"], found.to_dict()
-    assert rows["time_s"].max() <= 120.0 + 1e-9 and (rows.loc[rows["success"] == 1, "time_s"] < 120.0).all()
+    assert found.to_dict() == {"ISCG-PN-SM": 21, "UIS": 15}
+    assert rows["time_s"].max() <= 300.0 + 1e-9 and (rows.loc[rows["success"] == 1, "time_s"] < 300.0).all()
 
 
 def test_a_bad_indirect_section_names_the_field(tmp_path):

@@ -105,8 +105,8 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     if formats & {"png", "html", "md"}:
         f = out / "figures" / "indirect_success.png"
         plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f)
-        doc.figure(f, "Success rate against the view scale, one line per method (ours solid with Wilson 95% "
-                      "intervals; the paper's dotted)")
+        doc.figure(f, "Success rate against the view scale, one line per method: ours with Wilson 95% intervals "
+                      "(left), the paper's Table 3 (right)")
         if replay:
             for part in parts:
                 _replay(doc, part, run_rows(part.runs), out / "figures", notes)

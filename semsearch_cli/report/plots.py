@@ -314,23 +314,23 @@ def plot_chain_stages(stages, order: list, out: Path) -> None:
 
 # ---- indirect search (Loncomilla et al. 2018) ---------------------------------------------------
 def plot_success_by_scale(table, order: list, paper: dict, paper_scales, out: Path) -> None:
-    """Success rate against the view scale, one line per method: ours solid with Wilson 95%
-    intervals, the paper's Table 3 dotted in the same colour."""
-    fig, ax = plt.subplots(figsize=(9, 5.5))
+    """Success rate against the view scale, one line per method: ours with Wilson 95% intervals
+    (left), the paper's Table 3 (right), in the same colours and axes."""
+    fig, (ax, axp) = plt.subplots(1, 2, figsize=(13, 5.5), sharey=True)
     for k, m in enumerate(order):
         d = table[table["planner"] == m].sort_values("view_scale")
-        c = f"C{k % 10}"
-        ls = "-" if k < 10 else "-."
+        c, ls = f"C{k % 10}", ("-" if k < 10 else "--")
         ax.errorbar(d["view_scale"], 100 * d["success"], yerr=[100 * (d["success"] - d["ci_low"]), 100 * (d["ci_high"] - d["success"])],
                     fmt="o", ls=ls, c=c, ms=4, capsize=2, lw=1.4, label=m)
         ref = paper.get(m.split("[", 1)[0])
         if ref is not None:
-            ax.plot(paper_scales, ref, ":", c=c, lw=1.0)
-    ax.set_xlabel("view scale (m): how far the main object can be detected")
+            axp.plot(paper_scales, ref, "o", ls=ls, c=c, ms=4, lw=1.4, label=m)
+    for a, title in ((ax, "ours (Wilson 95% intervals)"), (axp, "the paper's Table 3")):
+        a.set_xlabel("view scale (m): how far the main object can be detected")
+        a.set_ylim(0, 100)
+        a.grid(alpha=0.3)
+        a.set_title(title, fontsize=10)
     ax.set_ylabel("success rate (%)")
-    ax.set_ylim(0, 100)
-    ax.grid(alpha=0.3)
-    ax.plot([], [], ":", c="gray", label="paper (Table 3)")
     ax.legend(fontsize=7, ncol=2, loc="lower right")
     fig.tight_layout()
     _save(fig, out)

@@ -12,7 +12,8 @@ secondary object, (5) the robot turns at ``turn_rate`` and drives at ``speed`` (
 until it faces its next waypoint), (6) the search ends at ``time_limit``.
 
 The shortest path of a run (for SPL): the geodesic, on the cells the robot can stand on, from the
-start to the nearest cell from which A is in view at the goal's scale for some heading.
+start to the nearest cell from which A is in view at the goal's scale for some heading and the
+detection table gives a chance of detecting it (A is not seen from every side).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..belief.indirect import IndirectBelief, relation_mask
-from ..config.indirect import CATEGORIES
+from ..config.indirect import CATEGORIES, LUT_DISTANCES
 from ..errors import ScenarioError
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
@@ -298,11 +299,6 @@ class IndirectTask(Task):
             raise ScenarioError(task.file, "indirect.coarse", f"the map ({H} x {W} cells) must divide by coarse = "
                                 f"{spec.coarse}; change the resolution or set coarse: 1")
         task.relations = {c: task.masks_for("soft")[c].full for c in spec.secondary}
-        for k, g in enumerate(task.grids):
-            for s in spec.view_scales:
-                if not np.isfinite(task.shortest_of(k, s)):
-                    raise ScenarioError(task.file, field, f"{g.room.name}: from the start no reachable pose sees "
-                                        f"{spec.target} at view scale {s:g} m")
         task.variants()
         return task
 
@@ -336,10 +332,19 @@ class IndirectTask(Task):
             dz = t.height - self.spec.camera.height
             r = np.hypot(h, dz)
             cam = self.camera
-            # in view for the heading that faces A: the vertical angle and the depth decide
+            # in view for the heading that faces A: the vertical angle and the depth decide; and
+            # the table must give a chance of detection from that side of A
             down = np.arctan2(-dz, h)  # angle below the horizon
             ok = (r >= self.spec.camera.min_depth) & (r <= scale) & (np.abs(down - cam.pitch) <= cam.half_v) & g.stand
-            if self.occ_any(g):
+            seen_yaw = np.degrees(np.arctan2(cy - t.y, cx - t.x)) - t.yaw
+            row = np.round((seen_yaw % 360.0) / 45.0).astype(np.int64) % 8
+            table = cam.table(self.spec.target)
+            p = np.zeros(ok.shape)
+            for b in range(8):
+                m = ok & (row == b)
+                p[m] = np.interp(r[m], LUT_DISTANCES, table[b])
+            ok &= p > 0
+            if g.blocked.any():
                 occ = g.blocked
                 v0, u0 = fr.to_cell(t.x, t.y)
                 rr, cc = np.nonzero(ok)
@@ -349,10 +354,6 @@ class IndirectTask(Task):
             lengths = g.lengths_from(*g.room.start[:2])
             self._shortest[key] = float(lengths[ok].min()) if ok.any() else float("inf")
         return self._shortest[key]
-
-    @staticmethod
-    def occ_any(g: RoomGrid) -> bool:
-        return bool(g.blocked.any())
 
     @property
     def goals(self) -> list:
@@ -390,7 +391,11 @@ class IndirectTask(Task):
 
     def describe(self):
         spec = self.spec
+        blind = {f"{s:g} m": [g.room.name for k, g in enumerate(self.grids) if not np.isfinite(self.shortest_of(k, s))]
+                 for s in spec.view_scales}
+        blind = {s: names for s, names in blind.items() if names}
         return {"name": self.sc.name, "kind": self.kind, "rooms": len(self.grids),
+                "rooms where no reachable pose can detect A (their searches cannot succeed)": blind or "none",
                 "grid": f"{self.grids[0].frame.height} x {self.grids[0].frame.width} cells at {spec.resolution} m",
                 "view scales (m)": spec.view_scales, "target": spec.target, "secondary": spec.secondary,
                 "planners": [v.label for v in self.variants()]}
