@@ -34,7 +34,7 @@ from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.semantic import SemanticCamera
 from ..world.rooms import Room, generate_rooms, read_rooms
-from .base import Outcome, RobotState, RunResult, Task, register_task, run_seed
+from .base import RobotState, RunResult, Task, register_task, run_seed
 from .loop import run_loop
 
 
