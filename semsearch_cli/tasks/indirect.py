@@ -34,7 +34,7 @@ from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.semantic import SemanticCamera
 from ..world.rooms import Room, generate_rooms, read_rooms
-from .base import RobotState, RunResult, Task, register_task, run_seed
+from .base import Outcome, RobotState, RunResult, Task, register_task, run_seed
 from .loop import run_loop
 
 
@@ -370,19 +370,29 @@ class IndirectTask(Task):
         t0 = time.perf_counter()
         scale = float(self.goal_value(goal))
         k = seed % len(self.grids)
-        g = self.grids[k]
         rng = np.random.default_rng(run_seed(self.sc.name, scale, seed, self.sc.experiment.base_seed))
-        x, y, h = g.room.start
-        st = RobotState(x, y, math.radians(h), trail=[(x, y)])
-        search = IndirectSearch(self, g, variant.build(), scale, rng, trace, recorder)
-        st.belief = search.new_belief()
+        out, st = self.episode(self.start_state_of(k), variant.build(), scale, rng, trace, recorder, room=k)
+        return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
+                         np.asarray(st.trail, np.float32), [], out.trace,
+                         message="the robot could not move" if out.outcome == "stuck" else "",
+                         time_s=out.steps / self.spec.camera.fps)
+
+    def start_state_of(self, room: int) -> RobotState:
+        """The robot at room ``room``'s start, with no belief yet."""
+        x, y, h = self.grids[room].room.start
+        return RobotState(x, y, math.radians(h), trail=[(x, y)])
+
+    def episode(self, state, planner, goal, rng, trace=False, recorder=None, room: int = 0):
+        """Search room ``room`` for A at view scale ``goal`` from ``state`` (a new map of A when it
+        has none); the time limit counts from the state's steps (camera frames)."""
         spec = self.spec
-        max_steps = int(round(spec.time_limit * spec.camera.fps))
-        outcome = run_loop(search, st, 0.0, math.inf, max_steps, move=search.move)
-        res = RunResult(outcome, st.distance, st.steps, search.decisions, time.perf_counter() - t0,
-                        np.asarray(st.trail, np.float32), [], search.trace, message="" if outcome != "stuck" else
-                        "the robot could not move", time_s=st.steps * search.dt)
-        return res
+        search = IndirectSearch(self, self.grids[room], planner, float(goal), rng, trace, recorder)
+        if state.belief is None:
+            state.belief = search.new_belief()
+        d0, s0 = state.distance, state.steps
+        max_steps = s0 + int(round(spec.time_limit * spec.camera.fps))
+        outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move)
+        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
 
     def rows(self, variant, goal, seed, res):
         scale = float(self.goal_value(goal))
