@@ -7,7 +7,8 @@ the same run, the baseline: UIS updates the map with A's non-detections only, so
 each method's secondary objects and planning add.
 
 Usage: python benchmarks/bench_indirect.py [--seeds 200] [--workers 2] [--out results/indirect]
-       (--seeds 20 is a tenth of the experiment, a couple of minutes)
+       (--seeds 20 is a tenth of the experiment, a couple of minutes); then
+       semsearch report results/indirect  for the tables, figures and the replay
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import argparse
 import time
 from pathlib import Path
 
+from semsearch_cli.report.build import write_meta
 from semsearch_cli.runner import Loaded, expand, run_batch
 
 SCENARIO = Path(__file__).resolve().parents[1] / "configs" / "indirect.yaml"
@@ -33,6 +35,7 @@ def main() -> None:
     runs_csv = args.out / "runs.csv"
     if runs_csv.is_file():
         raise SystemExit(f"{runs_csv} exists: the benchmark times a fresh run; give another --out")
+    write_meta(args.out, args.scenario)  # so that `semsearch report OUT` can replay a search
     t0 = time.perf_counter()
     rows = run_batch(loaded, specs, args.out, workers=args.workers)
     wall = time.perf_counter() - t0
