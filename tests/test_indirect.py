@@ -312,6 +312,9 @@ def test_a_bad_indirect_section_names_the_field(tmp_path):
     p = scenario(tmp_path, relations={"keyboard": [0.5, 0.5, 0.5, 0.0]})
     res = CliRunner().invoke(app, ["validate", str(p)])
     assert res.exit_code == 2 and "indirect.relations" in res.output and "sum to 1" in res.output, res.output
+    p = scenario(tmp_path, camera={"detection": {"monitor": [[50, 40, 30, 20, 10]] * 7}})
+    res = CliRunner().invoke(app, ["validate", str(p)])
+    assert res.exit_code == 2 and "indirect.camera.detection" in res.output and "8 rows" in res.output, res.output
     p = scenario(tmp_path, rooms="missing.yaml")
     res = CliRunner().invoke(app, ["validate", str(p)])
     assert res.exit_code == 2 and "missing.yaml" in res.output and "rooms file not found" in res.output, res.output
