@@ -3,6 +3,7 @@
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 from scipy.stats import mannwhitneyu
 from typer.testing import CliRunner
 
@@ -10,6 +11,7 @@ from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
 from semsearch_cli.report import tables as T
 from semsearch_cli.report.document import markdown_table
+from semsearch_cli.runner import read_runs
 
 
 def fixed_runs(n=6):
@@ -90,3 +92,20 @@ def test_report_with_replay_and_several_folders(demo_dir, tmp_path):
 def test_report_errors(tmp_path):
     res = CliRunner().invoke(app, ["report", str(tmp_path)])
     assert res.exit_code == 2 and "runs.csv" in res.output
+
+
+def test_a_scenario_with_a_numeric_name_runs_and_reports(demo_dir, tmp_path):
+    """A KTH floor is named by its number (50045233): pandas must not read the scenario column as
+    integers anywhere from the run to the report."""
+    d = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    d["name"] = "50045233"
+    d["map"]["image"] = str(demo_dir / d["map"]["image"])
+    d["doors"] = str(demo_dir / d["doors"])
+    p = tmp_path / "floor.yaml"
+    p.write_text(yaml.safe_dump(d))
+    res = CliRunner().invoke(app, ["run", str(p), "--seeds", "1", "--goal", "304", "--workers", "1", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(app, ["report", str(tmp_path / "o"), "--out", str(tmp_path / "r")])
+    assert res.exit_code == 0 and "Traceback" not in res.output, res.output
+    assert (tmp_path / "r" / "figures" / "boxes_50045233.png").is_file()
+    assert set(read_runs(tmp_path / "o" / "runs.csv")["scenario"]) == {"50045233"}

@@ -20,7 +20,8 @@ def read_runs(path: Path) -> pd.DataFrame:
     ``stage`` and ``map`` are read as text (empty for a run's own row)."""
     if not path.is_file() or path.stat().st_size == 0:
         return pd.DataFrame(columns=COLUMNS)
-    df = pd.read_csv(path, on_bad_lines="skip", dtype={"stage": str, "map": str, "message": str, "kind": str})
+    df = pd.read_csv(path, on_bad_lines="skip", dtype={"stage": str, "map": str, "message": str, "kind": str,
+                                                       "scenario": str})  # a scenario may be named 50045233
     if "kind" not in df.columns:
         raise ScenarioError(str(path), "kind", "this runs.csv was written by an older semsearch (no kind column); "
                             "write new runs into another folder with --out")
