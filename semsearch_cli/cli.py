@@ -23,6 +23,7 @@ from .world.rooms import generate_rooms as gen_rooms
 from .world.rooms import write_rooms
 from .world.kth import import_kth as imp_kth
 from .world.mobilesim import import_mobilesim as imp_mobilesim
+from .world.ros_import import import_ros as imp_ros
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
@@ -290,17 +291,40 @@ def import_mobilesim(
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
-        xy = None
-        if start:
-            try:
-                xs, ys = start.split(",")
-                xy = (float(xs), float(ys))
-            except ValueError:
-                raise ScenarioError("<command line>", "--start", f"expected X,Y in metres, got {start!r}") from None
-        path = imp_mobilesim(map_file, doors_file, out_dir, resolution, xy, _split([goals]) if goals else None, density_delta)
+        path = imp_mobilesim(map_file, doors_file, out_dir, resolution, _xy(start, "--start"),
+                             _split([goals]) if goals else None, density_delta)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+
+
+def _xy(value: str | None, flag: str) -> tuple[float, float] | None:
+    """``X,Y`` in metres from the command line, or None."""
+    if not value:
+        return None
+    try:
+        xs, ys = value.split(",")
+        return float(xs), float(ys)
+    except ValueError:
+        raise ScenarioError("<command line>", flag, f"expected X,Y in metres, got {value!r}") from None
+
+
+@import_app.command("ros")
+def import_ros(
+    map_file: Path = typer.Argument(..., help="ROS map YAML (map_server / map_saver: a PGM or PNG beside it)."),
+    doors_file: Path = typer.Argument(..., help="Door signs: CSV with columns number,x,y,facing (m, degrees) in the map's frame."),
+    out_dir: Path = typer.Option(..., "--out", help="Folder for map.yaml (and its image), doors.csv and scenario.yaml."),
+    start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
+    goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
+    density_delta: float = typer.Option(2.5, "--density-delta", help="m^2, segmentation delta (Eq. 4.4)."),
+):
+    """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
+    try:
+        path = imp_ros(map_file, doors_file, out_dir, _xy(start, "--start"), _split([goals]) if goals else None,
+                       density_delta=density_delta)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}")
 
 
 @import_app.command("kth")

@@ -1,10 +1,18 @@
-"""MobileSim import on a small line map written here."""
+"""MobileSim import on a small line map written here; ROS maps saved as map_saver saves them."""
 
+from pathlib import Path
+
+import cv2
 import numpy as np
+import pandas as pd
+import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.runner import Loaded
+from semsearch_cli.world.ros import read_ros_map
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_import_mobilesim_snaps_signs_and_runs(tmp_path):
@@ -92,3 +100,59 @@ def test_import_kth_reference_floor(tmp_path):
     L = Loaded.load(import_kth(f, tmp_path))
     assert len(L.world.signs) == 54  # one per room-to-corridor portal
     assert all(L.world.readable_mask(i).any() for i in range(len(L.world.signs)))
+
+
+def saved_like_map_saver(tmp_path, origin=(-3.0, -2.0)):
+    """Our demo map saved as ROS's map_saver saves one: a PGM with free 254, occupied 0, unknown
+    205, and its YAML (negate 0, thresholds 0.65 / 0.196), the origin moved to ``origin``."""
+    img = cv2.imread(str(ROOT / "maps" / "demo" / "map.png"), cv2.IMREAD_GRAYSCALE)
+    pgm = np.where(img >= 200, 254, np.where(img < 100, 0, 205)).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "lab.pgm"), pgm)
+    (tmp_path / "lab.yaml").write_text(f"image: lab.pgm\nresolution: 0.1\norigin: [{origin[0]}, {origin[1]}, 0.0]\n"
+                                       "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    doors = (ROOT / "maps" / "demo" / "doors.csv").read_text().splitlines()
+    rows = [doors[0]] + [f"{n},{float(x) + origin[0]},{float(y) + origin[1]},{f}" for n, x, y, f in
+                         (line.split(",") for line in doors[1:])]
+    (tmp_path / "doors.csv").write_text("\n".join(rows) + "\n")
+    return img, pgm
+
+
+def test_a_ros_map_reads_as_map_server_reads_it(tmp_path):
+    img, pgm = saved_like_map_saver(tmp_path)
+    grey, res, origin = read_ros_map(tmp_path / "lab.yaml")
+    assert res == 0.1 and origin == (-3.0, -2.0)
+    assert ((grey == 255) == (img >= 200)).all() and ((grey == 0) == (img < 100)).all()
+    # 205 is p = 50/255 = 0.196: not below free_thresh, so unknown, as map_server has it
+    assert (grey[pgm == 205] == 128).all()
+    (tmp_path / "neg.yaml").write_text("image: lab.pgm\nresolution: 0.1\norigin: [0, 0, 0]\nnegate: 1\n")
+    neg, _, _ = read_ros_map(tmp_path / "neg.yaml")
+    # negated, p = v / 255: 254 and 205 are occupied (above 0.65), 0 is free
+    assert ((neg == 0) == (pgm >= 205)).all() and ((neg == 255) == (pgm == 0)).all()
+
+
+def test_import_ros_writes_a_scenario_that_runs(tmp_path):
+    saved_like_map_saver(tmp_path)
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "lab.yaml"), str(tmp_path / "doors.csv"),
+                                   "--out", str(out), "--goals", "304"])
+    assert res.exit_code == 0, res.output
+    d = yaml.safe_load((out / "scenario.yaml").read_text())
+    assert d["map"] == {"ros": "map.yaml"} and (out / "lab.pgm").is_file()
+    ros = Loaded.load(out / "scenario.yaml")
+    demo = Loaded.load(ROOT / "configs" / "demo.yaml")
+    assert ros.world.frame.origin_x == -3.0 and (ros.world.free == demo.world.free).all()
+    assert ros.shortest[304] > 0
+    res = CliRunner().invoke(app, ["run", str(out / "scenario.yaml"), "--seeds", "1", "--planner", "greedy",
+                                   "--workers", "1", "--out", str(tmp_path / "r")])
+    assert res.exit_code == 0, res.output
+    assert (pd.read_csv(tmp_path / "r" / "runs.csv")["outcome"] == "found").all()
+
+
+def test_a_rotated_or_incomplete_ros_map_names_the_key(tmp_path):
+    saved_like_map_saver(tmp_path)
+    (tmp_path / "rot.yaml").write_text("image: lab.pgm\nresolution: 0.1\norigin: [0, 0, 0.5]\n")
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "rot.yaml"), str(tmp_path / "doors.csv"), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "origin" in res.output and "rotated" in res.output, res.output
+    (tmp_path / "bad.yaml").write_text("image: lab.pgm\norigin: [0, 0, 0]\n")
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "bad.yaml"), str(tmp_path / "doors.csv"), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "resolution" in res.output, res.output

@@ -6,16 +6,28 @@ from __future__ import annotations
 
 from typing import Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class MapSpec(Strict):
-    image: str = Field(description="PNG: dark (<100) wall, light (>=200) free, gray between = outside")
+    """A PNG of our own (``image`` with ``resolution`` and ``origin``), or a ROS map (``ros``: the
+    map_server YAML, which carries its own resolution and origin)."""
+
+    image: str | None = Field(None, description="PNG: dark (<100) wall, light (>=200) free, gray between = outside")
+    ros: str | None = Field(None, description="a ROS map_server / map_saver YAML (PGM or PNG image)")
     resolution: float = Field(0.1, gt=0.0, le=1.0, description="m/cell")
     origin: tuple[float, float] = Field((0.0, 0.0), description="world (x, y) m of the image's bottom-left corner")
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if (self.image is None) == (self.ros is None):
+            raise ValueError("give either image (a PNG) or ros (a map_server YAML)")
+        if self.ros is not None and self.model_fields_set & {"resolution", "origin"}:
+            raise ValueError("a ROS map carries its own resolution and origin; remove them here")
+        return self
 
 
 class StartSpec(Strict):

@@ -58,11 +58,13 @@ def write_doors(path: Path, signs) -> None:
             fh.write(f"{label},{x},{y},{f}\n")
 
 
-def write_building(out: Path, img: np.ndarray, signs, scen: dict, header: str) -> Path:
-    """Write ``out/map.png``, ``out/doors.csv`` (signs: (label, x, y, facing_deg)) and
-    ``out/scenario.yaml`` (prefixed by the comment ``header``); returns the YAML path."""
+def write_building(out: Path, img: np.ndarray | None, signs, scen: dict, header: str) -> Path:
+    """Write ``out/map.png`` (unless ``img`` is None: a map kept in its own format),
+    ``out/doors.csv`` (signs: (label, x, y, facing_deg)) and ``out/scenario.yaml`` (prefixed by
+    the comment ``header``); returns the YAML path."""
     out.mkdir(parents=True, exist_ok=True)
-    cv2.imwrite(str(out / "map.png"), img)
+    if img is not None:
+        cv2.imwrite(str(out / "map.png"), img)
     write_doors(out / "doors.csv", signs)
     path = out / "scenario.yaml"
     path.write_text(f"# {header}\n" + yaml.safe_dump(scen, sort_keys=False))

@@ -20,6 +20,7 @@ from ..errors import ScenarioError
 from ..geometry import GridFrame
 from ..kernels.grid import dijkstra
 from ..kernels.raycast import line_of_sight
+from .ros import read_ros_map
 
 WALL_BELOW = 100
 FREE_FROM = 200
@@ -228,10 +229,13 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     without a map (one that brings rooms of its own)."""
     if sc.map is None:
         return None
-    img = load_map(base / sc.map.image, owner=file)
+    if sc.map.ros is not None:
+        img, res, origin = read_ros_map(base / sc.map.ros, owner=file)
+    else:
+        img, res, origin = load_map(base / sc.map.image, owner=file), sc.map.resolution, sc.map.origin
     free = img >= FREE_FROM
     H, W = free.shape
-    frame = GridFrame(sc.map.resolution, sc.map.origin[0], sc.map.origin[1], H, W)
+    frame = GridFrame(res, origin[0], origin[1], H, W)
 
     doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
     dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file

@@ -1,0 +1,53 @@
+"""``semsearch import ros MAP.yaml DOORS.csv --out DIR``: a runnable scenario over a ROS map.
+
+The map stays in its own format (copied as ``DIR/map.yaml`` and its image; the scenario reads it
+with ``map: {ros: map.yaml}``). The free space is the 4-connected free region holding the start
+(default: the free cell farthest from walls and unknown space); each sign is snapped onto the
+nearest wall face of that region, facing into it, as the MobileSim importer does.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..errors import ScenarioError
+from ..geometry import GridFrame
+from .files import scenario_dict, write_building
+from .mobilesim import snap_signs, spread_goals
+from .ros import FREE, copy_ros_map, read_ros_map
+from .scenario import read_doors
+
+
+def import_ros(map_yaml: Path, doors: Path, out: Path, start: tuple[float, float] | None = None,
+               goals: list | None = None, name: str | None = None, density_delta: float = 2.5) -> Path:
+    """Write ``out/map.yaml`` (+ image), ``out/doors.csv`` and ``out/scenario.yaml``; returns the
+    scenario's path."""
+    img, res, origin = read_ros_map(map_yaml)
+    H, W = img.shape
+    frame = GridFrame(res, origin[0], origin[1], H, W)
+    space = img == FREE
+    _, lab = cv2.connectedComponents(space.astype(np.uint8), connectivity=4)
+    if start is None:
+        d = cv2.distanceTransform(space.astype(np.uint8), cv2.DIST_L2, 5)
+        r, c = np.unravel_index(int(np.argmax(d)), d.shape)
+        sx, sy = frame.to_world(r, c)
+        start = (round(float(sx), 2), round(float(sy), 2))
+    r, c = frame.to_index(*start)
+    if not (0 <= r < H and 0 <= c < W) or not space[r, c]:
+        raise ScenarioError("<command line>", "--start", f"start {start} m is not in the free space of {map_yaml}")
+    free = lab == lab[r, c]
+    signs = [(d.number, d.x, d.y, d.facing) for d in read_doors(Path(doors))]
+    if not signs:
+        raise ScenarioError(str(doors), "", "no door signs")
+    snapped = snap_signs(free, frame, signs)
+    if not goals:
+        goals = spread_goals(free, frame, snapped, start)
+    copy_ros_map(map_yaml, out)
+    scen = scenario_dict(name or Path(map_yaml).stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
+                         density_delta, origin)
+    scen["map"] = {"ros": "map.yaml"}
+    return write_building(out, None, snapped, scen,
+                          f"imported from {Path(map_yaml).name} and {Path(doors).name} by `semsearch import ros`")
