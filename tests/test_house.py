@@ -298,3 +298,44 @@ def test_the_html_report_reads_well_in_a_browser(mixed_report, tmp_path):
     assert probe["images"] > 0 and probe["broken_images"] == 0 and probe["tables"] > 0, probe
     assert any(h.startswith("Chained searches") for h in probe["headings"]), probe
     assert any(h.startswith("Door search") for h in probe["headings"]), probe
+
+
+# ---- signs that share a number ------------------------------------------------------------
+def duplicated_demo(tmp_path, policy=None):
+    """The demo with its sign nearest the start (by path) renumbered 304, so that 304 appears
+    twice: the original, 11.7 m away, and this nearer one."""
+    demo = Loaded.load(CONFIGS / "demo.yaml").world
+    others = [n for n in demo.signs.number if str(n) != "304"]
+    near = min(others, key=demo.shortest_path)
+    rows = (ROOT / "maps" / "demo" / "doors.csv").read_text().splitlines()
+    rows = [rows[0]] + [("304" + r[len(str(near)):]) if r.split(",")[0] == str(near) else r for r in rows[1:]]
+    (tmp_path / "doors.csv").write_text("\n".join(rows) + "\n")
+    extra = {"duplicates": policy} if policy else {}
+    d = demo_data(goals=[304], planners=[{"name": "greedy"}], experiment={"seeds": 1, "max_distance": 300}, **extra)
+    d["doors"] = str(tmp_path / "doors.csv")
+    return write_scenario(tmp_path, d), demo.shortest_path(near), demo.shortest_path(304), demo.signs.index_of(near) < demo.signs.index_of(304)
+
+
+def test_duplicate_numbers_are_refused_by_default_naming_each(tmp_path):
+    p, _, _, _ = duplicated_demo(tmp_path)
+    res = CliRunner().invoke(app, ["validate", str(p)])
+    out = res.output.replace("\n", " ")
+    assert res.exit_code == 2 and "304 at (" in out and "duplicates: keep-first" in out, res.output
+
+
+def test_duplicates_keep_first_keeps_the_first_sign_of_a_number(tmp_path):
+    p, near_m, orig_m, near_first = duplicated_demo(tmp_path, "keep-first")
+    L = Loaded.load(p)
+    assert len(L.world.signs.indices_of(304)) == 1 and "304" in L.world.duplicates
+    assert L.shortest[304] == pytest.approx(near_m if near_first else orig_m)  # the sign listed first
+
+
+def test_duplicates_any_finds_the_goal_at_the_nearest_sign(tmp_path):
+    p, near_m, orig_m, _ = duplicated_demo(tmp_path, "any")
+    L = Loaded.load(p)
+    assert len(L.world.signs.indices_of(304)) == 2
+    assert near_m < orig_m and L.shortest[304] == pytest.approx(near_m)  # the nearer of the two
+    res = CliRunner().invoke(app, ["validate", str(p)])
+    assert res.exit_code == 0 and "duplicated numbers (any)" in res.output and "304" in res.output, res.output
+    rows = run_batch(L, expand(L), tmp_path / "out")
+    assert (rows["outcome"] == "found").all()

@@ -43,6 +43,8 @@ class Scenario(Strict):
     chains: list[ChainSpec] | None = Field(None, description="chained searches (thesis ch. 6)")
     indirect: IndirectSpec | None = Field(None, description="indirect search with secondary objects (Loncomilla et al. 2018)")
     kind: Literal["doors", "objects", "chain", "indirect"] | None = Field(None, description="default: from the sections given")
+    duplicates: Literal["error", "keep-first", "any"] = Field(
+        "error", description="signs sharing a number: refuse them, keep the first of each, or accept any as the goal")
     planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
     experiment: ExperimentSpec = ExperimentSpec()
     robot: RobotSpec = RobotSpec()

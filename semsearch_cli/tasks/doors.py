@@ -34,7 +34,7 @@ class DoorSensing:
 
     def __init__(self, task: "DoorTask", goal, rng: np.random.Generator):
         self.task, self.goal, self.rng = task, goal, rng
-        self.goal_idx = task.world.signs.index_of(goal)
+        self.goal_idx = set(task.world.signs.indices_of(goal))  # more than one under duplicates: any
         self.bbox = np.empty(4, np.int64)
 
     def sense(self, st: RobotState) -> tuple[bool, bool]:
@@ -50,7 +50,7 @@ class DoorSensing:
         found = event = False
         for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
             st.read_signs.add(i)
-            if i == self.goal_idx and label == self.goal:
+            if i in self.goal_idx and label == self.goal:
                 found = True
             if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == spec.min_reads:
                 event = True
@@ -223,7 +223,9 @@ class DoorTask(Task):
     def describe(self):
         w = self.world
         readable = sum(1 for i in range(len(w.signs)) if w.readable_mask(i).any())
+        dup = {str(n): ", ".join(f"({x:g}, {y:g})" for x, y in xy) for n, xy in w.duplicates.items()}
         return {"name": self.sc.name, "kind": self.kind, "signs": len(w.signs), "readable_signs": readable,
+                f"duplicated numbers ({self.sc.duplicates})": dup or "none",
                 "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
                 "planners": [v.label for v in self.variants()],
                 "shortest_m": {str(k): round(v, 2) for k, v in self.shortest.items()}}

@@ -7,7 +7,7 @@ blocks beams like a wall). The world is immutable once built and shared by every
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
@@ -43,11 +43,17 @@ class Signs:
         return len(self.number)
 
     def index_of(self, label) -> int:
+        """The first sign carrying ``label``, or -1."""
         key = str(label)
         for i, n in enumerate(self.number):
             if str(n) == key:
                 return i
         return -1
+
+    def indices_of(self, label) -> list[int]:
+        """Every sign carrying ``label`` (more than one under ``duplicates: any``)."""
+        key = str(label)
+        return [i for i, n in enumerate(self.number) if str(n) == key]
 
 
 def _as_label(v):
@@ -115,6 +121,7 @@ class World:
     radius: float
     read_range: float
     read_fov: float = np.radians(60.0)
+    duplicates: dict = field(default_factory=dict)  # number -> [(x, y) m] of every sign carrying it, when > 1
 
     @cached_property
     def occ(self) -> np.ndarray:
@@ -199,17 +206,18 @@ class World:
 
     def reading_cells(self, label) -> np.ndarray:
         """(H, W) bool: the reachable cells nearest to sign ``label`` among those that read it
-        (the robot abreast of the door); empty when no reachable pose reads it."""
-        i = self.signs.index_of(label)
-        disk = self.readable_mask(i)
-        target = np.zeros_like(disk)
-        if not disk.any():
-            return target
-        rr, cc = np.nonzero(disk)
-        x, y = self.frame.to_world(rr, cc)
-        d = np.hypot(x - self.signs.x[i], y - self.signs.y[i])
-        near = d <= d.min() + 0.5 * self.frame.res
-        target[rr[near], cc[near]] = True
+        (the robot abreast of the door), for every sign carrying the label; empty when no
+        reachable pose reads one."""
+        target = np.zeros(self.free.shape, bool)
+        for i in self.signs.indices_of(label):  # several signs under duplicates: any; the nearest wins
+            disk = self.readable_mask(i)
+            if not disk.any():
+                continue
+            rr, cc = np.nonzero(disk)
+            x, y = self.frame.to_world(rr, cc)
+            d = np.hypot(x - self.signs.x[i], y - self.signs.y[i])
+            near = d <= d.min() + 0.5 * self.frame.res
+            target[rr[near], cc[near]] = True
         return target
 
     def geodesic(self, cell: tuple[int, int], target: np.ndarray) -> tuple[float, tuple[int, int] | None]:
@@ -239,12 +247,8 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
 
     doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
     dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file
+    doors, duplicates = apply_duplicates(doors, sc.duplicates, dfile)
     labels = [d.number for d in doors]
-    seen: set[str] = set()
-    for lab in labels:
-        if str(lab) in seen:
-            raise ScenarioError(dfile, "doors", f"sign number {lab} appears more than once (each room number must be unique)")
-        seen.add(str(lab))
     signs = Signs(
         number=tuple(labels),
         value=np.array([lab if isinstance(lab, int) else -1 for lab in labels], np.int64),
@@ -262,13 +266,38 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
 
     heading = None if sc.start.heading == "random" else float(np.radians(sc.start.heading))
     world = World(frame, free, signs, (sc.start.x, sc.start.y), heading, sc.robot.radius, sc.door_camera.range,
-                  float(np.radians(sc.door_camera.fov)))
+                  float(np.radians(sc.door_camera.fov)), duplicates)
     sr, scc = world.start_cell
     if not (0 <= sr < H and 0 <= scc < W):
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m lies outside the map")
     if not world.cspace[sr, scc]:
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m is inside a wall or closer than the robot radius ({sc.robot.radius} m) to one")
     return world
+
+
+def apply_duplicates(doors: list, policy: str, dfile: str) -> tuple[list, dict]:
+    """Signs that share a number, under the scenario's ``duplicates`` policy: ``error`` refuses
+    them, naming every duplicate with its positions; ``keep-first`` keeps the first sign of each
+    number; ``any`` keeps them all (the goal is found at whichever carries it). Returns the signs
+    kept and number -> [(x, y)] of every duplicated number."""
+    where: dict[str, list] = {}
+    for d in doors:
+        where.setdefault(str(d.number), []).append((round(d.x, 2), round(d.y, 2)))
+    dup = {n: xy for n, xy in where.items() if len(xy) > 1}
+    if dup and policy == "error":
+        listed = "; ".join(f"{n} at " + ", ".join(f"({x:g}, {y:g})" for x, y in xy) for n, xy in dup.items())
+        raise ScenarioError(dfile, "doors", f"{len(dup)} sign number(s) appear more than once: {listed}. Set "
+                            "duplicates: keep-first (the first sign of each number) or any (the goal is found at "
+                            "whichever sign carries it) in the scenario")
+    if dup and policy == "keep-first":
+        seen: set[str] = set()
+        kept = []
+        for d in doors:
+            if str(d.number) not in seen:
+                kept.append(d)
+                seen.add(str(d.number))
+        doors = kept
+    return doors, dup
 
 
 def check_goals_reachable(world: World, goals, file: str) -> dict:
