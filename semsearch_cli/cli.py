@@ -21,6 +21,7 @@ from .world.generate import generate_batch as gen_batch
 from .world.generate import generate_building as gen_building
 from .world.rooms import generate_rooms as gen_rooms
 from .world.rooms import write_rooms
+from .world.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
 from .world.kth import import_kth as imp_kth
 from .world.mobilesim import import_mobilesim as imp_mobilesim
 from .world.ros_import import import_ros as imp_ros
@@ -332,11 +333,14 @@ def import_kth(
     xml_file: Path = typer.Argument(..., help="KTH campus floor-plan XML file."),
     out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
     resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
-    goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
+    goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance, among readable signs)."),
+    corridor_types: str = typer.Option(",".join(KTH_CORRIDOR_TYPES), "--corridor-types",
+                                       help="Comma-separated space types the robot drives in (untyped spaces joined to several others count too)."),
 ):
-    """Convert a KTH floor plan: corridors become free space, each room-to-corridor portal a sign."""
+    """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
-        path = imp_kth(xml_file, out_dir, resolution, _split([goals]) if goals else None)
+        types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
+        path = imp_kth(xml_file, out_dir, resolution, _split([goals]) if goals else None, corridor_types=types)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")

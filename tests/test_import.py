@@ -98,7 +98,9 @@ def test_import_kth_reference_floor(tmp_path):
     from semsearch_cli.world.kth import import_kth
 
     L = Loaded.load(import_kth(f, tmp_path))
-    assert len(L.world.signs) == 54  # one per room-to-corridor portal
+    # one per room-to-circulation portal: 53 into its KORRIDOR spaces, 10 into two untyped halls
+    # and an anteroom (each joined to three or more spaces)
+    assert len(L.world.signs) == 63
     assert all(L.world.readable_mask(i).any() for i in range(len(L.world.signs)))
 
 
@@ -156,3 +158,51 @@ def test_a_rotated_or_incomplete_ros_map_names_the_key(tmp_path):
     (tmp_path / "bad.yaml").write_text("image: lab.pgm\norigin: [0, 0, 0]\n")
     res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "bad.yaml"), str(tmp_path / "doors.csv"), "--out", str(tmp_path / "o")])
     assert res.exit_code == 2 and "resolution" in res.output, res.output
+
+
+KTH_PASSAGE = """<?xml version="1.0" encoding="UTF-8"?>
+<floor BuildingName="B" FloorName="F">
+  <Scale PixelDistance="100" RealDistance="1"/>
+  <space name="B_P1" type="PASSAGE"><contour>
+    <linesegment x1="0" y1="0" x2="1000" y2="0" type="Wall" target=""/>
+    <linesegment x1="1000" y1="0" x2="1000" y2="200" type="Portal" target="B_H"/>
+    <linesegment x1="1000" y1="200" x2="0" y2="200" type="Wall" target=""/>
+    <linesegment x1="0" y1="200" x2="0" y2="0" type="Wall" target=""/>
+  </contour></space>
+  <space name="B_H"><contour>
+    <linesegment x1="1030" y1="0" x2="1600" y2="0" type="Wall" target=""/>
+    <linesegment x1="1600" y1="0" x2="1600" y2="200" type="Portal" target="B_STAIR"/>
+    <linesegment x1="1600" y1="200" x2="1030" y2="200" type="Portal" target="B_302"/>
+    <linesegment x1="1030" y1="200" x2="1030" y2="0" type="Portal" target="B_P1"/>
+  </contour></space>
+  <space name="B_301" type="KONTOR"><contour>
+    <linesegment x1="300" y1="-20" x2="400" y2="-20" type="Portal" target="B_P1"/>
+  </contour></space>
+  <space name="B_302" type="KONTOR"><contour>
+    <linesegment x1="1300" y1="220" x2="1400" y2="220" type="Portal" target="B_H"/>
+  </contour></space>
+  <space name="B_STAIR" type="TRAPPA"><contour>
+    <linesegment x1="1620" y1="50" x2="1620" y2="150" type="Portal" target="B_H"/>
+  </contour></space>
+</floor>
+"""
+
+
+def test_import_kth_drives_in_passages_and_untyped_halls(tmp_path):
+    """A floor with no KORRIDOR: a PASSAGE and an untyped hall joined to three other spaces are
+    the circulation; the default goals are readable signs; --corridor-types narrows the set."""
+    (tmp_path / "f.xml").write_text(KTH_PASSAGE)
+    res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "f.xml"), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    L = Loaded.load(tmp_path / "o" / "scenario.yaml")
+    assert sorted(map(str, L.world.signs.number)) == ["301", "302", "STAIR"]
+    assert L.world.reach.sum() > 800  # the passage and the hall, joined through their portal
+    assert all(np.isfinite(L.world.shortest_path(g)) for g in L.sc.goals)
+    res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "f.xml"), "--out", str(tmp_path / "k"),
+                                   "--corridor-types", "KORRIDOR"])
+    # the untyped hall alone still counts; with no circulation at all the import exits 2
+    assert res.exit_code == 0, res.output
+    (tmp_path / "g.xml").write_text(KTH_PASSAGE.replace('<space name="B_H">', '<space name="B_H" type="KONTOR">'))
+    res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "g.xml"), "--out", str(tmp_path / "g"),
+                                   "--corridor-types", "KORRIDOR"])
+    assert res.exit_code == 2 and "no circulation space" in res.output and "PASSAGE" in res.output, res.output

@@ -4,12 +4,17 @@ Format: ``<Scale PixelDistance RealDistance>`` gives pixels per metre; each ``<s
 "BUILDING_ROOM" type="KONTOR|KORRIDOR|...">`` has a ``<contour>`` of ``<linesegment x1 y1 x2 y2
 type="Wall|Window|Portal" target="other space">``; pixel y points down.
 
-The robot's free space is the union of the KORRIDOR spaces (rooms stay closed, as in the authors'
-maps); their boundary becomes a one-cell wall and everything else "outside". Each Portal from a
+The robot's free space is the union of the circulation spaces (rooms stay closed, as in the
+authors' maps): those typed KORRIDOR, PASSAGE, HALL, KULVERT or ENTRE (``corridor_types``), and
+untyped spaces joined by portals to several (three or more) other spaces: on the sample floor
+these are two halls joined to stairs, lifts, toilets and a corridor, and a toilets' anteroom,
+while an untyped space joined to one corridor is a room. Their boundary becomes a one-cell wall
+and everything else "outside". Each Portal from a
 room to a corridor is that room's door: a sign on the corridor wall at the portal's middle, facing
 into the corridor, numbered by the room number after the underscore (a name that is not a number
 is kept as text). A room with several doors gets its number on the first and ``NUMBER/2``, ... (text,
-ignored by the number-based factors) on the others, since sign numbers must be unique.
+ignored by the number-based factors) on the others, since sign numbers must be unique. Default
+goals are chosen only among signs the written scenario can read from the start's free space.
 """
 
 from __future__ import annotations
@@ -23,7 +28,9 @@ import numpy as np
 from ..errors import ScenarioError
 from ..geometry import GridFrame
 from .files import map_image, scenario_dict, write_building
+from ..config import parse_scenario
 from .mobilesim import MARGIN_M, snap_signs, spread_goals
+from .scenario import build_world
 
 
 def _label(name: str):
@@ -31,8 +38,27 @@ def _label(name: str):
     return int(tail) if tail.isdigit() else tail
 
 
+CORRIDOR_TYPES = ("KORRIDOR", "PASSAGE", "HALL", "KULVERT", "ENTRE")
+
+
+def circulation(spaces, types=CORRIDOR_TYPES) -> set[str]:
+    """Names of the spaces the robot drives in: typed as one of ``types``, or untyped and joined
+    by portals to three or more other spaces."""
+    types = {t.upper() for t in types}
+    out = set()
+    for s in spaces:
+        kind = (s.get("type") or "").strip().upper()
+        if kind in types:
+            out.add(s.get("name"))
+        elif not kind:
+            joined = {ls.get("target") for ls in s.iter("linesegment") if ls.get("type") == "Portal" and ls.get("target")}
+            if len(joined) >= 3:
+                out.add(s.get("name"))
+    return out
+
+
 def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None = None, name: str | None = None,
-               density_delta: float = 2.5) -> Path:
+               density_delta: float = 2.5, corridor_types=CORRIDOR_TYPES) -> Path:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path."""
     if not xml_path.is_file():
         raise ScenarioError(str(xml_path), "", "KTH floor-plan file not found")
@@ -45,9 +71,12 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         raise ScenarioError(str(xml_path), "Scale", "missing <Scale PixelDistance RealDistance> element")
     ppm = float(scale.get("PixelDistance")) / float(scale.get("RealDistance"))
     spaces = root.findall("space")
-    corridors = {s.get("name") for s in spaces if (s.get("type") or "").upper() == "KORRIDOR"}
+    corridors = circulation(spaces, corridor_types)
     if not corridors:
-        raise ScenarioError(str(xml_path), "space", "no space of type KORRIDOR: nothing for the robot to drive in")
+        found = sorted({(s.get("type") or "untyped") for s in spaces})
+        raise ScenarioError(str(xml_path), "space", f"no circulation space (types {', '.join(corridor_types)}, or untyped "
+                            f"spaces joined to several others): nothing for the robot to drive in. The floor's space "
+                            f"types are {', '.join(found)}; name the circulation ones with --corridor-types")
 
     def seg(ls):
         return [float(ls.get(k)) / ppm for k in ("x1", "y1", "x2", "y2")]
@@ -104,7 +133,21 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         raw.append((label if k == 1 else f"{label}/{k}", x, y, 0.0))
     snapped = snap_signs(free, frame, raw)
 
-    if not goals:
-        goals = spread_goals(main, frame, snapped, start)
-    scen = scenario_dict(name or xml_path.stem, res, start, goals, None, density_delta, (frame.origin_x, frame.origin_y))
-    return write_building(out, map_image(free), snapped, scen, f"imported from {xml_path.name} by `semsearch import kth`")
+    header = f"imported from {xml_path.name} by `semsearch import kth`"
+    chosen = goals or spread_goals(main, frame, snapped, start)
+    scen = scenario_dict(name or xml_path.stem, res, start, chosen, None, density_delta, (frame.origin_x, frame.origin_y))
+    path = write_building(out, map_image(free), snapped, scen, header)
+    if goals:
+        return path
+    # default goals: only signs the written scenario can read from the start's free space
+    world = build_world(parse_scenario(scen, path), out, str(path))
+    readable = [lab for lab, *_ in snapped if isinstance(lab, int) and np.isfinite(world.shortest_path(lab))]
+    if not readable:
+        raise ScenarioError(str(xml_path), "space", "no numbered sign can be read from the corridors' free space")
+    ok = [g for g in chosen if g in readable]
+    if len(ok) < len(chosen):
+        keep = [s for s in snapped if s[0] in readable]
+        ok = spread_goals(main, frame, keep, start)
+        scen["goals"] = ok
+        path = write_building(out, map_image(free), snapped, scen, header)
+    return path
