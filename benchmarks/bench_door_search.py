@@ -103,7 +103,7 @@ def main() -> int:
         lines.append(s)
 
     tmp = Path(tempfile.mkdtemp(prefix="semsearch-bench-"))
-    p = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5, "hotel-reference")
+    p, _ = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5, "hotel-reference")
     L = Loaded.load(p)
     say(f"# semsearch door-search benchmark ({time.strftime('%Y-%m-%d %H:%M')}, {sys.platform}, python {sys.version.split()[0]})")
     say()

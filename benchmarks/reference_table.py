@@ -59,7 +59,7 @@ def main() -> int:
              "|---|---|---|---|---|---|---|---|---|"]
     for stem, (name, start, delta) in MAPS.items():
         goals = list(GREEDY[name])
-        p = import_mobilesim(REF / f"{stem}.map", REF / f"{stem}.doors", tmp / stem, 0.1, start, goals, delta, f"{name.lower()}-reference")
+        p, _ = import_mobilesim(REF / f"{stem}.map", REF / f"{stem}.doors", tmp / stem, 0.1, start, goals, delta, f"{name.lower()}-reference")
         L = Loaded.load(p)
         start = L.sc.start.model_copy(update={"heading": a.heading if a.heading == "random" else float(a.heading)})
         L.sc = L.sc.model_copy(update={"planners": specs, "start": start})

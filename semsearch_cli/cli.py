@@ -292,11 +292,11 @@ def import_mobilesim(
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
-        path = imp_mobilesim(map_file, doors_file, out_dir, resolution, _xy(start, "--start"),
+        path, notes = imp_mobilesim(map_file, doors_file, out_dir, resolution, _xy(start, "--start"),
                              _split([goals]) if goals else None, density_delta)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+    out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
 
 
 def _xy(value: str | None, flag: str) -> tuple[float, float] | None:
@@ -321,11 +321,11 @@ def import_ros(
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
-        path = imp_ros(map_file, doors_file, out_dir, _xy(start, "--start"), _split([goals]) if goals else None,
+        path, notes = imp_ros(map_file, doors_file, out_dir, _xy(start, "--start"), _split([goals]) if goals else None,
                        density_delta=density_delta)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}")
+    out.print(escape(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
 
 
 @import_app.command("kth")
@@ -340,10 +340,10 @@ def import_kth(
     """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
         types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
-        path = imp_kth(xml_file, out_dir, resolution, _split([goals]) if goals else None, corridor_types=types)
+        path, notes = imp_kth(xml_file, out_dir, resolution, _split([goals]) if goals else None, corridor_types=types)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+    out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
 
 
 @app.command()

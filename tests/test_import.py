@@ -24,6 +24,7 @@ def test_import_mobilesim_snaps_signs_and_runs(tmp_path):
     res = CliRunner().invoke(app, ["import", "mobilesim", str(tmp_path / "c.map"), str(tmp_path / "c.doors"),
                                    "--out", str(out), "--start", "2,1", "--goals", "3,4"])
     assert res.exit_code == 0, res.output
+    assert "snapped 4 of 4 signs onto the walls" in res.output.replace("\n", " "), res.output
     L = Loaded.load(out / "scenario.yaml")
     s = L.world.signs
     # snapped onto the wall faces of the corridor, facing into it
@@ -97,7 +98,7 @@ def test_import_kth_reference_floor(tmp_path):
         pytest.skip(f"the KTH sample floor is not at {f} (../shared absent)")
     from semsearch_cli.world.kth import import_kth
 
-    L = Loaded.load(import_kth(f, tmp_path))
+    L = Loaded.load(import_kth(f, tmp_path)[0])
     # one per room-to-circulation portal: 53 into its KORRIDOR spaces, 10 into two untyped halls
     # and an anteroom (each joined to three or more spaces)
     assert len(L.world.signs) == 63
@@ -134,15 +135,19 @@ def test_a_ros_map_reads_as_map_server_reads_it(tmp_path):
 
 def test_import_ros_writes_a_scenario_that_runs(tmp_path):
     saved_like_map_saver(tmp_path)
+    with (tmp_path / "doors.csv").open("a") as fh:
+        fh.write("999,80.0,80.0,0\n")  # far outside the building: no pose could read it
     out = tmp_path / "out"
     res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "lab.yaml"), str(tmp_path / "doors.csv"),
                                    "--out", str(out), "--goals", "304"])
     assert res.exit_code == 0, res.output
+    assert "dropped 1 signs more than 2 m from the free space" in res.output.replace("\n", " ") and "999" in res.output
     d = yaml.safe_load((out / "scenario.yaml").read_text())
     assert d["map"] == {"ros": "map.yaml"} and (out / "lab.pgm").is_file()
     ros = Loaded.load(out / "scenario.yaml")
     demo = Loaded.load(ROOT / "configs" / "demo.yaml")
     assert ros.world.frame.origin_x == -3.0 and (ros.world.free == demo.world.free).all()
+    assert ros.world.signs.index_of(999) == -1 and len(ros.world.signs) == len(demo.world.signs)
     assert ros.shortest[304] > 0
     res = CliRunner().invoke(app, ["run", str(out / "scenario.yaml"), "--seeds", "1", "--planner", "greedy",
                                    "--workers", "1", "--out", str(tmp_path / "r")])

@@ -20,7 +20,7 @@ THESIS = {
 @pytest.mark.parametrize("name", sorted(THESIS))
 def test_shortest_paths_within_ten_percent_of_thesis(name, tmp_path):
     start, delta, published = THESIS[name]
-    p = import_mobilesim(REF / f"{name}.map", REF / f"{name}.doors", tmp_path, 0.1, start, list(published), delta)
+    p, _ = import_mobilesim(REF / f"{name}.map", REF / f"{name}.doors", tmp_path, 0.1, start, list(published), delta)
     L = Loaded.load(p)
     assert len(L.world.signs) == {"hotel2": 124, "par_impar_par_impar": 113, "par_impar_par_impar_inverse": 116}[name]
     for goal, ref in published.items():

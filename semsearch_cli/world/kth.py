@@ -29,7 +29,7 @@ from ..errors import ScenarioError
 from ..geometry import GridFrame
 from .files import map_image, scenario_dict, write_building
 from ..config import parse_scenario
-from .mobilesim import MARGIN_M, snap_signs, spread_goals
+from .mobilesim import MARGIN_M, snap_report, snap_signs, spread_goals
 from .scenario import build_world
 
 
@@ -58,8 +58,9 @@ def circulation(spaces, types=CORRIDOR_TYPES) -> set[str]:
 
 
 def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None = None, name: str | None = None,
-               density_delta: float = 2.5, corridor_types=CORRIDOR_TYPES) -> Path:
-    """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path."""
+               density_delta: float = 2.5, corridor_types=CORRIDOR_TYPES) -> tuple[Path, list[str]]:
+    """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path
+    and what happened to the signs (also in the YAML's header)."""
     if not xml_path.is_file():
         raise ScenarioError(str(xml_path), "", "KTH floor-plan file not found")
     try:
@@ -131,14 +132,18 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         k = seen.get(str(label), 0) + 1
         seen[str(label)] = k
         raw.append((label if k == 1 else f"{label}/{k}", x, y, 0.0))
-    snapped = snap_signs(free, frame, raw)
+    snapped, report = snap_report(raw, snap_signs(free, frame, raw), frame)
+    links_rooms = sum(1 for sp in spaces if sp.get("name") not in corridors for ls in sp.iter("linesegment")
+                      if ls.get("type") == "Portal" and ls.get("target") not in corridors)
+    report.append(f"{len(raw)} room-to-circulation portals became signs; {links_rooms} portals between rooms "
+                  f"(not reachable from the circulation) did not")
 
-    header = f"imported from {xml_path.name} by `semsearch import kth`"
+    header = f"imported from {xml_path.name} by `semsearch import kth`\n# " + "\n# ".join(report)
     chosen = goals or spread_goals(main, frame, snapped, start)
     scen = scenario_dict(name or xml_path.stem, res, start, chosen, None, density_delta, (frame.origin_x, frame.origin_y))
     path = write_building(out, map_image(free), snapped, scen, header)
     if goals:
-        return path
+        return path, report
     # default goals: only signs the written scenario can read from the start's free space
     world = build_world(parse_scenario(scen, path), out, str(path))
     readable = [lab for lab, *_ in snapped if isinstance(lab, int) and np.isfinite(world.shortest_path(lab))]
@@ -150,4 +155,4 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         ok = spread_goals(main, frame, keep, start)
         scen["goals"] = ok
         path = write_building(out, map_image(free), snapped, scen, header)
-    return path
+    return path, report

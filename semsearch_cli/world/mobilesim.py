@@ -80,6 +80,29 @@ def rasterise(segs: np.ndarray, res: float) -> tuple[np.ndarray, GridFrame]:
     return img.astype(bool), frame
 
 
+MAX_SNAP_M = 2.0  # a sign farther than this from the free space is dropped: no pose there could read it
+
+
+def snap_report(signs: list[tuple], snapped: list[tuple], frame: GridFrame) -> tuple[list[tuple], list[str]]:
+    """Drop the signs that :func:`snap_signs` had to move more than ``MAX_SNAP_M``, and say what
+    happened: how many signs were moved onto the walls (by more than a cell) and how far, how many
+    were dropped, and why. Returns (the signs kept, the lines of the report)."""
+    moved = [float(np.hypot(a[1] - b[1], a[2] - b[2])) for a, b in zip(signs, snapped)]
+    kept = [b for b, m in zip(snapped, moved) if m <= MAX_SNAP_M]
+    lines = []
+    far = [(str(a[0]), m) for a, m in zip(signs, moved) if m > MAX_SNAP_M]
+    near = [m for m in moved if frame.res < m <= MAX_SNAP_M]
+    if near:
+        lines.append(f"snapped {len(near)} of {len(signs)} signs onto the walls of the free space (moved {min(near):.2f}-"
+                     f"{max(near):.2f} m): they stood off the walls the robot drives along")
+    if far:
+        lines.append(f"dropped {len(far)} signs more than {MAX_SNAP_M:g} m from the free space the robot can reach "
+                     f"(no pose could read them): " + ", ".join(f"{n} ({m:.1f} m)" for n, m in far))
+    if not lines:
+        lines.append(f"kept all {len(signs)} signs where they stood (within a cell of the walls)")
+    return kept, lines
+
+
 def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[tuple]:
     """Move each sign onto the nearest wall face of ``free``, facing into the free cell."""
     _, (ir, ic) = ndimage.distance_transform_edt(~free, return_indices=True)
@@ -113,8 +136,9 @@ def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[t
 
 def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0.1,
                      start: tuple[float, float] | None = None, goals: list | None = None,
-                     density_delta: float = 2.5, name: str | None = None) -> Path:
-    """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path."""
+                     density_delta: float = 2.5, name: str | None = None) -> tuple[Path, list[str]]:
+    """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path
+    and what happened to the signs (see :func:`snap_report`; also in the YAML's header)."""
     segs = read_mobilesim_lines(map_path)
     signs = read_mobilesim_doors(doors_path)
     walls, frame = rasterise(segs, res)
@@ -131,14 +155,14 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
     if not (0 <= r < frame.height and 0 <= c < frame.width) or not space[r, c]:
         raise ScenarioError("<command line>", "--start", f"start {start} m is not in free space of {map_path}")
     free = lab == lab[r, c]
-    snapped = snap_signs(free, frame, signs)
+    snapped, report = snap_report(signs, snap_signs(free, frame, signs), frame)
 
     if not goals:
         goals = spread_goals(free, frame, snapped, start)
     scen = scenario_dict(name or map_path.stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
                          density_delta, (frame.origin_x, frame.origin_y))
-    return write_building(out, map_image(free, walls), snapped, scen,
-                          f"imported from {map_path.name} and {doors_path.name} by `semsearch import mobilesim`")
+    header = f"imported from {map_path.name} and {doors_path.name} by `semsearch import mobilesim`\n# " + "\n# ".join(report)
+    return write_building(out, map_image(free, walls), snapped, scen, header), report
 
 
 def spread_goals(free, frame, signs, start, k=4):

@@ -16,15 +16,15 @@ import numpy as np
 from ..errors import ScenarioError
 from ..geometry import GridFrame
 from .files import scenario_dict, write_building
-from .mobilesim import snap_signs, spread_goals
+from .mobilesim import snap_report, snap_signs, spread_goals
 from .ros import FREE, copy_ros_map, read_ros_map
 from .scenario import read_doors
 
 
 def import_ros(map_yaml: Path, doors: Path, out: Path, start: tuple[float, float] | None = None,
-               goals: list | None = None, name: str | None = None, density_delta: float = 2.5) -> Path:
+               goals: list | None = None, name: str | None = None, density_delta: float = 2.5) -> tuple[Path, list[str]]:
     """Write ``out/map.yaml`` (+ image), ``out/doors.csv`` and ``out/scenario.yaml``; returns the
-    scenario's path."""
+    scenario's path and what happened to the signs (also in the YAML's header)."""
     img, res, origin = read_ros_map(map_yaml)
     H, W = img.shape
     frame = GridFrame(res, origin[0], origin[1], H, W)
@@ -42,12 +42,12 @@ def import_ros(map_yaml: Path, doors: Path, out: Path, start: tuple[float, float
     signs = [(d.number, d.x, d.y, d.facing) for d in read_doors(Path(doors))]
     if not signs:
         raise ScenarioError(str(doors), "", "no door signs")
-    snapped = snap_signs(free, frame, signs)
+    snapped, report = snap_report(signs, snap_signs(free, frame, signs), frame)
     if not goals:
         goals = spread_goals(free, frame, snapped, start)
     copy_ros_map(map_yaml, out)
     scen = scenario_dict(name or Path(map_yaml).stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
                          density_delta, origin)
     scen["map"] = {"ros": "map.yaml"}
-    return write_building(out, None, snapped, scen,
-                          f"imported from {Path(map_yaml).name} and {Path(doors).name} by `semsearch import ros`")
+    header = f"imported from {Path(map_yaml).name} and {Path(doors).name} by `semsearch import ros`\n# " + "\n# ".join(report)
+    return write_building(out, None, snapped, scen, header), report
