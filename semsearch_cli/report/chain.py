@@ -6,13 +6,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from ..runner import file_stem
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import plot_chain_paths, plot_chain_stages, plot_scenario
+from .plots import plot_chain_stages, plot_paths_overlay, plot_scenario
 
 
 def chain_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -108,11 +106,7 @@ def _path_figures(doc: Document, parts: list, fdir: Path, notes: list) -> None:
         order = T.planner_order(chains["planner"])
         med = T.median_run(chains)
         for goal in dict.fromkeys(chains["goal"]):
-            paths = {}
-            for r in med[med["goal"] == goal].itertuples(index=False):
-                p = part.folder / "paths" / f"{file_stem(r.planner, goal, int(r.seed))}.npz"
-                if p.is_file():
-                    paths[r.planner] = (np.load(p)["path"], float(r.distance_m))
+            paths = {k: (path, float(r.distance_m)) for k, (path, r) in T.median_paths(part.folder, med, goal, order).items()}
             stages = loaded.task.stages.get(str(goal), [])
             if not paths or not stages:
                 continue
@@ -125,8 +119,7 @@ def _path_figures(doc: Document, parts: list, fdir: Path, notes: list) -> None:
                 label = ", ".join(str(k) for k, _ in ks) + ": " + " / ".join(dict.fromkeys(lab for _, lab in ks))
                 stops.append((label, float(w.signs.x[i]), float(w.signs.y[i])))
             f = fdir / f"chain_paths_{loaded.sc.name}_{goal}.png"
-            plot_chain_paths(w, {k: paths[k] for k in order if k in paths}, stops,
-                             f"{loaded.sc.name}: chain {goal}, median runs", f)
+            plot_paths_overlay(w, paths, stops, f"{loaded.sc.name}: chain {goal}, median runs", f)
             doc.figure(f, f"Chain {goal} ({loaded.sc.name}): the median run of each planner, stages numbered in order")
 
 

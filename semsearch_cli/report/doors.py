@@ -66,15 +66,13 @@ def _figures(doc, runs, parts, fdir: Path, replay: bool, notes: list) -> None:
             continue
         rows = run_rows(part.runs)
         med = T.median_run(rows)
+        w = loaded.world
         for goal in sorted(med["goal"].unique(), key=goal_key):
-            paths = {}
-            for _, r in med[med["goal"] == goal].iterrows():
-                p = part.folder / "paths" / f"{file_stem(r['planner'], goal, int(r['seed']))}.npz"
-                if p.is_file():
-                    paths[r["planner"]] = (np.load(p)["path"], float(r["distance_m"]))
+            paths = {k: (path, float(r.distance_m)) for k, (path, r) in T.median_paths(part.folder, med, goal, order).items()}
             if paths:
                 f = fdir / f"paths_{loaded.sc.name}_goal{goal}.png"
-                plot_paths_overlay(loaded.world, {k: paths[k] for k in order if k in paths}, loaded.task.goal_value(goal),
+                i = w.signs.index_of(loaded.task.goal_value(goal))
+                plot_paths_overlay(w, paths, [(f"goal {goal}", float(w.signs.x[i]), float(w.signs.y[i]))],
                                    f"{loaded.sc.name}: median runs, goal {goal}", f)
                 doc.figure(f, f"Median run of each planner for goal {goal} ({loaded.sc.name})")
         if replay:

@@ -12,7 +12,7 @@ import pandas as pd
 
 from ..belief.heatmap import heat_map
 from ..planners import LsosParams, lsos_goals
-from ..runner import file_stem, run_rows
+from ..runner import run_rows
 from ..tasks.objects import parse_label, read_log
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
@@ -123,14 +123,10 @@ def _figures(doc, runs, part, fdir: Path, notes: list) -> None:
                 f = fdir / f"heat_steps_{stem}.png"
                 _heat_steps(task, world, _log(folder, loaded, req.case), req, LsosParams(**params), f)
                 doc.figure(f, f"How the heat map for {label} is built (thesis Figures 5.7-5.8)")
-        paths = {}
-        for _, r in med[med["goal"] == label].iterrows():
-            p = folder / "paths" / f"{file_stem(r['planner'], label, int(r['seed']))}.npz"
-            if p.is_file():
-                paths[r["planner"]] = (np.load(p)["path"], float(r["distance_m"]), r["outcome"])
+        paths = {k: (path, float(r.distance_m), r.outcome) for k, (path, r) in T.median_paths(folder, med, label, order).items()}
         if paths:
             f = fdir / f"paths_{stem}.png"
-            plot_object_paths(world, {k: paths[k] for k in order if k in paths}, task.places, req.truth,
+            plot_object_paths(world, paths, task.places, req.truth,
                               f"{req.case}: {req.cls} at {req.hour:g}:00, median run of each planner", f)
             doc.figure(f, f"Median runs for {label}")
 

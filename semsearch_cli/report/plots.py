@@ -122,22 +122,9 @@ def plot_boxes(runs, scenario: str, order: list, out: Path) -> None:
     _save(fig, out)
 
 
-def plot_paths_overlay(world, paths: dict, goal, title: str, out: Path) -> None:
-    """The median run of each planner variant for one goal, overlaid on the ground-truth map."""
-    fig, ax = _map_figure(world)
-    ax.scatter(world.signs.x, world.signs.y, s=5, c="#9999cc")
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for k, (lab, (path, dist)) in enumerate(paths.items()):
-        ax.plot(path[:, 0], path[:, 1], "-", lw=1.3, c=colors[k % len(colors)], label=f"{lab}: {dist:.1f} m", alpha=0.85)
-    ax.plot(*world.start_xy, "s", c="tab:green", ms=8, label="start")
-    i = world.signs.index_of(goal)
-    ax.plot(world.signs.x[i], world.signs.y[i], "*", c="tab:red", ms=14, label=f"goal {goal}")
-    _finish_map(fig, ax, title, out)
-
-
-def plot_chain_paths(world, paths: dict, stops: list, title: str, out: Path) -> None:
-    """The median run of each planner over one whole chain, with the stage doors numbered in the
-    order the chain visits them (``stops``: (label, x, y))."""
+def plot_paths_overlay(world, paths: dict, stops: list, title: str, out: Path) -> None:
+    """The median run of each planner variant, overlaid on the ground-truth map, with the signs
+    it sought marked and labelled (``stops``: (label, x, y): a goal, or a chain's doors in order)."""
     fig, ax = _map_figure(world)
     ax.scatter(world.signs.x, world.signs.y, s=5, c="#9999cc")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]

@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
+import numpy as np
 import pandas as pd
 from scipy.stats import mannwhitneyu
+
+from ..runner import file_stem
 
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     """Per scenario x goal x planner variant: n, success rate, median, mean, std (ddof=1, as the
@@ -23,6 +27,18 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
         mean_ratio=("ratio", "mean"),
     ).reset_index()
     return out.round(3)
+
+
+def median_paths(folder: Path, med: pd.DataFrame, goal, order: list) -> dict:
+    """Planner label -> (path (n, 2) m, its row) of the median run of each planner for ``goal``
+    (``med`` from :func:`median_run`), in ``order``, for the runs whose path file is in
+    ``folder/paths``."""
+    out = {}
+    for r in med[med["goal"].astype(str) == str(goal)].itertuples(index=False):
+        p = folder / "paths" / f"{file_stem(r.planner, goal, int(r.seed))}.npz"
+        if p.is_file():
+            out[r.planner] = (np.load(p)["path"], r)
+    return {k: out[k] for k in order if k in out}
 
 
 def median_run(runs: pd.DataFrame) -> pd.DataFrame:
