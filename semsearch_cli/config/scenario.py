@@ -131,15 +131,20 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
         raise ScenarioError(str(file), field, msg) from None
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario YAML file."""
+def read_yaml(path: str | Path, what: str = "file", owner: str | None = None, field: str = "") -> Any:
+    """A YAML file's contents; a missing file or bad YAML is a :class:`ScenarioError` naming the
+    file (or ``owner`` and ``field``, the scenario that named it) and the line."""
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(str(path), "", "file not found")
+        raise ScenarioError(owner or str(path), field, f"{what} {path} not found" if owner else f"{what} not found")
     try:
-        data = yaml.safe_load(path.read_text())
+        return yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ScenarioError(str(path), "", f"not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
-    return parse_scenario(data, path)
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario YAML file."""
+    return parse_scenario(read_yaml(path), path)

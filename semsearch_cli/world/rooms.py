@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..config import read_yaml
 from ..config.indirect import CATEGORIES, MasksSpec
 from ..errors import ScenarioError
 from ..geometry import GridFrame
@@ -165,12 +166,7 @@ def write_rooms(path: Path, rooms: list[Room]) -> Path:
 def read_rooms(path: Path, target: str, secondary: list[str]) -> list[Room]:
     """Rooms from a rooms.yaml; errors name the file and the field."""
     path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(str(path), "", "rooms file not found")
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ScenarioError(str(path), "", f"not valid YAML: {exc}") from None
+    data = read_yaml(path, "rooms file")
     if not isinstance(data, dict) or not isinstance(data.get("rooms"), list) or not data["rooms"]:
         raise ScenarioError(str(path), "rooms", "expected a list of rooms")
     try:

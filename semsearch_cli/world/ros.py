@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 import yaml
 
+from ..config import read_yaml
 from ..errors import ScenarioError
 
 WALL, UNKNOWN, FREE = 0, 128, 255
@@ -26,13 +27,7 @@ WALL, UNKNOWN, FREE = 0, 128, 255
 def read_ros_yaml(path: Path, owner: str | None = None) -> dict:
     """The map's YAML, checked; errors name the file and the key."""
     path = Path(path)
-    where = owner or str(path)
-    if not path.is_file():
-        raise ScenarioError(where, "map.ros", f"ROS map file {path} not found")
-    try:
-        d = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ScenarioError(str(path), "", f"not valid YAML: {exc}") from None
+    d = read_yaml(path, "ROS map file", owner, "map.ros" if owner else "")
     if not isinstance(d, dict):
         raise ScenarioError(str(path), "", "expected the map_server keys (image, resolution, origin, ...)")
     for key in ("image", "resolution", "origin"):
