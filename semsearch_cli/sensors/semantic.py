@@ -64,10 +64,17 @@ class SemanticCamera:
             self._lut[cls] = np.asarray(self.spec.lut(cls), float) / 100.0
         return self._lut[cls]
 
-    def probability(self, cls: str, r: float, seen_yaw_deg: float) -> float:
-        """Detection probability of ``cls`` at distance ``r`` (m) seen at yaw ``seen_yaw_deg``."""
-        row = int(round((seen_yaw_deg % 360.0) / 45.0)) % len(LUT_YAWS)
-        return float(np.interp(r, LUT_DISTANCES, self.table(cls)[row]))
+    def probability(self, cls: str, r, seen_yaw_deg):
+        """Detection probability of ``cls`` at distance ``r`` (m) seen at yaw ``seen_yaw_deg``
+        (scalars, or arrays of one shape): the nearest yaw row, interpolated in distance."""
+        row = np.round((np.asarray(seen_yaw_deg, float) % 360.0) / 45.0).astype(np.int64) % len(LUT_YAWS)
+        r = np.asarray(r, float)
+        table = self.table(cls)
+        out = np.zeros(np.broadcast(r, row).shape)
+        for b in np.unique(row):
+            m = np.broadcast_to(row == b, out.shape)
+            out[m] = np.interp(np.broadcast_to(r, out.shape)[m], LUT_DISTANCES, table[b])
+        return float(out) if out.ndim == 0 else out
 
     def mean_table(self, cls: str) -> np.ndarray:
         """The table's mean over the eight yaws, per distance column."""
@@ -81,9 +88,10 @@ class SemanticCamera:
         return np.interp(r, LUT_DISTANCES, self.mean_table(cls))
 
     # ---- geometry ---------------------------------------------------------------------------
-    def to_camera(self, dx, dy, dz, heading: float):
-        """Eq. 37: world offsets from the camera (m) -> camera frame (x forward, y right, z up)."""
-        c, s = math.cos(heading), math.sin(heading)
+    def to_camera(self, dx, dy, dz, heading):
+        """Eq. 37: world offsets from the camera (m) -> camera frame (x forward, y right, z up);
+        scalars or arrays that broadcast together."""
+        c, s = (math.cos(heading), math.sin(heading)) if np.isscalar(heading) else (np.cos(heading), np.sin(heading))
         xr, yr = c * dx + s * dy, -s * dx + c * dy  # robot frame: x forward, y left
         cp, sp = math.cos(self.pitch), math.sin(self.pitch)
         return cp * xr - sp * dz, -yr, sp * xr + cp * dz
@@ -99,14 +107,9 @@ class SemanticCamera:
         poses = np.asarray(poses, float).reshape(-1, 3)
         dx = np.asarray(xs, float)[None, :] - poses[:, :1]
         dy = np.asarray(ys, float)[None, :] - poses[:, 1:2]
-        c, s = np.cos(poses[:, 2:3]), np.sin(poses[:, 2:3])
-        xr, yr = c * dx + s * dy, -s * dx + c * dy
-        dz = self.object_height - self.spec.height
-        cp, sp = math.cos(self.pitch), math.sin(self.pitch)
-        xc, zc = cp * xr - sp * dz, sp * xr + cp * dz
-        r = np.sqrt(xc * xc + yr * yr + zc * zc)
-        return ((xc > 0) & (np.abs(yr) <= self.tan_h * xc) & (np.abs(zc) <= self.tan_v * xc)
-                & (r >= self.spec.min_depth) & (r <= max_range))
+        xc, yc, zc = self.to_camera(dx, dy, self.object_height - self.spec.height, poses[:, 2:3])
+        r = np.sqrt(xc * xc + yc * yc + zc * zc)
+        return self.in_view(r, np.arctan2(yc, xc), np.arctan2(zc, xc), xc, max_range)
 
     # ---- ground truth -----------------------------------------------------------------------
     def visible(self, room, x: float, y: float, heading: float, ranges: dict[str, float]) -> list[Seen]:

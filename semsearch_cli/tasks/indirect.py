@@ -26,7 +26,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..belief.indirect import IndirectBelief, relation_mask
-from ..config.indirect import CATEGORIES, LUT_DISTANCES
+from ..config.indirect import CATEGORIES
 from ..errors import ScenarioError
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
@@ -337,13 +337,7 @@ class IndirectTask(Task):
             down = np.arctan2(-dz, h)  # angle below the horizon
             ok = (r >= self.spec.camera.min_depth) & (r <= scale) & (np.abs(down - cam.pitch) <= cam.half_v) & g.stand
             seen_yaw = np.degrees(np.arctan2(cy - t.y, cx - t.x)) - t.yaw
-            row = np.round((seen_yaw % 360.0) / 45.0).astype(np.int64) % 8
-            table = cam.table(self.spec.target)
-            p = np.zeros(ok.shape)
-            for b in range(8):
-                m = ok & (row == b)
-                p[m] = np.interp(r[m], LUT_DISTANCES, table[b])
-            ok &= p > 0
+            ok &= cam.probability(self.spec.target, r, seen_yaw) > 0
             if g.blocked.any():
                 occ = g.blocked
                 v0, u0 = fr.to_cell(t.x, t.y)
