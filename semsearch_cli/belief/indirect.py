@@ -103,7 +103,6 @@ class RelationMask:
     """A class's mixed mask split as R = local + kappa (see the module's docstring), with what
     the convolutions need: the local kernel's FFT at the padded size, and S."""
 
-    local: np.ndarray  # (2r + 1, 2r + 1), centred
     kappa: float
     full_centre: tuple[int, int]
     full: np.ndarray  # the whole mixed mask, for positive detections
@@ -137,7 +136,7 @@ def relation_mask(kind: str, m: MasksSpec, co: tuple, res: float, H: int, W: int
     ones = np.zeros(shape)
     ones[:H, :W] = 1.0
     S = sfft.irfft2(sfft.rfft2(ones) * sfft.rfft2(k), s=shape)[:H, :W] + kappa * H * W
-    return RelationMask(local, float(kappa), (ci, cj), full, S, sfft.rfft2(k.astype(np.float32)), shape)
+    return RelationMask(float(kappa), (ci, cj), full, S, sfft.rfft2(k.astype(np.float32)), shape)
 
 
 def convolve_local(images: np.ndarray, mask: RelationMask) -> np.ndarray:
@@ -182,7 +181,6 @@ class IndirectBelief:
         self._factor = np.ones(shape)  # product of the pending likelihood images
         self._factor0 = 1.0
         self._negatives: dict[str, list[np.ndarray]] = {c: [] for c in masks}
-        self.frames = 0
 
     # ---- observations (pending until flush) --------------------------------------------------
     def not_seen_main(self, D: np.ndarray) -> None:
@@ -231,12 +229,6 @@ class IndirectBelief:
             self.p, self.p0 = p / z, p0 / z
         self._factor = np.ones((self.H, self.W))
         self._factor0 = 1.0
-
-    def update(self, like: np.ndarray, like0: float) -> None:
-        """One Bayes step with a likelihood image and the outside cell's likelihood (Eqs. 6-9)."""
-        self._factor *= like
-        self._factor0 *= like0
-        self.flush()
 
     def probability(self) -> tuple[np.ndarray, float]:
         """(p(a_ij), p(a_0)) after folding in everything observed so far."""

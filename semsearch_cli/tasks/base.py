@@ -142,9 +142,14 @@ class Task:
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
                          np.asarray(st.trail, np.float32), sorted(st.read_signs), out.trace)
 
+    def shortest_for(self, goal, seed: int) -> float:
+        """The shortest path (m) of run ``seed`` for ``goal`` (the same for every seed unless a
+        task varies its world by seed)."""
+        return self.shortest.get(self.goal_value(goal), float("nan"))
+
     def rows(self, variant: Variant, goal, seed: int, res: RunResult) -> list[dict]:
         """The rows of one finished run: its own, then any per-stage rows."""
-        row = run_row(self.kind, self.sc.name, variant, goal, seed, res, self.shortest.get(self.goal_value(goal), float("nan")),
+        row = run_row(self.kind, self.sc.name, variant, goal, seed, res, self.shortest_for(goal, seed),
                       self.sc.navigation.navigator)
         return [row] + [{**row, **s} for s in res.stages]
 

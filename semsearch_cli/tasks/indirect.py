@@ -49,6 +49,7 @@ class RoomGrid:
     stand: np.ndarray
     cost: np.ndarray
     search: GridSearch
+    full_from: tuple = (-1, -1, -1)  # (row, col, search generation) of the last whole-room search
 
     @classmethod
     def of(cls, room: Room, res: float, radius: float) -> "RoomGrid":
@@ -68,6 +69,7 @@ class RoomGrid:
         r, c = (int(v) for v in self.frame.to_index(x, y))
         r, c = min(max(r, 0), self.frame.height - 1), min(max(c, 0), self.frame.width - 1)
         self.search.run(self.stand, self.cost, r, c, np.zeros(0, np.int64), np.zeros(0, np.int64), 0)
+        self.full_from = (r, c, self.search.gen)  # a whole-room search: path() can backtrack in it
         done = self.search.closed == self.search.gen
         return np.where(done, self.search.length_ * self.frame.res, np.inf)
 
@@ -81,7 +83,8 @@ class RoomGrid:
         if not (0 <= tr < H and 0 <= tc < W and self.stand[tr, tc]):
             return None
         r, c = min(max(r, 0), H - 1), min(max(c, 0), W - 1)
-        if self.search.run(self.stand, self.cost, r, c, np.array([tr]), np.array([tc]), 1) < 1:
+        reuse = self.full_from == (r, c, self.search.gen) and self.search.settled(tr, tc)
+        if not reuse and self.search.run(self.stand, self.cost, r, c, np.array([tr]), np.array([tc]), 1) < 1:
             return None
         rows, cols = self.search.path(tr, tc)
         occ = ~self.stand
@@ -388,10 +391,9 @@ class IndirectTask(Task):
         outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move)
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
 
-    def rows(self, variant, goal, seed, res):
-        scale = float(self.goal_value(goal))
-        self.shortest[scale] = self.shortest_of(seed % len(self.grids), scale)
-        return super().rows(variant, scale, seed, res)
+    def shortest_for(self, goal, seed: int) -> float:
+        """Run ``seed`` searches room ``seed mod n``: its own shortest path."""
+        return self.shortest_of(seed % len(self.grids), float(self.goal_value(goal)))
 
     def describe(self):
         spec = self.spec
