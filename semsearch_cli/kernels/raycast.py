@@ -89,6 +89,19 @@ def cast_rays(occ, v0, u0, thetas, max_cells):
     return dist, hit
 
 
+@njit(cache=True, inline="always")
+def _grow(bbox, r, c):
+    """Grow the box (r0, r1, c0, c1), inclusive, to hold cell (r, c)."""
+    if r < bbox[0]:
+        bbox[0] = r
+    if r > bbox[1]:
+        bbox[1] = r
+    if c < bbox[2]:
+        bbox[2] = c
+    if c > bbox[3]:
+        bbox[3] = c
+
+
 @njit(cache=True)
 def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
     """Histogramic in-motion mapping update (Borenstein and Koren 1991) for one scan.
@@ -132,14 +145,7 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
                 x = int(cv[r, c]) - dec
                 cv[r, c] = 0 if x < 0 else x
                 seen[r, c] = True
-                if r < bbox[0]:
-                    bbox[0] = r
-                if r > bbox[1]:
-                    bbox[1] = r
-                if c < bbox[2]:
-                    bbox[2] = c
-                if c > bbox[3]:
-                    bbox[3] = c
+                _grow(bbox, r, c)
             if tmr < tmc:
                 t = tmr
                 tmr += tdr
@@ -152,14 +158,7 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
             x = int(cv[hr, hc]) + inc
             cv[hr, hc] = cv_max if x > cv_max else x
             seen[hr, hc] = True
-            if hr < bbox[0]:
-                bbox[0] = hr
-            if hr > bbox[1]:
-                bbox[1] = hr
-            if hc < bbox[2]:
-                bbox[2] = hc
-            if hc > bbox[3]:
-                bbox[3] = hc
+            _grow(bbox, hr, hc)
 
 
 @njit(cache=True)
