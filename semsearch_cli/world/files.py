@@ -50,6 +50,21 @@ def fill_box(img: np.ndarray, res: float, x0: float, x1: float, y0: float, y1: f
     img[max(0, r0) : r1, max(0, c0) : c1] = value
 
 
+def corridor_floor(width_m: float, height_m: float, wall_m: float, corridor: tuple[float, float], res: float):
+    """A walled floor (free inside the outer wall) with a corridor along x between the walls at
+    y = ``corridor`` (lo, hi): (the image, ``box(x0, x1, y0, y1, value)`` painting onto it)."""
+    img = np.zeros((int(round(height_m / res)), int(round(width_m / res))), np.uint8)
+
+    def box(x0, x1, y0, y1, v):
+        fill_box(img, res, x0, x1, y0, y1, v)
+
+    lo, hi = corridor
+    box(wall_m, width_m - wall_m, wall_m, height_m - wall_m, 255)
+    box(0, width_m, hi, hi + wall_m, 0)  # the corridor's walls
+    box(0, width_m, lo - wall_m, lo, 0)
+    return img, box
+
+
 def write_doors(path: Path, signs) -> None:
     """A doors CSV (number,x,y,facing) from (label, x m, y m, facing degrees) tuples."""
     with path.open("w") as fh:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .files import fill_box
+from .files import corridor_floor
 
 WIDTH_M, HEIGHT_M = 44.0, 20.0
 WALL_M = 0.15
@@ -43,16 +43,8 @@ def rooms() -> list[tuple[int, float, float, str]]:
 
 def hospital_image(res: float = 0.1) -> np.ndarray:
     """(H, W) uint8 map: 255 free, 0 wall."""
-    H, W = int(round(HEIGHT_M / res)), int(round(WIDTH_M / res))
-    img = np.zeros((H, W), np.uint8)
-
-    def box(x0, x1, y0, y1, v):
-        fill_box(img, res, x0, x1, y0, y1, v)
-
-    box(WALL_M, WIDTH_M - WALL_M, WALL_M, HEIGHT_M - WALL_M, 255)
+    img, box = corridor_floor(WIDTH_M, HEIGHT_M, WALL_M, CORRIDOR, res)
     lo, hi = CORRIDOR
-    box(0, WIDTH_M, hi, hi + WALL_M, 0)  # the corridor's walls
-    box(0, WIDTH_M, lo - WALL_M, lo, 0)
     box(CROSS[0] - WALL_M, CROSS[0], 0, HEIGHT_M, 0)  # the cross corridor's walls
     box(CROSS[1], CROSS[1] + WALL_M, 0, HEIGHT_M, 0)
     box(CROSS[0], CROSS[1], 0, HEIGHT_M, 255)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .files import fill_box
+from .files import corridor_floor
 
 WIDTH_M, HEIGHT_M = 20.5, 14.5
 WALL_M = 0.15
@@ -40,16 +40,8 @@ TABLE_5_1 = {
 
 def office_image(res: float = 0.05) -> np.ndarray:
     """(H, W) uint8 map: 255 free, 0 wall."""
-    H, W = int(round(HEIGHT_M / res)), int(round(WIDTH_M / res))
-    img = np.zeros((H, W), np.uint8)
-
-    def box(x0, x1, y0, y1, v):
-        fill_box(img, res, x0, x1, y0, y1, v)
-
-    box(WALL_M, WIDTH_M - WALL_M, WALL_M, HEIGHT_M - WALL_M, 255)
+    img, box = corridor_floor(WIDTH_M, HEIGHT_M, WALL_M, CORRIDOR, res)
     lo, hi = CORRIDOR
-    box(0, WIDTH_M, hi, hi + WALL_M, 0)
-    box(0, WIDTH_M, lo - WALL_M, lo, 0)
     for x in TOP_SPLITS:
         box(x, x + WALL_M, hi, HEIGHT_M, 0)
     for x in BOTTOM_SPLITS:
