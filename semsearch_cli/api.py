@@ -7,13 +7,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
+import yaml
 
-from .config import PlannerSpec, load_scenario
+from .config import PlannerSpec, load_scenario, read_yaml, with_param
 from .errors import ScenarioError
 from .planners import expand_variants
 from .report import build as report_build
-from .report.plots import plot_alpha_sweep
-from .report.tables import summarise
+from .report.document import atomic_text, markdown_table
+from .report.plots import plot_alpha_sweep, plot_sweep
+from .report.tables import summarise, sweep_table
 from .runner import Loaded, expand, run_batch, run_rows
 from .tasks.objects import write_log
 
@@ -90,6 +92,59 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = N
     (res.out / "plots").mkdir(parents=True, exist_ok=True)
     plot_alpha_sweep(run_rows(res.runs)[run_rows(res.runs)["planner"].isin(labels)], res.out / "plots" / "alpha_sweep.png")
     return res
+
+
+@dataclass
+class SweepOutput:
+    out: Path
+    runs: pd.DataFrame  # every run, with the parameter's value in column ``value``
+    table: pd.DataFrame
+
+
+def parse_param(text: str) -> tuple[str, list]:
+    """``SECTION.FIELD=V1,V2,...`` -> (dotted name, values read as YAML scalars)."""
+    name, eq, vals = text.partition("=")
+    items = [v.strip() for v in vals.split(",") if v.strip()]
+    if not eq or not name.strip() or not items:
+        raise ScenarioError("<command line>", "--param", f"expected SECTION.FIELD=V1,V2,... (e.g. door_camera.p_misread=0,0.05,0.1), got {text!r}")
+    values = []
+    for v in items:
+        try:
+            values.append(yaml.safe_load(v))
+        except yaml.YAMLError:
+            raise ScenarioError("<command line>", "--param", f"cannot read the value {v!r}") from None
+    return name.strip(), values
+
+
+def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = None, workers: int | None = None,
+          goals=None, planners=None, out: str | Path | None = None, progress=None, trace: bool = False) -> SweepOutput:
+    """Run a scenario once per value of one parameter (see
+    :func:`~semsearch_cli.config.with_param`): each value's rows go to ``out/<param>=<value>/``
+    (resumable, as :func:`run`), then ``sweep.csv``, ``sweep.md`` and ``sweep.png`` compare them.
+    Every value is checked before anything runs."""
+    path = Path(scenario)
+    data = read_yaml(path)
+    loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
+    out_dir = Path(out) if out else Path("results") / f"{loaded[0].sc.name}-sweep-{param}"
+    frames = []
+    for v, ld in zip(values, loaded):
+        specs = expand(ld, seeds, goals, planners)
+        if not specs:
+            raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
+        sub = out_dir / f"{param}={v}"
+        report_build.write_meta(sub, ld.path)
+        ld.task.write_inputs(sub)
+        runs = run_batch(ld, specs, sub, workers or default_workers(), progress, trace)
+        write_summary(runs, sub)
+        frames.append(run_rows(runs).assign(value=v))
+    runs = pd.concat(frames, ignore_index=True)
+    table = sweep_table(runs, param)
+    tmp = out_dir / ".sweep.csv.tmp"
+    table.to_csv(tmp, index=False)
+    os.replace(tmp, out_dir / "sweep.csv")
+    atomic_text(out_dir / "sweep.md", markdown_table(table, fmt="{:g}") + "\n")
+    plot_sweep(table, param, out_dir / "sweep.png")
+    return SweepOutput(out_dir, runs, table)
 
 
 def write_summary(runs: pd.DataFrame, out_dir: Path) -> pd.DataFrame:

@@ -17,6 +17,7 @@ from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .errors import ScenarioError
 from .report.build import console_tables
+from .world.generate import SCHEMES
 from .world.generate import generate_batch as gen_batch
 from .world.generate import generate_building as gen_building
 from .world.rooms import generate_rooms as gen_rooms
@@ -85,8 +86,35 @@ def sweep_alpha(
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
 
-def _batch(call):
-    """Run a batch with a progress bar, print its summary; bad input exits with status 2."""
+@app.command()
+def sweep(
+    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    param: str = typer.Option(..., "--param", help="SECTION.FIELD=V1,V2,... e.g. door_camera.p_misread=0,0.02,0.05,0.1, "
+                              "or PLANNER.PARAM=... e.g. nsos.alpha=0.8,0.9,1.0."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and variant (default: the scenario's)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
+    goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
+    planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label."),
+    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>-sweep-<param>)."),
+    trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
+):
+    """Run a scenario once per value of one parameter: each value's rows in <out>/<param>=<value>/
+    (resumable), then sweep.csv, sweep.md and sweep.png (mean ratio to the shortest path and success
+    rate against the value, per goal and planner)."""
+
+    try:
+        name, values = api.parse_param(param)
+    except ScenarioError as exc:
+        _fail(exc)
+    res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal), _split(planner), out_dir,
+                                                progress=tick, trace=trace))
+    _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
+    _warn_errors(res.runs)
+    out.print(escape(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv"))
+
+
+def _with_progress(call):
+    """Call ``call(tick)`` under a progress bar; bad input exits with status 2."""
     try:
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       TimeRemainingColumn(), console=err, transient=False, disable=not err.is_terminal) as prog:
@@ -99,15 +127,24 @@ def _batch(call):
                 prog.advance(task)
                 prog.update(task, description=f"{row['planner']} goal {row['goal']} seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m")
 
-            res = call(tick)
+            return call(tick)
     except ScenarioError as exc:
         _fail(exc)
-    for title, df in console_tables(res.runs):
-        _print_table(title, df)
-    errors = res.runs[res.runs["outcome"] == "error"]
+
+
+def _warn_errors(runs) -> None:
+    errors = runs[runs["outcome"] == "error"]
     if len(errors):
         err.print(escape(f"warning: {len(errors)} run(s) raised an error (outcome error in runs.csv), e.g. "
                          f"{errors['planner'].iloc[0]}: {errors['message'].iloc[0]}"), highlight=False)
+
+
+def _batch(call):
+    """Run a batch with a progress bar, print its summary; bad input exits with status 2."""
+    res = _with_progress(call)
+    for title, df in console_tables(res.runs):
+        _print_table(title, df)
+    _warn_errors(res.runs)
     out.print(escape(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {res.out / 'figures'}  "
                      f"report: {res.out / 'report.md'}"))
     return res
@@ -226,7 +263,7 @@ app.add_typer(generate_app, name="generate")
 @generate_app.command("building")
 def generate_building(
     layout: str = typer.Option(..., "--layout", help="grid, wings, angled or single."),
-    numbering: str = typer.Option(..., "--numbering", help="odd-even-out, odd-even-in, floor, blocks or random."),
+    numbering: str = typer.Option(..., "--numbering", help=", ".join(SCHEMES) + "."),
     seed: int = typer.Option(0, "--seed", help="Seed of the layout's variations (and of random numbering)."),
     out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
     spacing: float = typer.Option(2.5, "--spacing", min=0.5, help="m between door slots along a wall."),

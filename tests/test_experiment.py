@@ -3,6 +3,7 @@
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli import api
@@ -130,3 +131,75 @@ def test_goal_behind_a_mid_corridor_start_is_found(tmp_path):
     res = build_task(sc, world, p).run(Variant("greedy", ()), s.number[behind], 0)
     assert res.outcome == "found"
     assert res.path[:, 0].max() > L.sc.start.x + 20  # it went east first, then came back
+
+
+def dead_end_scenario(tmp_path):
+    """A 2 m x 21.6 m corridor with goal 99 on its east end wall, facing down the corridor: side
+    cameras read it only from a robot turned across the corridor near the end. The old search
+    drove to both ends (a U-turn flips the heading in one step) and stopped ``stuck`` after
+    29.7 m with greedy, though the sign is readable 10.5 m from the start."""
+    from semsearch_cli.world.files import fill_box, scenario_dict, write_building
+
+    img = np.zeros((30, 220), np.uint8)
+    fill_box(img, 0.1, 0.2, 21.8, 0.5, 2.5, 255)
+    signs = [(99, 21.8, 1.5, 180.0), (101, 5.0, 2.5, 270.0), (102, 8.0, 0.5, 90.0), (103, 14.0, 2.5, 270.0)]
+    sc = scenario_dict("deadend", 0.1, (11.0, 1.5), [99], planners=[{"name": n} for n in ("greedy", "bvp", "nsos", "draft")])
+    sc["start"]["heading"] = 0.0
+    return write_building(tmp_path, img, signs, sc, "dead-end regression map")
+
+
+def test_a_sign_readable_only_by_turning_is_found(tmp_path):
+    """Completeness: with no frontier left, the robot goes back to the wall faces its cameras
+    have not looked at from within reading range, and looks round there."""
+    from semsearch_cli.runner import Loaded
+
+    L = Loaded.load(dead_end_scenario(tmp_path))
+    for v in L.task.variants():
+        res = L.task.run(v, 99, 0)
+        assert res.outcome == "found", v.label
+        assert res.distance_m >= L.shortest[99] - 0.5
+    res = L.task.run(Variant("greedy", ()), 99, 0)
+    assert 40 < res.distance_m < 60  # both ends first (29.7 m, where it used to stop), then back east
+
+
+def test_a_goal_nobody_can_read_ends_stuck_not_in_a_loop(tmp_path):
+    """The sweep gives up on each wall face once it has looked round near it: a goal read only
+    through a misread that never happens ends ``stuck`` well within the budget."""
+    from semsearch_cli.runner import Loaded
+
+    p = dead_end_scenario(tmp_path)
+    d = yaml.safe_load(p.read_text())
+    d["door_camera"] = {"p_read": 0.0}  # the cameras never read anything
+    p.write_text(yaml.safe_dump(d))
+    L = Loaded.load(p)
+    res = L.task.run(Variant("greedy", ()), 99, 0)
+    assert res.outcome == "stuck"
+    assert res.distance_m < 200
+
+
+def test_sweep_runs_one_folder_per_value(demo_dir, tmp_path):
+    out = tmp_path / "sw"
+    r = CliRunner().invoke(app, ["sweep", str(demo_dir / "scenario.yaml"), "--param", "door_camera.p_misread=0,0.5",
+                                 "--seeds", "2", "--planner", "greedy", "--goal", "452", "--workers", "1", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    table = pd.read_csv(out / "sweep.csv")
+    assert table["door_camera.p_misread"].tolist() == [0.0, 0.5]
+    assert table["n"].tolist() == [2, 2] and set(table["planner"]) == {"greedy"}
+    for v in ("0", "0.5"):
+        rows = pd.read_csv(out / f"door_camera.p_misread={v}" / "runs.csv")
+        assert len(rows) == 2
+    assert (out / "sweep.png").stat().st_size > 0 and "| door_camera.p_misread |" in (out / "sweep.md").read_text()
+    # value 0 is the scenario itself: the same rows as a plain run
+    plain = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, goals=[452], planners=["greedy"], out=tmp_path / "plain", plots=False)
+    a = pd.read_csv(out / "door_camera.p_misread=0" / "runs.csv").sort_values("seed")
+    assert a["distance_m"].tolist() == plain.runs.sort_values("seed")["distance_m"].tolist()
+
+
+@pytest.mark.parametrize("param,field", [("door_camera.p_misread=2", "door_camera.p_misread"), ("camera.range=3", "--param"),
+                                         ("p_misread=0.1", "--param"), ("door_camera.p_misread", "--param"),
+                                         ("bvp.bogus=1", "planners[1]")])
+def test_sweep_bad_param_exits_2(demo_dir, tmp_path, param, field):
+    r = CliRunner().invoke(app, ["sweep", str(demo_dir / "scenario.yaml"), "--param", param, "--out", str(tmp_path / "x")])
+    assert r.exit_code == 2, r.output
+    assert field in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "x").exists()  # every value is checked before anything runs

@@ -194,3 +194,33 @@ def test_rolling_histogram_matches_the_plain_one():
     for _ in range(12):
         items.extend(rng.uniform(-math.pi, math.pi, int(rng.integers(0, 30))).tolist())
         assert np.allclose(rh.update(items), heading_histogram(items[-50:], 18, fold=False))
+
+
+# ---- the draft paper's planner (SPEC 4: tau + Omega + alpha Gamma) ------------------------------
+def test_draft_parity_attraction_follows_the_authors_code():
+    from semsearch_cli.planners.doors.draft import parity_attraction
+
+    assert parity_attraction([], 101, 0.1) == 0.5  # no sign counts: neutral
+    assert parity_attraction([101, 103, 105], 101, 0.1) == pytest.approx(0.65)  # bel 0.3, diff 0
+    # only the other parity: bel 0, diff = -0.2, 0.5 + (0 - 0.04) / 2
+    assert parity_attraction([102, 104], 101, 0.1) == pytest.approx(0.48)
+    assert parity_attraction(list(range(101, 121, 2)), 101, 0.1) == 1.0  # ten of the goal's parity: full belief
+    assert parity_attraction(list(range(102, 122, 2)), 101, 0.1) == 0.0  # ten of the other: none
+    assert parity_attraction([102], 102, 0.1) == pytest.approx(0.55)  # even goals alike
+
+
+def test_draft_growing_attraction_eqs_9_10():
+    from semsearch_cli.planners.doors.draft import growing_attraction
+
+    nums, xs, ys = np.array([101, 103]), np.array([0.0, 3.0]), np.zeros(2)  # increasing toward +x
+    # goal bigger than every sign: toward FF; one vector over max(w_g = 8, 1): GG = 1/8
+    assert growing_attraction(nums, xs, ys, 107, 0.0, 8) == pytest.approx(0.5 + 1 / 16)
+    assert growing_attraction(nums, xs, ys, 107, math.pi, 8) == pytest.approx(0.5 - 1 / 16)
+    assert growing_attraction(nums, xs, ys, 107, math.pi / 2, 8) == pytest.approx(0.5)  # TT = pi/2: TT' = 0
+    # goal smaller than every sign: toward FF - pi
+    assert growing_attraction(nums, xs, ys, 99, math.pi, 8) == pytest.approx(0.5 + 1 / 16)
+    # SMALLER < g < BIGGER: 0.5 whatever the direction
+    assert growing_attraction(np.array([101, 109]), xs, ys, 105, 0.0, 8) == 0.5
+    assert growing_attraction(np.array([101]), np.zeros(1), np.zeros(1), 107, 0.0, 8) == 0.5  # no direction
+    # with w_g = 1 and one vector, full strength: Omega is 1 straight on
+    assert growing_attraction(nums, xs, ys, 107, 0.0, 1) == pytest.approx(1.0)

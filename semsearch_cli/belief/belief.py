@@ -16,6 +16,7 @@ from skimage.morphology import skeletonize
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch, branch_walk, local_reach, segment_flood
+from ..kernels.raycast import mark_viewed
 
 CLEARANCE_CAP_M = 1.0
 CONNECT_M = 1.5
@@ -148,15 +149,26 @@ class Belief:
         self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
         self._cands = None
         self._seg_labels = None
+        self.views: list = []  # camera poses (v, u, heading) not yet folded into ``viewed``
+        self.viewed = np.zeros((H, W), bool)  # free cells next to a wall that a side camera has looked at
+        self.examined = np.zeros((H, W), bool)  # such cells given up on after a look from close by
 
     # ---- per-step updates -------------------------------------------------------------
     def refresh_free(self, bbox: np.ndarray) -> None:
-        """Re-derive ``free`` inside a scan's bounding box and grow the dirty box."""
+        """Re-derive ``free`` inside a scan's bounding box and grow the dirty box by the cells
+        whose state changed (so the derived maps are refreshed where the map changed, not
+        wherever the robot looked: a re-thinned window whose seam moves with the robot would
+        change the skeleton of open areas under it)."""
         r0, r1, c0, c1 = int(bbox[0]), int(bbox[1]) + 1, int(bbox[2]), int(bbox[3]) + 1
         if r1 <= r0:
             return
-        self.free[r0:r1, c0:c1] = self.seen[r0:r1, c0:c1] & (self.cv[r0:r1, c0:c1] < self.spec.occupied_threshold)
-        _grow(self.dirty, (r0, r1 - 1, c0, c1 - 1))
+        new = self.seen[r0:r1, c0:c1] & (self.cv[r0:r1, c0:c1] < self.spec.occupied_threshold)
+        changed = new != self.free[r0:r1, c0:c1]
+        if not changed.any():
+            return
+        self.free[r0:r1, c0:c1] = new
+        rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
+        _grow(self.dirty, (r0 + int(rows[0]), r0 + int(rows[-1]), c0 + int(cols[0]), c0 + int(cols[-1])))
 
     def visit(self, r: int, c: int) -> None:
         """Mark the visited kernel around the robot and give its newly visited cells the local
@@ -294,6 +306,44 @@ class Belief:
         edge = cv2.dilate(unseen, cross).astype(bool) & self.free[r0:r1, c0:c1]  # free, 4-adjacent to unseen
         near = cv2.dilate(edge.astype(np.uint8), np.ones((2 * k + 1, 2 * k + 1), np.uint8)).astype(bool)
         return self._groups(near & self.passable[r0:r1, c0:c1], r0, c0, need_branch=False)
+
+    # ---- completeness: walls not yet looked at from close enough to read signs ---------------
+    def unread_walls(self, cam_range: float, half_fov: float, approach: float) -> Candidates:
+        """Where to go once no frontier is left: the known free space within ``approach`` m
+        (through free space) of a wall face no side camera has looked at from within its range
+        ``cam_range`` m (``half_fov`` radians either side of the perpendicular). A sign anywhere
+        on such a face may be unread (passed at an angle, or with the robot turning on the
+        spot), so a complete search goes back to look at it. One candidate per group of such
+        cells, the widest; empty when every wall face has been looked at (or given up on, see
+        :meth:`mark_examined`)."""
+        H, W = self.free.shape
+        if self.views:
+            mark_viewed(self.free, self.viewed, np.array(self.views, np.float64), half_fov, cam_range / self.frame.res)
+            self.views.clear()
+        rr, cc = np.nonzero(self.seen)
+        if rr.size == 0:
+            return _empty()
+        k = int(np.ceil(approach / self.frame.res)) + 1
+        r0, r1, c0, c1 = max(0, rr.min() - k), min(H, rr.max() + k + 1), max(0, cc.min() - k), min(W, cc.max() + k + 1)
+        free = self.free[r0:r1, c0:c1]
+        wall = (self.seen[r0:r1, c0:c1] & ~free).astype(np.uint8)
+        cross = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], np.uint8)
+        face = cv2.dilate(wall, cross).astype(bool) & free
+        todo = face & ~self.viewed[r0:r1, c0:c1] & ~self.examined[r0:r1, c0:c1]
+        if not todo.any():
+            return _empty()
+        near = todo.astype(np.uint8)  # grown through free space only, so it stays on the face's side of the wall
+        free8 = free.astype(np.uint8)
+        for _ in range(k - 1):
+            near = cv2.dilate(near, cross) & free8
+        return self._groups(near.astype(bool) & self.passable[r0:r1, c0:c1], r0, c0, need_branch=False)
+
+    def mark_examined(self, r: int, c: int, radius: float) -> None:
+        """Give up on the unviewed wall faces within ``radius`` m of (r, c) through free space:
+        the robot has looked around there (so a search that cannot read a sign in a spot its
+        cameras cannot see still ends)."""
+        pr, pc = local_reach(self.free, r, c, radius / self.frame.res + 1.0, False)
+        self.examined[pr, pc] = True
 
     def _front(self, r0, r1, c0, c1) -> np.ndarray:
         vis = self.visited[r0:r1, c0:c1]

@@ -5,9 +5,9 @@ from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, ExperimentSpec, LaserSp
 from .chain import ChainSpec, StageSpec
 from .objects import (CaseSpec, ClassCameraSpec, DetectTable, ObjectCameraSpec, ObjectsSpec, PlaceSpec,
                       RequestSpec)
-from .scenario import KINDS, Scenario, load_scenario, parse_scenario, read_yaml
+from .scenario import KINDS, Scenario, load_scenario, parse_scenario, read_yaml, with_param
 
 __all__ = ["BeliefSpec", "CaseSpec", "ChainSpec", "ClassCameraSpec", "DetectTable", "DoorCameraSpec", "DoorSpec",
            "ExperimentSpec", "KINDS", "LaserSpec", "MapSpec", "NavigationSpec", "ObjectCameraSpec", "ObjectsSpec",
            "PlaceSpec", "PlannerSpec", "RequestSpec", "RobotSpec", "Scenario", "StageSpec", "StartSpec", "Strict",
-           "load_scenario", "parse_scenario", "read_yaml"]
+           "load_scenario", "parse_scenario", "read_yaml", "with_param"]

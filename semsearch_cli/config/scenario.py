@@ -148,3 +148,36 @@ def read_yaml(path: str | Path, what: str = "file", owner: str | None = None, fi
 def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario YAML file."""
     return parse_scenario(read_yaml(path), path)
+
+
+def with_param(data: dict, param: str, value: Any, file: str | Path) -> dict:
+    """A copy of the scenario document ``data`` with one parameter set, for sweeps.
+
+    ``param`` is a dotted path: a section and its field (``door_camera.p_misread``,
+    ``belief.density_delta``, ``experiment.max_distance``), or a planner name and one of its
+    parameters (``nsos.alpha``: set on every entry of that planner). The result is validated by
+    the caller (:func:`parse_scenario`), so a bad value is reported like one in the file.
+    """
+    keys = [k for k in param.split(".")]
+    if not data or not isinstance(data, dict) or len(keys) < 2 or any(not k for k in keys):
+        raise ScenarioError("<command line>", "--param", f"expected SECTION.FIELD=VALUES (e.g. door_camera.p_misread=0,0.05), got {param!r}")
+    out = yaml.safe_load(yaml.safe_dump(data))  # a deep copy of plain YAML data
+    planners = [p for p in out.get("planners") or [] if isinstance(p, dict) and p.get("name") == keys[0]]
+    if planners:
+        for p in planners:
+            _set(p, keys[1:], value)
+        return out
+    if keys[0] not in Scenario.model_fields or keys[0] in ("name", "planners"):
+        names = sorted({p.get("name") for p in out.get("planners") or [] if isinstance(p, dict)} - {None})
+        raise ScenarioError("<command line>", "--param", f"{keys[0]!r} is neither a section of {file} nor one of its planners "
+                            f"({', '.join(names)}); sections: {', '.join(k for k in Scenario.model_fields if k not in ('name', 'planners'))}")
+    _set(out, keys, value)
+    return out
+
+
+def _set(d: dict, keys: list[str], value: Any) -> None:
+    for k in keys[:-1]:
+        if not isinstance(d.get(k), dict):
+            d[k] = {}
+        d = d[k]
+    d[keys[-1]] = value

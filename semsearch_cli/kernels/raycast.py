@@ -176,3 +176,51 @@ def line_of_sight(occ, v0, u0, v1, u1, stop_short):
     theta = math.atan2(-dv, du)
     d, h = cast_ray(occ, v0, u0, theta, L - stop_short)
     return not h
+
+
+@njit(cache=True)
+def mark_viewed(free, viewed, views, half_fov, max_cells):
+    """Mark, for each view, the last free cell before the first cell that is not free along every
+    ray of two side cameras: ``viewed`` (H, W) bool is changed in place.
+
+    Parameters
+    ----------
+    free : (H, W) bool
+        Cells the camera sees through (a ray stops at the first other cell or at the grid's edge).
+    views : (n, 3) float64
+        Camera poses ``(v, u, heading)``: continuous cell coordinates and radians; the cameras look
+        along ``heading +- pi/2``, each over ``+-half_fov``.
+    max_cells : float
+        Camera range, cells. Rays are spaced so that neighbouring rays are at most half a cell
+        apart at that range.
+    """
+    H, W = free.shape
+    n_side = int(math.ceil(2.0 * half_fov * max_cells / 0.5)) + 1
+    step = 2.0 * half_fov / max(1, n_side - 1)
+    for k in range(views.shape[0]):
+        v0, u0, heading = views[k, 0], views[k, 1], views[k, 2]
+        for side in (-1.0, 1.0):
+            centre = heading + side * 0.5 * math.pi
+            for j in range(n_side):
+                theta = centre - half_fov + j * step
+                dv = -math.sin(theta)
+                du = math.cos(theta)
+                r, c, sr, sc, tmr, tmc, tdr, tdc = _setup(v0, u0, dv, du)
+                pr, pc = r, c
+                t = 0.0
+                while t <= max_cells:
+                    if r < 0 or r >= H or c < 0 or c >= W:
+                        break
+                    if not free[r, c]:
+                        if t > 0.0:
+                            viewed[pr, pc] = True
+                        break
+                    pr, pc = r, c
+                    if tmr < tmc:
+                        t = tmr
+                        tmr += tdr
+                        r += sr
+                    else:
+                        t = tmc
+                        tmc += tdc
+                        c += sc

@@ -9,7 +9,7 @@ search).
 
 from .base import (PLANNERS, Decision, NoParams, PlanContext, Planner, Variant, expand_variants, load_entry_points,
                    load_planner_file, register_planner)
-from .doors import bvp, greedy, nsos  # noqa: F401  (registration side effect)
+from .doors import bvp, draft, greedy, nsos  # noqa: F401  (registration side effect)
 from .indirect import Goal, IndirectContext, IndirectPlanner
 from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 

@@ -87,6 +87,31 @@ def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy") -> None:
     _save(fig, out)
 
 
+def plot_sweep(table, param: str, out: Path) -> None:
+    """A parameter sweep (:func:`~semsearch_cli.report.tables.sweep_table`): mean ratio to the
+    shortest path (+- std over seeds) against the parameter, one line per planner, one panel per
+    goal, and the success rate in a panel underneath."""
+    goals = sorted(table["goal"].unique(), key=goal_key)
+    fig, axes = plt.subplots(2, len(goals), figsize=(4.2 * len(goals), 5.6), squeeze=False, sharex=True,
+                             gridspec_kw={"height_ratios": [3, 1.2]})
+    for j, g in enumerate(goals):
+        d = table[table["goal"] == g]
+        for planner, p in d.groupby("planner", sort=False):
+            x = p[param].to_numpy()
+            axes[0, j].errorbar(x, p["mean_ratio"], yerr=p["std_ratio"].fillna(0), fmt="o-", capsize=3, label=planner)
+            axes[1, j].plot(x, p["success_rate"], "o-", label=planner)
+        axes[0, j].axhline(1.0, c="gray", lw=0.8)
+        axes[0, j].set_title(f"goal {g}")
+        axes[0, j].set_ylabel("distance / shortest path")
+        axes[1, j].set_ylabel("success rate")
+        axes[1, j].set_ylim(-0.05, 1.05)
+        axes[1, j].set_xlabel(param)
+        axes[0, j].legend(fontsize=7)
+    fig.suptitle(f"sweep of {param}: mean ratio to the shortest path (+- std over seeds) and success")
+    fig.tight_layout()
+    _save(fig, out)
+
+
 def plot_scenario(world, goals, title: str, out: Path) -> None:
     """The ground-truth map with every sign (dot, number, facing tick), the start and the goals."""
     fig, ax = _map_figure(world, 12.0)

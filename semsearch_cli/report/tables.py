@@ -157,3 +157,14 @@ def cells(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> tup
             out.append((text, mark))
         rows.append(out)
     return head, rows
+
+
+def sweep_table(runs: pd.DataFrame, param: str) -> pd.DataFrame:
+    """One row per value of a swept parameter x goal x planner variant: runs, success rate
+    (found within the budget), mean and std of the ratio to the shortest path and the median
+    distance (m), over every run, failures included at the distance they travelled."""
+    g = runs.groupby(["value", "goal", "planner"], sort=False)
+    out = g.agg(n=("distance_m", "size"), success_rate=("success", "mean"), mean_ratio=("ratio", "mean"),
+                std_ratio=("ratio", "std"), median_m=("distance_m", "median")).reset_index()
+    out = out.rename(columns={"value": param})
+    return out.round(3)

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..config import Scenario, load_scenario
+from ..config import Scenario, load_scenario, parse_scenario
 from ..planners import Variant
 from ..tasks import Task, build_task
 from ..world.scenario import World, build_world
@@ -45,9 +45,11 @@ class Loaded:
     task: Task
 
     @classmethod
-    def load(cls, path: str | Path) -> "Loaded":
+    def load(cls, path: str | Path, data: dict | None = None) -> "Loaded":
+        """Load the scenario file ``path``, or the document ``data`` in its place (a sweep's
+        variation of it: paths in it are relative to ``path``'s folder)."""
         path = Path(path)
-        sc = load_scenario(path)
+        sc = load_scenario(path) if data is None else parse_scenario(data, path)
         world = build_world(sc, path.parent, str(path))
         return cls(path, sc, build_task(sc, world, path))
 

@@ -21,6 +21,7 @@ from ..geometry import wrap_angle
 from ..kernels.raycast import himm_update
 from ..navigation import NAVIGATORS
 from ..planners import PlanContext
+from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.scenario import check_goals_reachable
 from .base import Outcome, RobotState, Task, register_task
@@ -47,6 +48,7 @@ class DoorSensing:
         spec = t.sc.belief
         himm_update(b.cv, b.seen, float(v), float(u), thetas, dist, hit, spec.himm_inc, spec.himm_dec, spec.himm_max, self.bbox)
         b.refresh_free(self.bbox)
+        b.views.append((float(v), float(u), st.heading))
         found = event = False
         for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
             st.read_signs.add(i)
@@ -76,25 +78,43 @@ class DoorSearch(DoorSensing):
         self.target: tuple[int, int] | None = None  # the cell the robot is heading for
         self.trace: list = []
         self.start_distance = 0.0
+        cam = task.sc.door_camera
+        # completeness sweep: how close to an unviewed wall face to go, and the turns that
+        # sweep the two side cameras over every direction
+        self.approach = min(cam.range, max(0.5 * cam.range, task.world.frame.res * 3 + task.sc.robot.radius))
+        self.look_turns = int(np.ceil(180.0 / cam.fov)) - 1
+        self.sweep_target: tuple[int, int] | None = None
 
     def replan_due(self, path_done, since_plan, event):
         return path_done or since_plan >= self.replan_every or (event and self.uses_signs)
 
+    def turn(self, st, turns: int, angle: float) -> bool:
+        """Turn on the spot ``turns`` times by ``angle`` radians, sensing after each; whether the
+        goal was read."""
+        found = False
+        for _ in range(turns):
+            st.heading = float(wrap_angle(st.heading + angle))
+            f, _ = self.sense(st)
+            found = found or f
+        return found
+
     def plan(self, st):
         b, fr = st.belief, self.task.world.frame
         r, c = (int(v) for v in fr.to_index(st.x, st.y))
+        if self.sweep_target is not None and max(abs(r - self.sweep_target[0]), abs(c - self.sweep_target[1])) <= 1:
+            # at a wall face not yet looked at: look all round (the two side cameras cover every
+            # direction over a half turn), then give up on the faces near here
+            self.sweep_target = None
+            if self.turn(st, self.look_turns, np.pi / (self.look_turns + 1)):
+                return "found"
+            b.mark_examined(r, c, self.approach + 2 * fr.res)
         b.refresh_derived()
         cands = b.candidates()
         if len(cands) == 0 and not self.looked_around:
             # nowhere to go with what the forward laser has seen: turn on the spot (three quarter
             # turns, no distance travelled) and look again
             self.looked_around = True
-            found = False
-            for _ in range(3):
-                st.heading = float(wrap_angle(st.heading + np.pi / 2))
-                f, _ = self.sense(st)
-                found = found or f
-            if found:
+            if self.turn(st, 3, np.pi / 2):
                 return "found"
             b.refresh_derived()
             cands = b.candidates()
@@ -103,28 +123,53 @@ class DoorSearch(DoorSensing):
             dec = self.planner.choose(ctx, cands)
             if dec is None:
                 break
-            # a decision is a new target: the one the robot heads for already, chosen again at a
-            # re-plan or kept by the planner (info["kept"]), is not one, for every planner alike
-            kept = dec.info.get("kept", False) or (dec.row, dec.col) == self.target
-            self.decisions += not kept
-            if self.recorder is not None and not kept:
-                self.recorder(b, st.trail, st.distance - self.start_distance, cands, dec)
-            if self.keep_trace and not kept:
-                tx, ty = fr.to_world(dec.row, dec.col)
-                self.trace.append({"step": st.steps, "distance_m": round(st.distance - self.start_distance, 3),
-                                   "x": round(float(st.x), 3), "y": round(float(st.y), 3),
-                                   "heading_deg": round(float(np.degrees(st.heading)), 1),
-                                   "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(cands), **dec.info})
-            p = self.navigator.plan(b, r, c, dec.row, dec.col)
-            if p is not None and len(p[0]) >= 2:
-                self.looked_around = False
-                self.target = (dec.row, dec.col)
-                return fr.to_world(p[0], p[1])
+            p = self.go(st, ctx, cands, dec)
+            if p is not None:
+                return p
             keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
             if keep.all():
                 break
             cands = cands.take(np.flatnonzero(keep))
+        return self.sweep(st, ctx)
+
+    def sweep(self, st, ctx):
+        """No frontier left (or none reachable): go to the nearest wall face no camera has looked
+        at from within reading range; ``stuck`` only when there is none the robot can reach."""
+        cam = self.task.sc.door_camera
+        for _ in range(MAX_RETRIES):
+            cands = st.belief.unread_walls(cam.range, np.radians(cam.fov) / 2, self.approach)
+            dec = nearest_candidate(ctx, cands)
+            if dec is None:
+                return "stuck"
+            dec.info["sweep"] = True
+            p = self.go(st, ctx, cands, dec)
+            if p is not None:
+                self.sweep_target = (dec.row, dec.col)
+                return p
+            st.belief.mark_examined(dec.row, dec.col, self.approach + 2 * self.task.world.frame.res)
         return "stuck"
+
+    def go(self, st, ctx, cands, dec):
+        """Record decision ``dec`` and plan a path to it: waypoints (m), or None without a path."""
+        b, fr = st.belief, self.task.world.frame
+        # a decision is a new target: the one the robot heads for already, chosen again at a
+        # re-plan or kept by the planner (info["kept"]), is not one, for every planner alike
+        kept = dec.info.get("kept", False) or (dec.row, dec.col) == self.target
+        self.decisions += not kept
+        if self.recorder is not None and not kept:
+            self.recorder(b, st.trail, st.distance - self.start_distance, cands, dec)
+        if self.keep_trace and not kept:
+            tx, ty = fr.to_world(dec.row, dec.col)
+            self.trace.append({"step": st.steps, "distance_m": round(st.distance - self.start_distance, 3),
+                               "x": round(float(st.x), 3), "y": round(float(st.y), 3),
+                               "heading_deg": round(float(np.degrees(st.heading)), 1),
+                               "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(cands), **dec.info})
+        p = self.navigator.plan(b, ctx.row, ctx.col, dec.row, dec.col)
+        if p is not None and len(p[0]) >= 2:
+            self.looked_around = False
+            self.target = (dec.row, dec.col)
+            return fr.to_world(p[0], p[1])
+        return None
 
 
 class GoToRead(DoorSensing):

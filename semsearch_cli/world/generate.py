@@ -17,6 +17,11 @@ Numbering schemes (``SCHEMES``):
   odd-even-out  odd numbers on one wall, even on the other, rising with the distance from the
                 middle of the building along the corridors (the thesis' Normal);
   odd-even-in   the same, falling with that distance (its Inverse);
+  corridor-parity  one parity per corridor on both of its walls, the corridors alternating (odd,
+                even, odd, ...; a hundred-block per pair of corridors), numbers rising from the
+                corridor's middle outward and alternating between the walls: the authors' Normal
+                map (``par_impar_par_impar``, "even odd even odd");
+  corridor-parity-in  the same, rising from the corridor's ends toward its middle: their Inverse;
   floor         rising along each corridor, both walls in turn, floor digit first (201, 202, ...);
   blocks        one hundred-block per corridor (101.., 201.., ...), rising along it, with gaps;
   random        a random permutation: the control case where no planner can use the signs.
@@ -38,7 +43,7 @@ from .files import map_image, scenario_dict, write_building
 from .mobilesim import spread_goals
 
 LAYOUTS = ("grid", "wings", "angled", "single")
-SCHEMES = ("odd-even-out", "odd-even-in", "floor", "blocks", "random")
+SCHEMES = ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks", "random")
 
 
 @dataclass(frozen=True)
@@ -188,6 +193,8 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
             nums[i] = nxt[side]
             nxt[side] += 2
         return nums
+    if scheme in ("corridor-parity", "corridor-parity-in"):
+        return corridor_parity(slots, plan, outward=scheme == "corridor-parity")
     if scheme == "floor":
         nums, i = [], 0
         order = sorted(range(len(slots)), key=lambda k: (slots[k].corridor, slots[k].t, -slots[k].side))
@@ -207,6 +214,30 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
     if scheme == "random":
         return [int(x) for x in rng.permutation(len(slots)) + 1]
     raise ScenarioError("<command line>", "--numbering", f"unknown numbering scheme {scheme!r}; valid: {', '.join(SCHEMES)}")
+
+
+def corridor_parity(slots: list[Slot], plan: Plan, outward: bool) -> list[int]:
+    """Numbers of the ``corridor-parity`` schemes. Corridor k (in the plan's order) carries odd
+    numbers when k is even and even numbers when k is odd, in the hundred-block 100 (k // 2). Its
+    slots are split at the point of the corridor nearest the middle of the building: the half
+    toward the corridor's end ``b`` is numbered first, then the other half, each rising away from
+    the middle (``outward``) or toward it, the two walls alternating (as the authors' Normal and
+    Inverse maps: 1, 3, 5 ... from the middle to one end, then on from the middle to the other)."""
+    nums = [0] * len(slots)
+    mid = np.array(plan.size) / 2
+    for k, cor in enumerate(plan.corridors):
+        a, b = np.array(cor.a), np.array(cor.b)
+        L = float(np.linalg.norm(b - a))
+        t_mid = float(np.clip(np.dot(mid - a, (b - a) / L), 0.0, L))
+        mine = [i for i, sl in enumerate(slots) if sl.corridor == k]
+        halves = ([i for i in mine if slots[i].t >= t_mid], [i for i in mine if slots[i].t < t_mid])
+        nxt = 100 * (k // 2) + (1 if k % 2 == 0 else 2)
+        for half in halves:
+            far = -1 if outward else 1
+            for i in sorted(half, key=lambda i: (far * -abs(slots[i].t - t_mid), -slots[i].side)):
+                nums[i] = nxt
+                nxt += 2
+    return nums
 
 
 def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: float = 0.1,

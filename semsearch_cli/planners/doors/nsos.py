@@ -135,9 +135,20 @@ class NSOSParams(BaseModel):
     hysteresis: float = Field(0.01, ge=0.0, description="keep the last target while its phi is within this of the best")
 
 
-@register_planner("nsos")
-class NSOS(Planner):
-    """The semantic planner, with hysteresis between re-plans.
+def pick(phi: np.ndarray, D: np.ndarray, keep: int | None, hysteresis: float, rng) -> int:
+    """argmax phi, keeping candidate ``keep`` while its phi is within ``hysteresis`` of the best;
+    ties go to the nearest (smallest D), then to ``rng``."""
+    if keep is not None and phi[keep] >= phi.max() - hysteresis:
+        return keep
+    best = np.flatnonzero(phi >= phi.max() - 1e-12)
+    if best.size > 1:  # ties (common at alpha = 1 before any sign counts): nearest, then random
+        best = best[D[best] <= D[best].min() + 1e-9]
+    return int(best[0] if best.size == 1 else rng.choice(best))
+
+
+class KeepTarget(Planner):
+    """A scoring planner with hysteresis between re-plans: subclasses give ``_decide(ctx, cands,
+    keep)``, ``keep`` the index of the last target among ``cands`` when it may be kept.
 
     Closeness is relative to the nearest candidate, so as the robot moves every candidate's phi
     drifts; with the argmax taken afresh at each re-plan, a robot travelling toward a far
@@ -145,24 +156,20 @@ class NSOS(Planner):
     back, and repeats for ever (seen on Inverse goal 124: 2000 m between two poses 1.1 m apart).
     So the planner keeps its last target while it is still a candidate and its phi is within
     ``hysteresis`` of the best; it chooses afresh whenever a sign reaches ``min_reads`` (new
-    semantic evidence) or the target is gone. ``hysteresis = 0`` is the plain argmax of Eq. 4.8.
+    semantic evidence) or the target is gone. ``hysteresis = 0`` is the plain argmax.
     """
 
-    Params = NSOSParams
     replan_on_signs = True
-    use_semantics = True
 
     def __init__(self, params):
         super().__init__(params)
         self._last = None  # (target cell, counted signs) of the last decision
-        self._h_d = RollingHistogram(self.params.door_bins, True, self.params.lambda_d)
-        self._h_r = RollingHistogram(self.params.robot_bins, False, self.params.lambda_r)
 
     def choose(self, ctx, cands):
         if len(cands) == 0:
             return None
         b = ctx.belief
-        min_reads = self.params.min_reads or b.spec.min_reads
+        min_reads = getattr(self.params, "min_reads", None) or b.spec.min_reads
         counted = sum(1 for n in b.reads.total.values() if n >= min_reads)
         keep = None
         if self._last is not None and self._last[1] == counted and self.params.hysteresis > 0:
@@ -171,6 +178,22 @@ class NSOS(Planner):
         d = self._decide(ctx, cands, keep)
         self._last = None if d is None else ((d.row, d.col), counted)
         return d
+
+    def _decide(self, ctx, cands, keep: int | None) -> Decision | None:
+        raise NotImplementedError
+
+
+@register_planner("nsos")
+class NSOS(KeepTarget):
+    """The semantic planner (Eqs. 4.5-4.8), with :class:`KeepTarget`'s hysteresis."""
+
+    Params = NSOSParams
+    use_semantics = True
+
+    def __init__(self, params):
+        super().__init__(params)
+        self._h_d = RollingHistogram(self.params.door_bins, True, self.params.lambda_d)
+        self._h_r = RollingHistogram(self.params.robot_bins, False, self.params.lambda_r)
 
     def _decide(self, ctx, cands, keep: int | None = None):
         k = len(cands)
@@ -209,13 +232,7 @@ class NSOS(Planner):
         SF = phi_g * phi_p
         phi = alpha * SF + (1.0 - alpha) * GF
         phi[~reach] = -np.inf
-        if keep is not None and phi[keep] >= phi.max() - p.hysteresis:
-            j = keep
-        else:
-            best = np.flatnonzero(phi >= phi.max() - 1e-12)
-            if best.size > 1:  # ties (common at alpha = 1 before any sign counts): nearest, then random
-                best = best[D[best] <= D[best].min() + 1e-9]
-            j = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+        j = pick(phi, D, keep, p.hysteresis, ctx.rng)
         info = {"chosen": j, "candidates": [
             {"x": round(float(x), 2), "y": round(float(y), 2), "theta_f_deg": round(float(np.degrees(t)), 1),
              "segment": int(seg[i]), "D_m": round(float(D[i]) * b.frame.res, 2) if reach[i] else None,
