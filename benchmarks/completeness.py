@@ -8,8 +8,8 @@ Usage:
 
 A folder argument is a generated batch (its index.txt lists the scenarios); a file is one
 scenario. Every scenario is run with every door planner (greedy, bvp, geometric, nsos at
-alpha 0.9, draft); ``--all-signs`` makes every readable sign of the scenario a goal (instead of
-its own goals). Rows go to ``<out>/<scenario>/runs.csv`` (resumable). Prints, per source and
+alpha 0.9, draft); ``--all-signs`` makes every readable sign of each scenario file a goal
+(instead of its own goals; a batch's scenarios keep theirs). Rows go to ``<out>/<scenario>/runs.csv`` (resumable). Prints, per source and
 planner, the runs and how many ended other than ``found`` (stuck, budget), and lists them.
 """
 
@@ -21,6 +21,8 @@ import time
 from pathlib import Path
 
 import pandas as pd
+
+from output import emit
 
 from semsearch_cli.config import PlannerSpec, read_yaml
 from semsearch_cli.report.document import markdown_table
@@ -41,7 +43,7 @@ def main() -> int:
     ap.add_argument("sources", type=Path, nargs="+")
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--all-signs", action="store_true")
+    ap.add_argument("--all-signs", action="store_true", help="every readable sign a goal, for single scenario files")
     ap.add_argument("--out", type=Path, default=Path("results/completeness"))
     ap.add_argument("--md", type=Path)
     a = ap.parse_args()
@@ -50,7 +52,7 @@ def main() -> int:
     for src in a.sources:
         for p in scenarios(src):
             L = Loaded.load(p)
-            if a.all_signs:
+            if a.all_signs and not src.is_dir():
                 w = L.world
                 data = read_yaml(p)
                 data["goals"] = sorted({w.signs.number[i] for i in range(len(w.signs)) if w.readable_mask(i).any()}, key=str)
@@ -72,10 +74,7 @@ def main() -> int:
     if len(bad):
         text += "\n\nnot found:\n\n" + markdown_table(bad, fmt="{:g}")
     text += f"\n\n{len(df)} runs in {wall:.0f} s\n"
-    print(text)
-    if a.md:
-        a.md.write_text(text)
-    return 0
+    return emit(text, a.md)
 
 
 if __name__ == "__main__":

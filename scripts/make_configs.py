@@ -22,10 +22,11 @@ PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8,
 
 # name: (layout, numbering, seed, spacing m, signs, goals, floor digit, density delta m^2, description)
 LIBRARY = {
-    "normal": ("grid", "odd-even-out", 3, 3.9, 113, [54, 55, 111, 124], 2, 4.5,
-               "corridors around room blocks; odd and even on opposite walls, rising from the middle to the borders"),
-    "inverse": ("grid", "odd-even-in", 3, 3.9, 116, [54, 55, 111, 124], 2, 4.5,
-                "the Normal building numbered the other way: rising from the borders to the middle"),
+    "normal": ("grid", "corridor-parity", 3, 2.7, 113, [54, 55, 111, 124], 2, 4.5,
+               "four long corridors around room blocks, each of one parity on both walls (even, odd, even, odd from the "
+               "start's), numbers rising from the middle to the ends, as the authors' Normal"),
+    "inverse": ("grid", "corridor-parity-in", 3, 2.7, 116, [54, 55, 111, 124], 2, 4.5,
+                "the Normal building numbered the other way: rising from the ends of each corridor to its middle"),
     "hotel": ("wings", "odd-even-out", 0, 3.0, 124, [76, 135, 148, 185], 2, 2.5,
               "long corridors with wings and a loop; half the door slots unsigned, so runs of numbers are irregular"),
     "kth": ("angled", "floor", 0, 3.5, 47, [756], 7, 2.5,

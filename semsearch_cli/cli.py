@@ -17,7 +17,7 @@ from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .errors import ScenarioError
 from .report.build import console_tables
-from .world.generate import SCHEMES
+from .world.generate import LAYOUTS, SCHEMES
 from .world.generate import generate_batch as gen_batch
 from .world.generate import generate_building as gen_building
 from .world.rooms import generate_rooms as gen_rooms
@@ -280,15 +280,29 @@ def generate_building(
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
 
 
+def _choices(text: Optional[str], valid: tuple, flag: str) -> tuple:
+    if text is None:
+        return valid
+    items = tuple(t.strip() for t in text.split(",") if t.strip())
+    bad = [t for t in items if t not in valid]
+    if bad or not items:
+        raise ScenarioError("<command line>", flag, f"unknown value(s) {bad or [text]}; valid: {', '.join(valid)}")
+    return items
+
+
 @generate_app.command("batch")
 def generate_batch(
     out_dir: Path = typer.Option(..., "--out", help="Folder for the buildings (one sub-folder each) and index.txt."),
     seeds: int = typer.Option(3, "--seeds", min=1, help="Buildings per layout and numbering scheme."),
     runs: int = typer.Option(3, "--runs", min=1, help="Runs per goal and planner in each scenario."),
+    layouts: Optional[str] = typer.Option(None, "--layouts", help="Comma-separated layouts (default: all)."),
+    schemes: Optional[str] = typer.Option(None, "--schemes", help="Comma-separated numbering schemes (default: all)."),
 ):
-    """Every layout x numbering scheme x seed: a robustness set (4 x 5 x 3 = 60 buildings by default)."""
+    """Every layout x numbering scheme x seed: a robustness set (4 x 7 x 3 = 84 buildings by default)."""
     try:
-        paths = gen_batch(out_dir, seeds=seeds, runs=runs)
+        lays = _choices(layouts, LAYOUTS, "--layouts")
+        schs = _choices(schemes, SCHEMES, "--schemes")
+        paths = gen_batch(out_dir, seeds=seeds, runs=runs, layouts=lays, schemes=schs)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {len(paths)} scenarios under {out_dir} (listed in {out_dir / 'index.txt'})")

@@ -86,3 +86,42 @@ def test_generate_batch_covers_every_layout_and_scheme(tmp_path):
     assert names == {f"{lay}-{sch}" for lay in LAYOUTS for sch in SCHEMES}
     L = Loaded.load(tmp_path / index[0])
     assert L.sc.experiment.seeds == 2 and [p.name for p in L.sc.planners] == ["greedy", "nsos"]
+
+
+def test_corridor_parity_gives_each_long_corridor_one_parity(tmp_path):
+    """The authors' Normal: every long corridor one parity on both walls, even and odd in turn
+    from the start's corridor, a hundred-block per pair; rising outward from the middle, the
+    walls alternating; no signs on the cross corridors."""
+    generate_building("grid", "corridor-parity", 3, tmp_path / "n", spacing=2.7)
+    generate_building("grid", "corridor-parity-in", 3, tmp_path / "i", spacing=2.7)
+    d = doors(tmp_path / "n")
+    assert all(f in (90.0, -90.0) for n, x, y, f in d)  # horizontal walls only: cross corridors unsigned
+    rows = {}
+    for n, x, y, f in d:  # a corridor = the two walls facing each other, 2 m apart
+        key = round((y + (1.0 if f == 90.0 else -1.0)) / 2.0)  # centre line, rounded to 2 m
+        rows.setdefault(key, []).append((n, x, y))
+    assert len(rows) == 4
+    top_down = [rows[k] for k in sorted(rows, reverse=True)]  # the start is on the top corridor
+    for k, signs in enumerate(top_down):
+        parities = {n % 2 for n, _, _ in signs}
+        assert parities == {0 if k % 2 == 0 else 1}  # even, odd, even, odd
+        assert {n // 100 for n, _, _ in signs} == {k // 2}
+        assert len({round(y, 1) for _, _, y in signs}) == 2  # on both walls
+        mid = 25.0
+        right = sorted((x, n) for n, x, _ in signs if x > mid)
+        assert [n for _, n in right] == sorted(n for _, n in right)  # rising from the middle outward
+    inv = {(round(x, 2), round(y, 2)): n for n, x, y, f in doors(tmp_path / "i")}
+    nor = {(round(x, 2), round(y, 2)): n for n, x, y, f in d}
+    assert set(inv) == set(nor)
+    assert all(inv[p] % 2 == nor[p] % 2 and inv[p] // 100 == nor[p] // 100 for p in nor)  # same corridors
+    far_right = max((p for p in nor if nor[p] < 100 and nor[p] % 2 == 0), key=lambda p: p[0])
+    assert inv[far_right] in (2, 4)  # the Inverse starts at the corridor's end
+
+
+def test_generate_batch_picks_layouts_and_schemes(tmp_path):
+    r = CliRunner().invoke(app, ["generate", "batch", "--out", str(tmp_path), "--seeds", "1", "--layouts", "single",
+                                 "--schemes", "corridor-parity,floor"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "index.txt").read_text().split() == ["single-corridor-parity-0/scenario.yaml", "single-floor-0/scenario.yaml"]
+    r = CliRunner().invoke(app, ["generate", "batch", "--out", str(tmp_path / "x"), "--schemes", "parity"])
+    assert r.exit_code == 2 and "--schemes" in r.output and "corridor-parity" in r.output

@@ -217,23 +217,37 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
 
 
 def corridor_parity(slots: list[Slot], plan: Plan, outward: bool) -> list[int]:
-    """Numbers of the ``corridor-parity`` schemes. Corridor k (in the plan's order) carries odd
-    numbers when k is even and even numbers when k is odd, in the hundred-block 100 (k // 2). Its
-    slots are split at the point of the corridor nearest the middle of the building: the half
-    toward the corridor's end ``b`` is numbered first, then the other half, each rising away from
-    the middle (``outward``) or toward it, the two walls alternating (as the authors' Normal and
-    Inverse maps: 1, 3, 5 ... from the middle to one end, then on from the middle to the other)."""
+    """Numbers of the ``corridor-parity`` schemes (0: no sign in that slot).
+
+    As in the authors' Normal and Inverse maps (``par_impar_par_impar``, "even odd even odd"
+    from the start's corridor on), the signs line the corridors parallel to the plan's first one
+    (the building's long corridors); cross corridors carry none. Taken in order of distance from
+    the start, the k-th long corridor carries even numbers when k is even and odd numbers when k
+    is odd, in the hundred-block 100 (k // 2). Its slots are split at the point of the corridor
+    nearest the middle of the building: the half toward the corridor's end ``b`` is numbered
+    first, then the other half, each rising away from the middle (``outward``) or toward it, the
+    two walls alternating (1, 3, 5 ... from the middle to one end, then on from the middle to the
+    other end)."""
     nums = [0] * len(slots)
-    mid = np.array(plan.size) / 2
-    for k, cor in enumerate(plan.corridors):
+    mid, start = np.array(plan.size) / 2, np.array(plan.start)
+    first = np.subtract(plan.corridors[0].b, plan.corridors[0].a)
+    long = []
+    for j, cor in enumerate(plan.corridors):
         a, b = np.array(cor.a), np.array(cor.b)
         L = float(np.linalg.norm(b - a))
+        if abs(first[0] * (b - a)[1] - first[1] * (b - a)[0]) > 1e-6 * L * np.linalg.norm(first):
+            continue  # a cross corridor
+        near = a + (b - a) * float(np.clip(np.dot(start - a, b - a) / L**2, 0.0, 1.0))
+        long.append((float(np.linalg.norm(start - near)), j))
+    for k, (_, j) in enumerate(sorted(long)):
+        a, b = np.array(plan.corridors[j].a), np.array(plan.corridors[j].b)
+        L = float(np.linalg.norm(b - a))
         t_mid = float(np.clip(np.dot(mid - a, (b - a) / L), 0.0, L))
-        mine = [i for i, sl in enumerate(slots) if sl.corridor == k]
+        mine = [i for i, sl in enumerate(slots) if sl.corridor == j]
         halves = ([i for i in mine if slots[i].t >= t_mid], [i for i in mine if slots[i].t < t_mid])
-        nxt = 100 * (k // 2) + (1 if k % 2 == 0 else 2)
+        nxt = 100 * (k // 2) + (2 if k % 2 == 0 else 1)
+        far = -1 if outward else 1
         for half in halves:
-            far = -1 if outward else 1
             for i in sorted(half, key=lambda i: (far * -abs(slots[i].t - t_mid), -slots[i].side)):
                 nums[i] = nxt
                 nxt += 2
@@ -253,12 +267,12 @@ def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: 
     img, frame = rasterise(plan, res)
     slots = door_slots(plan, img, frame, spacing)
     nums = number_slots(slots, plan, scheme, img, frame, rng, floor)
-    keep = [i for i, s in enumerate(slots) if s.ok]
+    keep = [i for i, s in enumerate(slots) if s.ok and nums[i] > 0]  # 0: a slot the scheme leaves unsigned
     goal_set = {int(g) for g in goals or []}
     missing = goal_set - {nums[i] for i in keep}
     if missing:
         raise ScenarioError("<command line>", "--goals", f"no door of this building carries {sorted(missing)} "
-                            f"(numbers run {min(nums)}..{max(nums)} with gaps at junctions)")
+                            f"(numbers run {min(n for n in nums if n > 0)}..{max(nums)} with gaps at junctions)")
     if signs is not None:
         if signs > len(keep):
             raise ScenarioError("<command line>", "--signs", f"the building has room for {len(keep)} signs at {spacing} m spacing, fewer than {signs}")
