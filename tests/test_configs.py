@@ -30,13 +30,20 @@ def test_numbering_follows_the_thesis_description():
     inverse = Loaded.load(CONFIGS / "inverse.yaml").world
     # the same building, numbered in opposite directions from its middle
     assert (normal.free == inverse.free).all()
-    mid = np.array([normal.frame.width, normal.frame.height]) * normal.frame.res / 2
+    mid_x = normal.frame.width * normal.frame.res / 2
 
     def corr(w):
-        num = w.signs.value.astype(float)
-        d = np.hypot(w.signs.x - mid[0], w.signs.y - mid[1])
-        return np.corrcoef(num, d)[0, 1]
+        """Per corridor (a hundred-block and a parity) and per half: the correlation of the
+        number with the distance from the middle."""
+        num = w.signs.value.astype(int)
+        out = []
+        for key in set(zip(num // 100, num % 2)):
+            for half in (w.signs.x > mid_x, w.signs.x < mid_x):
+                m = half & (num // 100 == key[0]) & (num % 2 == key[1])
+                out.append(np.corrcoef(num[m], np.abs(w.signs.x[m] - mid_x))[0, 1])
+        return np.array(out)
 
-    assert corr(normal) > 0.5 and corr(inverse) < -0.5
+    # one parity per corridor, rising from the middle outward (Normal) or inward (Inverse)
+    assert len(corr(normal)) == 8 and (corr(normal) > 0.9).all() and (corr(inverse) < -0.9).all()
     kth = Loaded.load(CONFIGS / "kth.yaml").world
     assert all(str(n).startswith("7") for n in kth.signs.number)
