@@ -92,7 +92,7 @@ def plot_sweep(table, param: str, out: Path) -> None:
     shortest path (+- std over seeds) against the parameter, one line per planner, one panel per
     goal, and the success rate in a panel underneath."""
     goals = sorted(table["goal"].unique(), key=goal_key)
-    fig, axes = plt.subplots(2, len(goals), figsize=(4.2 * len(goals), 5.6), squeeze=False, sharex=True,
+    fig, axes = plt.subplots(2, len(goals), figsize=(max(6.5, 4.2 * len(goals)), 5.8), squeeze=False, sharex=True,
                              gridspec_kw={"height_ratios": [3, 1.2]})
     for j, g in enumerate(goals):
         d = table[table["goal"] == g]
@@ -107,7 +107,7 @@ def plot_sweep(table, param: str, out: Path) -> None:
         axes[1, j].set_ylim(-0.05, 1.05)
         axes[1, j].set_xlabel(param)
         axes[0, j].legend(fontsize=7)
-    fig.suptitle(f"sweep of {param}: mean ratio to the shortest path (+- std over seeds) and success")
+    fig.suptitle(f"sweep of {param}\nmean ratio to the shortest path (+- std over seeds) and success rate")
     fig.tight_layout()
     _save(fig, out)
 
