@@ -203,3 +203,19 @@ def test_sweep_bad_param_exits_2(demo_dir, tmp_path, param, field):
     assert r.exit_code == 2, r.output
     assert field in r.output and "Traceback" not in r.output
     assert not (tmp_path / "x").exists()  # every value is checked before anything runs
+
+
+def test_a_goal_with_a_slash_writes_its_path_file(tmp_path):
+    """KTH second doors are labelled e.g. ``2512/2``: the run's files stay in paths/."""
+    from semsearch_cli.runner import Loaded, file_stem
+    from semsearch_cli.world.files import fill_box, scenario_dict, write_building
+
+    img = np.zeros((30, 120), np.uint8)
+    fill_box(img, 0.1, 0.2, 11.8, 0.5, 2.5, 255)
+    sc = scenario_dict("slash", 0.1, (2.0, 1.5), ["12/2"], planners=[{"name": "greedy"}])
+    p = write_building(tmp_path / "b", img, [("12/2", 8.0, 2.5, 270.0), (14, 4.0, 0.5, 90.0)], sc, "a goal with a slash")
+    L = Loaded.load(p)
+    runs = run_batch(L, expand(L, 1), tmp_path / "out", 1)
+    assert runs["outcome"].tolist() == ["found"]
+    assert "/" not in file_stem("greedy", "12/2", 0)
+    assert (tmp_path / "out" / "paths" / f"{file_stem('greedy', '12/2', 0)}.npz").is_file()

@@ -6,6 +6,7 @@ do not depend on the number of workers or the executor.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,9 +32,14 @@ class RunSpec:
 
 
 def file_stem(label: str, goal, seed=None) -> str:
-    """File-name stem of a run (or, without seed, of a goal x variant)."""
+    """File-name stem of a run (or, without seed, of a goal x variant): one path component
+    whatever the planner label or goal holds (a KTH room's second door is the goal ``2512/2``)."""
     safe = label.replace("[", "_").replace("]", "").replace("=", "").replace(",", "_")
-    return f"{safe}__goal{goal}" + (f"__seed{seed}" if seed is not None else "")
+    stem = f"{safe}__goal{goal}" + (f"__seed{seed}" if seed is not None else "")
+    return _UNSAFE.sub("_", stem)
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9._+\-]")
 
 
 @dataclass
