@@ -150,8 +150,10 @@ class Belief:
         self._cands = None
         self._seg_labels = None
         self.views: list = []  # camera poses (v, u, heading) not yet folded into ``viewed``
-        self.viewed = np.zeros((H, W), bool)  # free cells next to a wall that a side camera has looked at
-        self.examined = np.zeros((H, W), bool)  # such cells given up on after a look from close by
+        self.viewed = None  # (H, W) uint8: how many poses a side camera looked at each free cell from (lazy)
+        self.examined = None  # (H, W) bool: wall faces given up on after a look from close by (lazy)
+        self._view_stamp = None  # (H, W) int64: the last pose that counted for each cell
+        self._n_views = 0
 
     # ---- per-step updates -------------------------------------------------------------
     def refresh_free(self, bbox: np.ndarray) -> None:
@@ -180,16 +182,24 @@ class Belief:
         segments change under it as it passes a junction, moving signs between segments and, at
         alpha = 1, sending the robot back and forth between two candidates for ever (seen on Hotel
         goal 148).
+
+        Only newly visited cells mark the candidates for recomputation: a window that moved with
+        the robot over cells it had visited already would recompute candidates near its seam
+        differently at each pose, and a candidate that appears and vanishes as the robot goes
+        back and forth keeps it going back and forth.
         """
         res = self.frame.res
-        dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res + 1e-6, True)
-        cls = int(np.floor(dr.shape[0] * res * res / self.spec.density_delta))
         vr, vc = local_reach(self.free, r, c, self.spec.visited_radius / res + 1e-6, False)
         if vr.size == 0:
             return
         new = ~self.visited[vr, vc]
+        if not new.any():
+            return
+        vr, vc = vr[new], vc[new]
+        dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res + 1e-6, True)
+        cls = int(np.floor(dr.shape[0] * res * res / self.spec.density_delta))
         self.visited[vr, vc] = True
-        self.seg_class[vr[new], vc[new]] = cls
+        self.seg_class[vr, vc] = cls
         box = (int(vr.min()), int(vr.max()), int(vc.min()), int(vc.max()))
         _grow(self.vbox, box)
         _grow(self.cdirty, box)
@@ -272,8 +282,11 @@ class Belief:
             else:
                 r0, r1 = max(0, b[0] - 2, d[0] - m), min(H, b[1] + 3, d[1] + m + 1)
                 c0, c1 = max(0, b[2] - 2, d[2] - m), min(W, b[3] + 3, d[3] + m + 1)
-            new = self._groups(self._front(r0, r1, c0, c1) & self.skeleton[r0:r1, c0:c1], r0, c0, need_branch=True)
-            if self._cands is not None:
+            if r1 <= r0 or c1 <= c0:  # what changed lies away from the visited region: nothing to redo
+                new = self._cands
+            else:
+                new = self._groups(self._front(r0, r1, c0, c1) & self.skeleton[r0:r1, c0:c1], r0, c0, need_branch=True)
+            if self._cands is not None and new is not self._cands:
                 old = self._cands
                 out_w = ~((old.rows >= r0) & (old.rows < r1) & (old.cols >= c0) & (old.cols < c1))
                 kept = old.take(np.flatnonzero(out_w))
@@ -308,17 +321,24 @@ class Belief:
         return self._groups(near & self.passable[r0:r1, c0:c1], r0, c0, need_branch=False)
 
     # ---- completeness: walls not yet looked at from close enough to read signs ---------------
-    def unread_walls(self, cam_range: float, half_fov: float, approach: float) -> Candidates:
+    def unread_walls(self, cam_range: float, half_fov: float, approach: float, need: int = 1) -> Candidates:
         """Where to go once no frontier is left: the known free space within ``approach`` m
-        (through free space) of a wall face no side camera has looked at from within its range
-        ``cam_range`` m (``half_fov`` radians either side of the perpendicular). A sign anywhere
-        on such a face may be unread (passed at an angle, or with the robot turning on the
-        spot), so a complete search goes back to look at it. One candidate per group of such
+        (through free space) of a wall face that a side camera has looked at from fewer than
+        ``need`` poses within its range ``cam_range`` m (``half_fov`` radians either side of the
+        perpendicular). A sign anywhere on such a face may be unread (passed at an angle, with the
+        robot turning on the spot, or missed by a camera that reads a visible sign only with some
+        probability), so a complete search goes back to look at it. One candidate per group of such
         cells, the widest; empty when every wall face has been looked at (or given up on, see
         :meth:`mark_examined`)."""
         H, W = self.free.shape
+        if self.viewed is None:
+            self.viewed = np.zeros((H, W), np.uint8)
+            self.examined = np.zeros((H, W), bool)
+            self._view_stamp = np.full((H, W), -1, np.int64)
         if self.views:
-            mark_viewed(self.free, self.viewed, np.array(self.views, np.float64), half_fov, cam_range / self.frame.res)
+            mark_viewed(self.free, self.viewed, self._view_stamp, self._n_views, np.array(self.views, np.float64),
+                        half_fov, cam_range / self.frame.res)
+            self._n_views += len(self.views)
             self.views.clear()
         rr, cc = np.nonzero(self.seen)
         if rr.size == 0:
@@ -329,7 +349,7 @@ class Belief:
         wall = (self.seen[r0:r1, c0:c1] & ~free).astype(np.uint8)
         cross = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], np.uint8)
         face = cv2.dilate(wall, cross).astype(bool) & free
-        todo = face & ~self.viewed[r0:r1, c0:c1] & ~self.examined[r0:r1, c0:c1]
+        todo = face & (self.viewed[r0:r1, c0:c1] < need) & ~self.examined[r0:r1, c0:c1]
         if not todo.any():
             return _empty()
         near = todo.astype(np.uint8)  # grown through free space only, so it stays on the face's side of the wall

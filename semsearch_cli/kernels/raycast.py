@@ -179,9 +179,11 @@ def line_of_sight(occ, v0, u0, v1, u1, stop_short):
 
 
 @njit(cache=True)
-def mark_viewed(free, viewed, views, half_fov, max_cells):
-    """Mark, for each view, the last free cell before the first cell that is not free along every
-    ray of two side cameras: ``viewed`` (H, W) bool is changed in place.
+def mark_viewed(free, viewed, stamp, first, views, half_fov, max_cells):
+    """Count, for each view, the last free cell before the first cell that is not free along
+    every ray of two side cameras: ``viewed`` (H, W) uint8 (saturating) is incremented in place,
+    once per view and cell (``stamp`` (H, W) int64 holds the last view that counted, views being
+    numbered from ``first``).
 
     Parameters
     ----------
@@ -199,6 +201,7 @@ def mark_viewed(free, viewed, views, half_fov, max_cells):
     step = 2.0 * half_fov / max(1, n_side - 1)
     for k in range(views.shape[0]):
         v0, u0, heading = views[k, 0], views[k, 1], views[k, 2]
+        vid = first + k
         for side in (-1.0, 1.0):
             centre = heading + side * 0.5 * math.pi
             for j in range(n_side):
@@ -212,8 +215,10 @@ def mark_viewed(free, viewed, views, half_fov, max_cells):
                     if r < 0 or r >= H or c < 0 or c >= W:
                         break
                     if not free[r, c]:
-                        if t > 0.0:
-                            viewed[pr, pc] = True
+                        if t > 0.0 and stamp[pr, pc] != vid:
+                            stamp[pr, pc] = vid
+                            if viewed[pr, pc] < 255:
+                                viewed[pr, pc] += 1
                         break
                     pr, pc = r, c
                     if tmr < tmc:

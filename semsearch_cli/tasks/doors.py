@@ -64,6 +64,17 @@ class DoorSensing:
         st.headings.append(st.heading)
 
 
+def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
+    """Frames from which a wall face must be seen before a sign on it counts as read-or-absent:
+    the fewest n with (1 - p_read)^n <= ``miss`` (1 for a camera that never misses), at most
+    ``cap`` (a camera that never reads would otherwise need infinitely many)."""
+    if p_read >= 1.0:
+        return 1
+    if p_read <= 0.0:
+        return cap
+    return int(min(cap, max(1, np.ceil(np.log(miss) / np.log1p(-p_read)))))
+
+
 class DoorSearch(DoorSensing):
     """Explore with a door planner until the goal sign is read."""
 
@@ -83,29 +94,40 @@ class DoorSearch(DoorSensing):
         # sweep the two side cameras over every direction
         self.approach = min(cam.range, max(0.5 * cam.range, task.world.frame.res * 3 + task.sc.robot.radius))
         self.look_turns = int(np.ceil(180.0 / cam.fov)) - 1
+        self.views_needed = views_needed(cam.p_read)
         self.sweep_target: tuple[int, int] | None = None
 
     def replan_due(self, path_done, since_plan, event):
         return path_done or since_plan >= self.replan_every or (event and self.uses_signs)
 
-    def turn(self, st, turns: int, angle: float) -> bool:
-        """Turn on the spot ``turns`` times by ``angle`` radians, sensing after each; whether the
-        goal was read."""
+    def turn(self, st, turns: int, angle: float, frames: int = 1) -> bool:
+        """Turn on the spot ``turns`` times by ``angle`` radians, sensing ``frames`` times after
+        each; whether the goal was read."""
         found = False
         for _ in range(turns):
             st.heading = float(wrap_angle(st.heading + angle))
-            f, _ = self.sense(st)
-            found = found or f
+            for _ in range(frames):
+                f, _ = self.sense(st)
+                found = found or f
         return found
+
+    def look_round(self, st) -> bool:
+        """At a wall face not yet looked at enough: dwell ``views_needed`` frames at each of the
+        headings that sweep the two side cameras over every direction (a half turn); whether
+        the goal was read."""
+        found = False
+        for _ in range(self.views_needed - 1):  # the frame of this step was the first
+            found = self.sense(st)[0] or found
+        return self.turn(st, self.look_turns, np.pi / (self.look_turns + 1), self.views_needed) or found
 
     def plan(self, st):
         b, fr = st.belief, self.task.world.frame
         r, c = (int(v) for v in fr.to_index(st.x, st.y))
         if self.sweep_target is not None and max(abs(r - self.sweep_target[0]), abs(c - self.sweep_target[1])) <= 1:
-            # at a wall face not yet looked at: look all round (the two side cameras cover every
-            # direction over a half turn), then give up on the faces near here
+            # at a wall face not yet looked at enough: look all round, then give up on the faces
+            # near here
             self.sweep_target = None
-            if self.turn(st, self.look_turns, np.pi / (self.look_turns + 1)):
+            if self.look_round(st):
                 return "found"
             b.mark_examined(r, c, self.approach + 2 * fr.res)
         b.refresh_derived()
@@ -137,7 +159,7 @@ class DoorSearch(DoorSensing):
         at from within reading range; ``stuck`` only when there is none the robot can reach."""
         cam = self.task.sc.door_camera
         for _ in range(MAX_RETRIES):
-            cands = st.belief.unread_walls(cam.range, np.radians(cam.fov) / 2, self.approach)
+            cands = st.belief.unread_walls(cam.range, np.radians(cam.fov) / 2, self.approach, self.views_needed)
             dec = nearest_candidate(ctx, cands)
             if dec is None:
                 return "stuck"
