@@ -219,3 +219,22 @@ def test_a_goal_with_a_slash_writes_its_path_file(tmp_path):
     assert runs["outcome"].tolist() == ["found"]
     assert "/" not in file_stem("greedy", "12/2", 0)
     assert (tmp_path / "out" / "paths" / f"{file_stem('greedy', '12/2', 0)}.npz").is_file()
+
+
+def test_views_needed_for_a_camera_that_misses():
+    from semsearch_cli.tasks.doors import views_needed
+
+    assert [views_needed(p) for p in (1.0, 0.99, 0.95, 0.5, 0.0)] == [1, 1, 2, 7, 20]  # (1 - p)^n <= 1%, capped at 20
+
+
+def test_a_camera_that_misses_half_its_reads_still_finds_the_dead_end_sign(tmp_path):
+    """With p_read 0.5 one look from each heading misses the sign half the time: the robot
+    dwells views_needed frames per heading, and counts a wall face as looked at only after that
+    many poses."""
+    from semsearch_cli.runner import Loaded
+
+    p = dead_end_scenario(tmp_path)
+    d = yaml.safe_load(p.read_text())
+    d["door_camera"] = {"p_read": 0.5}
+    L = Loaded.load(p, d)
+    assert all(L.task.run(Variant("greedy", ()), 99, s).outcome == "found" for s in range(6))
