@@ -16,8 +16,9 @@ from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import Loaded, expand, run_batch, run_rows
+from .runner import Loaded, check_folder, expand, folder_lock, run_batch, run_rows
 from .tasks.objects import write_log
+from .files import temp_path
 
 
 @dataclass
@@ -41,11 +42,13 @@ def default_workers() -> int:
 
 def run(scenario: str | Path, seeds: int | None = None, workers: int | None = None, goals=None,
         planners=None, out: str | Path | None = None, progress=None, plots: bool = True,
-        trace: bool = False, planner_specs=None) -> RunOutput:
+        trace: bool = False, planner_specs=None, force: bool = False) -> RunOutput:
     """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/.
 
     ``planner_specs`` (a list of :class:`~semsearch_cli.config.PlannerSpec`) replaces the
-    scenario's planners; ``trace`` writes each run's decisions to traces/<run>.jsonl.
+    scenario's planners; ``trace`` writes each run's decisions to traces/<run>.jsonl. The
+    output folder is locked for the command; rows of another (or an edited) scenario in it are
+    refused unless ``force`` (see :func:`~semsearch_cli.runner.run_batch`).
     """
     loaded = Loaded.load(Path(scenario))
     if planner_specs is not None:
@@ -59,12 +62,14 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
     out_dir = default_out(loaded, out)
-    report_build.write_meta(out_dir, loaded.path)
-    loaded.task.write_inputs(out_dir)
-    runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress, trace)
-    summary = write_summary(runs, out_dir)
-    if plots:
-        report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
+    with folder_lock(out_dir):
+        check_folder(loaded, out_dir, force)
+        report_build.write_meta(out_dir, loaded.path)
+        loaded.task.write_inputs(out_dir)
+        runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress, trace)
+        summary = write_summary(runs, out_dir)
+        if plots:
+            report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
     return RunOutput(out_dir, runs, summary)
 
 
@@ -80,14 +85,14 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
 
 
 def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
-                goals=None, out: str | Path | None = None, progress=None, trace: bool = False) -> RunOutput:
+                goals=None, out: str | Path | None = None, progress=None, trace: bool = False, force: bool = False) -> RunOutput:
     """nsos at each alpha with greedy beside it: the rows and summary of :func:`run`, plus
     ``plots/alpha_sweep.png``. Other nsos parameters come from the scenario's first nsos entry."""
     sc = load_scenario(scenario)
     base = next((p.params() for p in sc.planners if p.name == "nsos"), {})
     base.pop("alpha", None)
     specs = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[float(a) for a in alphas], **base)]
-    res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs)
+    res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs, force=force)
     labels = {v.label for v in expand_variants(specs, str(scenario))}
     (res.out / "plots").mkdir(parents=True, exist_ok=True)
     plot_alpha_sweep(run_rows(res.runs)[run_rows(res.runs)["planner"].isin(labels)], res.out / "plots" / "alpha_sweep.png")
@@ -117,7 +122,8 @@ def parse_param(text: str) -> tuple[str, list]:
 
 
 def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = None, workers: int | None = None,
-          goals=None, planners=None, out: str | Path | None = None, progress=None, trace: bool = False) -> SweepOutput:
+          goals=None, planners=None, out: str | Path | None = None, progress=None, trace: bool = False,
+          force: bool = False) -> SweepOutput:
     """Run a scenario once per value of one parameter (see
     :func:`~semsearch_cli.config.with_param`): each value's rows go to ``out/<param>=<value>/``
     (resumable, as :func:`run`), then ``sweep.csv``, ``sweep.md`` and ``sweep.png`` compare them.
@@ -126,31 +132,35 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
     out_dir = Path(out) if out else Path("results") / f"{loaded[0].sc.name}-sweep-{param}"
-    frames = []
-    for v, ld in zip(values, loaded):
-        specs = expand(ld, seeds, goals, planners)
-        if not specs:
-            raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
-        sub = out_dir / f"{param}={v}"
-        report_build.write_meta(sub, ld.path)
-        ld.task.write_inputs(sub)
-        runs = run_batch(ld, specs, sub, workers or default_workers(), progress, trace)
-        write_summary(runs, sub)
-        frames.append(run_rows(runs).assign(value=v))
-    runs = pd.concat(frames, ignore_index=True)
-    table = sweep_table(runs, param)
-    tmp = out_dir / ".sweep.csv.tmp"
-    table.to_csv(tmp, index=False)
-    os.replace(tmp, out_dir / "sweep.csv")
-    atomic_text(out_dir / "sweep.md", markdown_table(table, fmt="{:g}") + "\n")
-    plot_sweep(table, param, out_dir / "sweep.png")
+    with folder_lock(out_dir):
+        subs = [out_dir / f"{param}={v}" for v in values]
+        for ld, sub in zip(loaded, subs):  # refuse foreign rows before anything runs
+            check_folder(ld, sub, force)
+        frames = []
+        for v, ld, sub in zip(values, loaded, subs):
+            specs = expand(ld, seeds, goals, planners)
+            if not specs:
+                raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
+            with folder_lock(sub):
+                report_build.write_meta(sub, ld.path)
+                ld.task.write_inputs(sub)
+                runs = run_batch(ld, specs, sub, workers or default_workers(), progress, trace, force=force)
+                write_summary(runs, sub)
+            frames.append(run_rows(runs).assign(value=v))
+        runs = pd.concat(frames, ignore_index=True)
+        table = sweep_table(runs, param)
+        tmp = temp_path(out_dir / "sweep.csv")
+        table.to_csv(tmp, index=False)
+        os.replace(tmp, out_dir / "sweep.csv")
+        atomic_text(out_dir / "sweep.md", markdown_table(table, fmt="{:g}") + "\n")
+        plot_sweep(table, param, out_dir / "sweep.png")
     return SweepOutput(out_dir, runs, table)
 
 
 def write_summary(runs: pd.DataFrame, out_dir: Path) -> pd.DataFrame:
     """summary.csv: per scenario x goal x planner, the statistics of the runs' distances."""
     summary = summarise(run_rows(runs))
-    tmp = out_dir / ".summary.csv.tmp"
+    tmp = temp_path(out_dir / "summary.csv")
     summary.to_csv(tmp, index=False)
     os.replace(tmp, out_dir / "summary.csv")
     return summary

@@ -26,6 +26,7 @@ from .world.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
 from .world.kth import import_kth as imp_kth
 from .world.mobilesim import import_mobilesim as imp_mobilesim
 from .world.ros_import import import_ros as imp_ros
+from .files import temp_path
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
@@ -36,7 +37,7 @@ err = Console(stderr=True) if sys.stderr.isatty() else Console(stderr=True, widt
 
 
 def _fail(exc: ScenarioError) -> None:
-    err.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+    err.print("[bold red]error:[/] " + escape(str(exc)), highlight=False, soft_wrap=True)
     raise typer.Exit(2)
 
 
@@ -56,11 +57,13 @@ def run(
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
     out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl."),
+    force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
 ):
     """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
-    _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick, trace=trace))
+    _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick, trace=trace,
+                                force=force))
 
 
 @app.command("sweep-alpha")
@@ -72,6 +75,7 @@ def sweep_alpha(
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
     out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
+    force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
 ):
     """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
     plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
@@ -82,7 +86,8 @@ def sweep_alpha(
         _fail(ScenarioError("<command line>", "--alphas", f"expected comma-separated numbers, got {alphas!r}"))
     if not values or any(not 0.0 <= a <= 1.0 for a in values):
         _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
-    res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal), out_dir, progress=tick, trace=trace))
+    res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal), out_dir, progress=tick, trace=trace,
+                                                     force=force))
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
 
@@ -97,6 +102,7 @@ def sweep(
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label."),
     out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>-sweep-<param>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
+    force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
 ):
     """Run a scenario once per value of one parameter: each value's rows in <out>/<param>=<value>/
     (resumable), then sweep.csv, sweep.md and sweep.png (mean ratio to the shortest path and success
@@ -107,7 +113,7 @@ def sweep(
     except ScenarioError as exc:
         _fail(exc)
     res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal), _split(planner), out_dir,
-                                                progress=tick, trace=trace))
+                                                progress=tick, trace=trace, force=force))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
     out.print(escape(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv"))
@@ -205,7 +211,7 @@ def presence(
         t.add_row(f"{rh:g}", *[f"{v:.2f}" + ("*" if c == best else "") for c, v in row.items()])
     out.print(t)
     if out_file:
-        tmp = out_file.with_suffix(out_file.suffix + ".tmp")
+        tmp = temp_path(out_file)
         scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv(tmp)
         tmp.replace(out_file)
         out.print(f"wrote {out_file}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 COLUMNS = ["kind", "scenario", "planner", "params", "goal", "seed", "stage", "map", "outcome", "success", "distance_m",
-           "shortest_m", "ratio", "spl", "time_s", "steps", "decisions", "navigator", "wall_s", "message"]
+           "shortest_m", "ratio", "spl", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint"]
 
 
 def spl(success: bool, shortest: float, distance: float) -> float:

@@ -13,6 +13,7 @@ from pathlib import Path
 import pandas as pd
 
 from .tables import cells
+from ..files import temp_path
 
 
 @dataclass
@@ -132,7 +133,7 @@ def markdown_table(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}
 
 def atomic_text(path: Path, text: str) -> None:
     """Write a text file atomically (a reader never sees half of it)."""
-    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp = temp_path(path)
     tmp.write_text(text)
     os.replace(tmp, path)
 
@@ -141,6 +142,6 @@ def write_table(tdir: Path, name: str, df: pd.DataFrame, formats) -> None:
     """tables/<name>.csv (atomic), when csv is among the formats."""
     if "csv" in formats:
         tdir.mkdir(parents=True, exist_ok=True)
-        tmp = tdir / f".{name}.csv.tmp"
+        tmp = temp_path(tdir / f"{name}.csv")
         df.to_csv(tmp, index=not isinstance(df.index, pd.RangeIndex))
         os.replace(tmp, tdir / f"{name}.csv")

@@ -6,6 +6,7 @@ import json
 import os
 from pathlib import Path
 
+from ..files import temp_path
 from .tables import goal_key
 
 import matplotlib
@@ -41,7 +42,7 @@ def _finish_map(fig, ax, title: str, out: Path, dpi: int = 110) -> None:
 
 def _save(fig, out: Path, dpi: int = 110) -> None:
     """Write a figure atomically and close it."""
-    tmp = out.with_suffix(".tmp" + out.suffix)
+    tmp = temp_path(out)
     fig.savefig(tmp, dpi=dpi)
     plt.close(fig)
     os.replace(tmp, out)
@@ -186,7 +187,7 @@ def animate_run(world, frames: list, title: str, out: Path, fps: int = 5) -> Non
         ax.legend(loc="upper right", fontsize=6)
 
     anim = FuncAnimation(fig, draw, frames=len(frames))
-    tmp = out.with_suffix(".tmp.gif")
+    tmp = temp_path(out)
     anim.save(tmp, writer=PillowWriter(fps=fps))
     plt.close(fig)
     os.replace(tmp, out)
@@ -409,7 +410,7 @@ def animate_probability(room, target: str, frames: list, title: str, out: Path, 
         ax.set_yticks([])
 
     anim = FuncAnimation(fig, draw, frames=len(frames))
-    tmp = out.with_suffix(".tmp.gif")
+    tmp = temp_path(out)
     anim.save(tmp, writer=PillowWriter(fps=fps))
     plt.close(fig)
     os.replace(tmp, out)

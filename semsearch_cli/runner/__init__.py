@@ -1,9 +1,10 @@
 """The runner: run specs and seeds, executors, the row store (append, resume)."""
 
-from .batch import run_batch
+from .batch import check_folder, run_batch
+from .lock import folder_lock
 from .executors import ProcessExecutor, SerialExecutor, execute, make_executor
 from .specs import Loaded, RunSpec, expand, file_stem
 from .store import RowWriter, read_runs, run_rows, save_run_files
 
-__all__ = ["Loaded", "ProcessExecutor", "RowWriter", "RunSpec", "SerialExecutor", "execute", "expand", "file_stem",
+__all__ = ["Loaded", "check_folder", "ProcessExecutor", "RowWriter", "RunSpec", "SerialExecutor", "execute", "expand", "file_stem", "folder_lock",
            "make_executor", "read_runs", "run_batch", "run_rows", "save_run_files"]

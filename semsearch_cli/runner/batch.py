@@ -8,28 +8,59 @@ from typing import Callable
 
 import pandas as pd
 
+from ..errors import ScenarioError
 from .executors import SerialExecutor, make_executor
+from .lock import folder_lock
 from .specs import Loaded, RunSpec
 from .store import RowWriter, read_runs, run_rows
 
 
-def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
-              progress: Callable[[dict], None] | None = None, trace: bool = False,
-              start_method: str | None = None) -> pd.DataFrame:
-    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
-    With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
-    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`)."""
+def check_folder(loaded: Loaded, out: Path, force: bool = False) -> pd.DataFrame:
+    """The rows of ``out/runs.csv`` that a batch of ``loaded`` may resume (see :func:`run_batch`);
+    a :class:`ScenarioError` when they were made with another scenario, unless ``force``."""
     runs_csv = out / "runs.csv"
     done = run_rows(read_runs(runs_csv))
-    have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
-    todo = [s for s in specs if s.key not in have]
-    executor = make_executor(workers, start_method) if len(todo) > 1 else SerialExecutor()
-    writer = RowWriter(runs_csv)
-    try:
-        for rows in executor.rows(loaded, todo, out, trace):
-            writer.write(rows)
-            if progress:
-                progress(rows[0])
-    finally:
-        writer.close()
-    return read_runs(runs_csv)
+    fp = loaded.fingerprint
+    foreign = len(done) and ("fingerprint" not in done.columns or (done["fingerprint"].astype(str) != fp).any())
+    if foreign and not force:
+        raise ScenarioError(str(runs_csv), "fingerprint", f"these rows were made with another scenario, with {loaded.path} before it was edited, "
+                            "or by an older semsearch, so they cannot be resumed; write into a fresh folder with --out, "
+                            "or re-run everything here with --force (the old runs.csv is kept as runs.<n>.csv.bak)")
+    if foreign:
+        n = 1
+        while (out / f"runs.{n}.csv.bak").exists():
+            n += 1
+        runs_csv.rename(out / f"runs.{n}.csv.bak")
+        done = run_rows(read_runs(runs_csv))
+    return done
+
+
+def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
+              progress: Callable[[dict], None] | None = None, trace: bool = False,
+              start_method: str | None = None, force: bool = False) -> pd.DataFrame:
+    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
+    With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
+    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`).
+
+    The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's
+    fingerprint (:attr:`Loaded.fingerprint`); rows of another scenario (or an edited one) in the
+    folder are refused, unless ``force``, which moves that runs.csv aside (kept as
+    ``runs.<n>.csv.bak``) and starts afresh."""
+    runs_csv = out / "runs.csv"
+    fp = loaded.fingerprint
+    with folder_lock(out):
+        done = check_folder(loaded, out, force)
+        have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
+        todo = [s for s in specs if s.key not in have]
+        executor = make_executor(workers, start_method) if len(todo) > 1 else SerialExecutor()
+        writer = RowWriter(runs_csv)
+        try:
+            for rows in executor.rows(loaded, todo, out, trace):
+                for r in rows:
+                    r["fingerprint"] = fp
+                writer.write(rows)
+                if progress:
+                    progress(rows[0])
+        finally:
+            writer.close()
+        return read_runs(runs_csv)

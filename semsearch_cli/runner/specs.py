@@ -7,7 +7,9 @@ do not depend on the number of workers or the executor.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+import hashlib
+import json
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config import Scenario, load_scenario, parse_scenario
@@ -49,6 +51,7 @@ class Loaded:
     path: Path
     sc: Scenario
     task: Task
+    _fingerprint: str | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def load(cls, path: str | Path, data: dict | None = None) -> "Loaded":
@@ -75,12 +78,46 @@ class Loaded:
     def shortest(self) -> dict:
         return self.task.shortest
 
+    @property
+    def fingerprint(self) -> str:
+        """A hash of what decides a run's outcome: the resolved scenario without the run list
+        (planners, goals, seeds, output folder), with every file it names (map image, doors,
+        logs, ...) standing for its bytes, not its path (a scenario moved with its files keeps
+        its fingerprint). Rows carry it, and a batch resumes only rows that match."""
+        if self._fingerprint is None:
+            d = self.sc.model_dump(mode="json")
+            for key in ("planners", "goals"):
+                d.pop(key, None)
+            for key in ("seeds", "out"):
+                d["experiment"].pop(key, None)
+            d = _files_by_content(d, self.path.parent)
+            h = hashlib.sha256(json.dumps(d, sort_keys=True).encode())
+            self._fingerprint = h.hexdigest()[:16]
+        return self._fingerprint
+
     def with_planners(self, specs) -> "Loaded":
         """The same scenario with other planner entries (checked for this kind of search)."""
         sc = self.sc.model_copy(update={"planners": specs})
         self.task.variants(specs)
         self.task.sc = sc
         return Loaded(self.path, sc, self.task)
+
+
+def _files_by_content(d, base: Path):
+    """The scenario document ``d`` with each string that names an existing file (relative to
+    ``base``) replaced by a hash of the file's bytes."""
+    if isinstance(d, dict):
+        return {k: _files_by_content(v, base) for k, v in d.items()}
+    if isinstance(d, list):
+        return [_files_by_content(v, base) for v in d]
+    if isinstance(d, str) and ("." in d or "/" in d) and len(d) < 4096:
+        try:
+            p = base / d
+            if p.is_file():
+                return "file:" + hashlib.sha256(p.read_bytes()).hexdigest()
+        except OSError:
+            pass
+    return d
 
 
 def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> list[RunSpec]:

@@ -4,6 +4,7 @@ reports; and each run's path (and trace) beside it (SPEC 9)."""
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 from pathlib import Path
@@ -13,20 +14,46 @@ import pandas as pd
 
 from ..errors import ScenarioError
 from ..metrics import COLUMNS
+from ..files import temp_path
 
 
 def read_runs(path: Path) -> pd.DataFrame:
-    """runs.csv as a DataFrame (empty with the columns when absent); a torn last line is dropped.
-    ``stage`` and ``map`` are read as text (empty for a run's own row)."""
+    """runs.csv as a DataFrame (empty with the columns when absent). A torn last line (a write
+    cut by power loss or a full disk, even inside a quoted field) is left out; a file that is not
+    a runs.csv written by semsearch is a :class:`ScenarioError`. ``stage`` and ``map`` are read as
+    text (empty for a run's own row)."""
     if not path.is_file() or path.stat().st_size == 0:
         return pd.DataFrame(columns=COLUMNS)
-    df = pd.read_csv(path, on_bad_lines="skip", dtype={"stage": str, "map": str, "message": str, "kind": str,
-                                                       "scenario": str})  # a scenario may be named 50045233
-    if "kind" not in df.columns:
+    data = path.read_bytes()
+    data = data[: data.rfind(b"\n") + 1]  # whole lines only
+    bad = "not a runs.csv written by semsearch; move it away or write into another folder with --out"
+    try:
+        df = pd.read_csv(io.BytesIO(data), dtype={"stage": str, "map": str, "message": str, "kind": str, "scenario": str,
+                                                  "fingerprint": str}, encoding="utf-8")  # a scenario may be named 50045233
+    except (ValueError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise ScenarioError(str(path), "", f"{bad} ({type(exc).__name__})") from None
+    if "kind" not in df.columns and "wall_s" in df.columns:
         raise ScenarioError(str(path), "kind", "this runs.csv was written by an older semsearch (no kind column); "
                             "write new runs into another folder with --out")
+    missing = [c for c in COLUMNS if c not in df.columns and c != "fingerprint"]
+    if missing:
+        raise ScenarioError(str(path), "", f"{bad} (no column {', '.join(missing[:3])})")
     df[["stage", "map", "message"]] = df[["stage", "map", "message"]].fillna("")
     return df.dropna(subset=["wall_s"])
+
+
+def _whole_lines(fh) -> int:
+    """The length of an open binary file up to and including its last newline (0 without one)."""
+    end = fh.seek(0, os.SEEK_END)
+    pos = end
+    while pos > 0:
+        step = min(65536, pos)
+        fh.seek(pos - step)
+        k = fh.read(step).rfind(b"\n")
+        if k >= 0:
+            return pos - step + k + 1
+        pos -= step
+    return 0
 
 
 def run_rows(df: pd.DataFrame) -> pd.DataFrame:
@@ -39,13 +66,12 @@ class RowWriter:
 
     def __init__(self, path: Path):
         path.parent.mkdir(parents=True, exist_ok=True)
+        if path.is_file():  # drop a last line cut by an interruption
+            with open(path, "rb+") as fh:
+                fh.truncate(_whole_lines(fh))
         new = not path.is_file() or path.stat().st_size == 0
         fields = COLUMNS
-        if not new:  # repair a file cut mid-line by an interruption; keep its columns
-            with open(path, "rb+") as fh:
-                fh.seek(-1, os.SEEK_END)
-                if fh.read(1) != b"\n":
-                    fh.write(b"\n")
+        if not new:  # keep the file's columns
             with open(path, newline="") as fh:
                 fields = next(csv.reader(fh))
         self.fh = open(path, "a", newline="")
@@ -69,14 +95,14 @@ def save_run_files(out: Path, stem: str, res) -> None:
     (one JSON object per decision); each written atomically."""
     paths = out / "paths"
     paths.mkdir(parents=True, exist_ok=True)
-    tmp = paths / f".{stem}.tmp.npz"
+    tmp = temp_path(paths / f"{stem}.npz")
     with open(tmp, "wb") as fh:
         np.savez_compressed(fh, path=res.path, read_signs=np.asarray(res.read_signs, np.int64))
     os.replace(tmp, paths / f"{stem}.npz")
     if res.trace:
         traces = out / "traces"
         traces.mkdir(parents=True, exist_ok=True)
-        tmp = traces / f".{stem}.tmp.jsonl"
+        tmp = temp_path(traces / f"{stem}.jsonl")
         with open(tmp, "w") as fh:
             for d in res.trace:
                 fh.write(json.dumps(d) + "\n")

@@ -48,6 +48,7 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from .base import Outcome, RobotState, Task, register_task
 from .loop import run_loop
+from ..files import temp_path
 
 LOG_COLUMNS = ["day", "hour", "class", "x", "y", "robot_x", "robot_y", "place"]
 
@@ -431,7 +432,7 @@ def read_log(path: Path) -> pd.DataFrame:
 
 def write_log(df: pd.DataFrame, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
+    tmp = temp_path(path)
     df.to_csv(tmp, index=False, float_format="%.3f")
     tmp.replace(path)
 

@@ -35,6 +35,7 @@ from ..config import read_yaml
 from ..config.indirect import CATEGORIES, MasksSpec
 from ..errors import ScenarioError
 from ..geometry import GridFrame
+from ..files import temp_path
 
 WALL_MARGIN = 0.25  # m, objects and the start keep this from walls and obstacles
 OBJECT_GAP = 0.3  # m, between objects
@@ -157,7 +158,7 @@ def write_rooms(path: Path, rooms: list[Room]) -> Path:
     text = yaml.safe_dump({"size": list(size), "rooms": [r.to_dict() for r in rooms]}, sort_keys=False,
                           default_flow_style=None)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
+    tmp = temp_path(path)
     tmp.write_text("# rooms for indirect search: semsearch generate rooms\n" + text)
     os.replace(tmp, path)
     return path

@@ -1,0 +1,130 @@
+"""Output folders are safe: one batch per folder, rows of another scenario never reused, a torn
+last line (even inside a quoted field) survives, garbage files are refused cleanly; user text is
+never read as console markup (issue 14)."""
+
+import fcntl
+import os
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from semsearch_cli import api
+from semsearch_cli.cli import app
+from semsearch_cli.errors import ScenarioError
+from semsearch_cli.runner import Loaded, expand, folder_lock, read_runs, run_batch
+
+runner = CliRunner()
+
+
+def demo_copy(demo_dir, tmp_path, fname="scenario.yaml", **over):
+    d = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    d["map"]["image"] = str(demo_dir / "map.png")
+    d["doors"] = str(demo_dir / "doors.csv")
+    d["planners"] = [{"name": "greedy"}]
+    d.update(over)
+    p = tmp_path / fname
+    p.write_text(yaml.safe_dump(d))
+    return p
+
+
+def test_a_second_batch_into_a_folder_in_use_is_refused(demo_dir, tmp_path):
+    out = tmp_path / "out"
+    with folder_lock(out):  # as a running `semsearch run` holds it
+        child = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "run",
+                                str(demo_dir / "scenario.yaml"), "--seeds", "1", "--out", str(out)],
+                               capture_output=True, text=True, timeout=120)
+    assert child.returncode == 2, child.stderr
+    text = " ".join(child.stderr.split())
+    assert f"process {os.getpid()}" in text and "in use" in text and "Traceback" not in text
+    assert not (out / "runs.csv").exists()
+
+
+def test_the_lock_is_reentrant_and_released(tmp_path):
+    out = tmp_path / "o"
+    with folder_lock(out):
+        with folder_lock(out):
+            pass
+        fh = open(out / ".semsearch.lock")
+        with pytest.raises(BlockingIOError):
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fh.close()
+    fh = open(out / ".semsearch.lock")
+    fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)  # free again
+    fh.close()
+
+
+def test_rows_of_another_scenario_are_refused_then_forced(demo_dir, tmp_path):
+    out = tmp_path / "out"
+    a = demo_copy(demo_dir, tmp_path, "a.yaml")
+    api.run(a, seeds=1, workers=1, goals=[452], out=out, plots=False)
+    b = demo_copy(demo_dir, tmp_path, "b.yaml", experiment={"seeds": 1, "max_distance": 300.0})  # an edited budget
+    with pytest.raises(ScenarioError, match="--force"):
+        api.run(b, seeds=1, workers=1, goals=[452], out=out, plots=False)
+    r = runner.invoke(app, ["run", str(b), "--seeds", "1", "--goal", "452", "--out", str(out), "--workers", "1"])
+    assert r.exit_code == 2 and "another scenario" in " ".join(r.output.split())
+    res = api.run(b, seeds=1, workers=1, goals=[452], out=out, plots=False, force=True)
+    assert len(res.runs) == 1 and res.runs["fingerprint"].nunique() == 1
+    assert (out / "runs.1.csv.bak").is_file()  # nothing is lost
+    # the same scenario resumes: nothing re-runs
+    again = api.run(b, seeds=1, workers=1, goals=[452], out=out, plots=False)
+    assert len(again.runs) == 1
+
+
+def test_the_fingerprint_ignores_the_run_list_but_not_the_map(demo_dir, tmp_path):
+    base = Loaded.load(demo_copy(demo_dir, tmp_path, "a.yaml"))
+    more = Loaded.load(demo_copy(demo_dir, tmp_path, "b.yaml", planners=[{"name": "bvp"}], goals=[304],
+                                 experiment={"seeds": 7, "max_distance": 500.0}))
+    assert base.fingerprint == more.fingerprint  # planners, goals and seeds only choose runs
+    img = tmp_path / "map.png"
+    img.write_bytes((demo_dir / "map.png").read_bytes())
+    moved = demo_copy(demo_dir, tmp_path, "c.yaml")
+    d = yaml.safe_load(moved.read_text())
+    d["map"]["image"] = "map.png"
+    moved.write_text(yaml.safe_dump(d))
+    assert Loaded.load(moved).fingerprint == base.fingerprint  # the same bytes
+    import cv2
+
+    m = cv2.imread(str(img), cv2.IMREAD_GRAYSCALE)
+    m[0, 0] = 0 if m[0, 0] else 255
+    cv2.imwrite(str(img), m)
+    assert Loaded.load(moved).fingerprint != base.fingerprint
+
+
+@pytest.mark.parametrize("cut", [5, 40, -3])
+def test_a_torn_last_line_is_dropped_wherever_it_is_cut(demo_loaded, tmp_path, cut):
+    out = tmp_path / "out"
+    run_batch(demo_loaded, expand(demo_loaded, 2)[:2], out, 1)
+    f = out / "runs.csv"
+    lines = f.read_bytes().split(b"\n")
+    last = lines[-2]
+    assert b'"{' in last or b"{" in last  # the params field is quoted JSON
+    f.write_bytes(b"\n".join(lines[:-2]) + b"\n" + last[:cut])  # cut inside the last row
+    assert len(read_runs(f)) == 1
+    runs = run_batch(demo_loaded, expand(demo_loaded, 2)[:2], out, 1)
+    assert len(runs) == 2 and len(pd.read_csv(f)) == 2
+
+
+@pytest.mark.parametrize("content", [b"\x00\xff\xfe garbage \x00" * 50, b"a,b,c\n1,2,3\n", "é".encode("latin-1") * 10])
+def test_a_garbage_runs_csv_is_refused_cleanly(demo_dir, tmp_path, content):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "runs.csv").write_bytes(content)
+    r = runner.invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "1", "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "runs.csv" in r.output and "Traceback" not in r.output
+    r = runner.invoke(app, ["report", str(out)])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+
+
+def test_user_text_is_not_console_markup(demo_dir, tmp_path):
+    r = runner.invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--planner", "[/x]", "--out", str(tmp_path / "o")])
+    assert r.exit_code == 2 and "[/x]" in r.output and "MarkupError" not in r.output
+    r = runner.invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--goal", "[bold]", "--out", str(tmp_path / "o")])
+    assert r.exit_code == 2 and "[bold]" in r.output
+    p = demo_copy(demo_dir, tmp_path, "[a].yaml", name="x[/a]")
+    r = runner.invoke(app, ["validate", str(p)])
+    assert r.exit_code == 2 and "[a].yaml" in r.output
