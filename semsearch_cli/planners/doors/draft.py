@@ -46,7 +46,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ...geometry import wrap_angle
 from ..base import Decision, register_planner
-from .nsos import KeepTarget, closeness, increasing_direction, pick
+from .nsos import KeepTarget, increasing_sum, pick
 
 
 def parity_attraction(numbers, goal: int, beta: float) -> float:
@@ -63,16 +63,10 @@ def parity_attraction(numbers, goal: int, beta: float) -> float:
 def increasing_strength(numbers, xs, ys, w_g: float) -> tuple[float | None, float]:
     """(FF, GG): the direction of the summed unit vectors from each sign to every larger one, and
     their norm over max(w_g, number of vectors); (None, 0) without two distinct numbers."""
-    numbers = np.asarray(numbers)
-    th = increasing_direction(numbers, np.asarray(xs, float), np.asarray(ys, float))
-    if th is None:
+    ff, norm, pairs = increasing_sum(np.asarray(numbers), np.asarray(xs, float), np.asarray(ys, float))
+    if ff is None:
         return None, 0.0
-    i, j = np.nonzero(numbers[:, None] < numbers[None, :])
-    dx, dy = np.asarray(xs, float)[j] - np.asarray(xs, float)[i], np.asarray(ys, float)[j] - np.asarray(ys, float)[i]
-    n = np.hypot(dx, dy)
-    ok = n > 1e-9
-    norm = math.hypot((dx[ok] / n[ok]).sum(), (dy[ok] / n[ok]).sum())
-    return th, min(1.0, norm / max(w_g, float(i.size)))
+    return ff, min(1.0, norm / max(w_g, float(pairs)))
 
 
 def growing_attraction(numbers, xs, ys, goal: int, theta_f: float, w_g: float) -> float:
@@ -106,13 +100,10 @@ class Draft(KeepTarget):
     def _decide(self, ctx, cands, keep: int | None = None):
         k = len(cands)
         p, b = self.params, ctx.belief
-        gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, k)
-        D = gs.lengths(cands.rows, cands.cols)
-        reach = np.isfinite(D)
-        if not reach.any():
+        dist = self.distances(ctx, cands)
+        if dist is None:
             return None
-        gamma = np.zeros(k)
-        gamma[reach] = closeness(D[reach])
+        D, reach, gamma = dist
         tau = np.full(k, 0.5)
         omega = np.full(k, 0.5)
         goal = ctx.goal if isinstance(ctx.goal, (int, np.integer)) else None

@@ -38,20 +38,25 @@ from ..base import Decision, Planner, register_planner
 
 
 # ---- the five factors, as pure functions ------------------------------------------------------
-def increasing_direction(numbers: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> float | None:
-    """theta_inc (radians): direction of the sum of unit vectors from each sign to every larger
-    one; None with fewer than two distinct numbers or when the vectors cancel."""
+def increasing_sum(numbers: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[float | None, float, int]:
+    """(theta_inc, norm, pairs): the direction (radians) and norm of the sum of unit vectors
+    from each sign to every larger one, and the number of such pairs; theta_inc is None with
+    fewer than two distinct numbers or when the vectors cancel."""
     numbers = np.asarray(numbers)
     if np.unique(numbers).size < 2:
-        return None
+        return None, 0.0, 0
     i, j = np.nonzero(numbers[:, None] < numbers[None, :])
     dx, dy = xs[j] - xs[i], ys[j] - ys[i]
     n = np.hypot(dx, dy)
     ok = n > 1e-9
     sx, sy = (dx[ok] / n[ok]).sum(), (dy[ok] / n[ok]).sum()
-    if math.hypot(sx, sy) < 1e-9:
-        return None
-    return math.atan2(sy, sx)
+    norm = math.hypot(sx, sy)
+    return (None if norm < 1e-9 else math.atan2(sy, sx)), norm, int(i.size)
+
+
+def increasing_direction(numbers: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> float | None:
+    """theta_inc (radians) of :func:`increasing_sum`."""
+    return increasing_sum(numbers, xs, ys)[0]
 
 
 def growing_direction(numbers, xs, ys, goal: int, theta_f: float, w_g: float) -> tuple[float, float, float]:
@@ -182,6 +187,19 @@ class KeepTarget(Planner):
     def _decide(self, ctx, cands, keep: int | None) -> Decision | None:
         raise NotImplementedError
 
+    @staticmethod
+    def distances(ctx, cands):
+        """(D, reach, phi_c): skeleton distances to the candidates (cells), which are reachable,
+        and their closeness (0 where unreachable); None when none is reachable."""
+        gs = ctx.belief.search(ctx.row, ctx.col, cands.rows, cands.cols, len(cands))
+        D = gs.lengths(cands.rows, cands.cols)
+        reach = np.isfinite(D)
+        if not reach.any():
+            return None
+        phi_c = np.zeros(len(cands))
+        phi_c[reach] = closeness(D[reach])
+        return D, reach, phi_c
+
 
 @register_planner("nsos")
 class NSOS(KeepTarget):
@@ -199,13 +217,10 @@ class NSOS(KeepTarget):
         k = len(cands)
         p, b = self.params, ctx.belief
         alpha = p.alpha if self.use_semantics else 0.0
-        gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, k)
-        D = gs.lengths(cands.rows, cands.cols)
-        reach = np.isfinite(D)
-        if not reach.any():
+        dist = self.distances(ctx, cands)
+        if dist is None:
             return None
-        phi_c = np.zeros(k)
-        phi_c[reach] = closeness(D[reach])
+        D, reach, phi_c = dist
         h_d = self._h_d.update(b.reads.headings)
         h_r = self._h_r.update(ctx.headings)
         phi_o = histogram_lookup(h_d, cands.theta, fold=True)
