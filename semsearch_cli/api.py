@@ -18,7 +18,7 @@ from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Loaded, check_folder, expand, folder_lock, run_batch, run_rows
 from .tasks.objects import write_log
-from .files import temp_path
+from .files import output_file, output_folder, temp_path
 
 
 @dataclass
@@ -29,8 +29,8 @@ class RunOutput:
 
 
 def default_out(loaded: Loaded, out: str | Path | None) -> Path:
-    if out:
-        return Path(out)
+    if out is not None:
+        return output_folder(out)
     if loaded.sc.experiment.out:
         return (loaded.path.parent / loaded.sc.experiment.out).resolve()
     return Path("results") / loaded.sc.name
@@ -193,7 +193,6 @@ def validate(scenario: str | Path) -> dict:
 
 def show(scenario: str | Path, out: str | Path) -> Path:
     """Draw a scenario (map, signs or places, start, goals) to a PNG without simulating."""
+    out = output_file(out, "--out", (".png", ".pdf", ".svg"))
     loaded = Loaded.load(Path(scenario))
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     return report_build.show(loaded, out)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 from typing import List, Optional
 
@@ -41,10 +42,22 @@ def _fail(exc: ScenarioError) -> None:
     raise typer.Exit(2)
 
 
-def _split(values: Optional[List[str]]) -> Optional[list]:
-    if not values:
+def _path(value: Optional[str]) -> Optional[Path]:
+    """An --out value as a Path; an empty one is refused (Path("") would be the working folder)."""
+    if value is None:
+        return None
+    if not value.strip():
+        raise typer.BadParameter("an empty path; give a folder or file name")
+    return Path(value)
+
+
+def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
+    """Repeated or comma-separated values of ``flag`` (numbers as int); None when not given."""
+    if values is None or values == []:
         return None
     items = [v.strip() for s in values for v in s.split(",") if v.strip()]
+    if not items:
+        raise ScenarioError("<command line>", flag, f"no values in {' '.join(map(repr, values))}; give one or more, comma-separated")
     return [int(v) if v.lstrip("-").isdigit() else v for v in items]
 
 
@@ -55,14 +68,14 @@ def run(
     workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate)."),
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
-    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
+    out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
 ):
     """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
-    _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal), _split(planner), out_dir, progress=tick, trace=trace,
+    _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir, progress=tick, trace=trace,
                                 force=force))
 
 
@@ -73,7 +86,7 @@ def sweep_alpha(
     seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and variant (default: the scenario's)."),
     workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
-    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>)."),
+    out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
 ):
@@ -86,7 +99,7 @@ def sweep_alpha(
         _fail(ScenarioError("<command line>", "--alphas", f"expected comma-separated numbers, got {alphas!r}"))
     if not values or any(not 0.0 <= a <= 1.0 for a in values):
         _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
-    res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal), out_dir, progress=tick, trace=trace,
+    res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal, "--goal"), out_dir, progress=tick, trace=trace,
                                                      force=force))
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
@@ -100,7 +113,7 @@ def sweep(
     workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label."),
-    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default results/<name>-sweep-<param>)."),
+    out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>-sweep-<param>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
 ):
@@ -112,30 +125,64 @@ def sweep(
         name, values = api.parse_param(param)
     except ScenarioError as exc:
         _fail(exc)
-    res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal), _split(planner), out_dir,
+    res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir,
                                                 progress=tick, trace=trace, force=force))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
     out.print(escape(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv"))
 
 
+class _Lines:
+    """Progress off a terminal (CI logs, nohup, SLURM): one line on stderr every ``every`` s or
+    every tenth of the batch, whichever comes first, and a last line with the count."""
+
+    def __init__(self, every: float = 30.0):
+        self.every, self.t0, self.last, self.step = every, time.monotonic(), time.monotonic(), 1
+
+    def __call__(self, row: dict, done: int, total: int) -> None:
+        now = time.monotonic()
+        if done == 1:
+            self.step = max(1, total // 10)
+        if done == total or done % self.step == 0 or now - self.last >= self.every:
+            self.last = now
+            err.print(escape(f"runs: {done} of {total} done, {now - self.t0:.0f} s; last {row['planner']} goal {row['goal']} "
+                             f"seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m"), highlight=False, soft_wrap=True)
+
+
 def _with_progress(call):
-    """Call ``call(tick)`` under a progress bar; bad input exits with status 2."""
+    """Call ``call(tick)`` with a progress display (a bar on a terminal, else lines every 30 s);
+    bad input exits with status 2; Ctrl-C stops the batch, keeping its finished runs, and says
+    how to resume (status 130)."""
+    done = 0
     try:
+        if not err.is_terminal:
+            lines = _Lines()
+
+            def tick(row, n, total):
+                nonlocal done
+                done += 1
+                lines(row, n, total)
+
+            return call(tick)
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                      TimeRemainingColumn(), console=err, transient=False, disable=not err.is_terminal) as prog:
+                      TimeRemainingColumn(), console=err, transient=False) as prog:
             task = None
 
-            def tick(row):
-                nonlocal task
-                if task is None:
-                    task = prog.add_task("runs", total=None)
-                prog.advance(task)
-                prog.update(task, description=f"{row['planner']} goal {row['goal']} seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m")
+            def tick(row, n, total):
+                nonlocal task, done
+                done += 1
+                if task is None or n == 1:  # a sweep runs one batch per value
+                    task = prog.add_task("runs", total=total)
+                prog.update(task, completed=n, description=escape(
+                    f"{row['planner']} goal {row['goal']} seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m"))
 
             return call(tick)
     except ScenarioError as exc:
         _fail(exc)
+    except KeyboardInterrupt:
+        err.print(f"interrupted: the {done} run(s) finished are kept in runs.csv; run the same command again to resume "
+                  "(runs already in runs.csv are not run again)", highlight=False, soft_wrap=True)
+        raise typer.Exit(130) from None
 
 
 def _warn_errors(runs) -> None:
@@ -169,7 +216,7 @@ def _print_table(title: str, df) -> None:
 @app.command()
 def report(
     folders: List[Path] = typer.Argument(..., help="Results folders (each with a runs.csv)."),
-    out_dir: Optional[Path] = typer.Option(None, "--out", help="Where to write (default: into each results folder)."),
+    out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Where to write (default: into each results folder)."),
     fmt: str = typer.Option("md,csv,png,html", "--format", help="Comma-separated: md, csv, png, html."),
     replay: bool = typer.Option(True, "--replay/--no-replay", help="Also re-simulate one run into an animated GIF."),
 ):
@@ -188,7 +235,7 @@ def report(
 def presence(
     counts_file: Path = typer.Argument(..., help="CSV: first column the hour (0-23), one column per place."),
     hours: str = typer.Option(..., "--hours", help="Comma-separated request hours, e.g. 1,10,16,18,22."),
-    out_file: Optional[Path] = typer.Option(None, "--out", help="Also write the scores to this CSV."),
+    out_file: Optional[str] = typer.Option(None, "--out", callback=_path, help="Also write the scores to this CSV."),
 ):
     """Score every place at each request hour from hourly counts (thesis 5.3.5, Eq. 5.3); the
     highest of each hour is marked."""
@@ -220,7 +267,7 @@ def presence(
 @app.command()
 def record(
     scenario: Path = typer.Argument(..., help="Object-search scenario YAML file."),
-    out_dir: Path = typer.Option(Path("logs"), "--out", help="Folder for the detection logs (one CSV per case)."),
+    out_dir: str = typer.Option("logs", "--out", callback=_path, help="Folder for the detection logs (one CSV per case)."),
     cases: Optional[List[str]] = typer.Option(None, "--case", help="Only these cases (repeat or comma-separate)."),
 ):
     """Recording mode: patrol the route at each recording hour and write the detection log of
@@ -228,7 +275,7 @@ def record(
     with `record: path/to/log.csv` in its case."""
 
     try:
-        written = api.record(scenario, out_dir, _split(cases))
+        written = api.record(scenario, out_dir, _split(cases, "--case"))
     except ScenarioError as exc:
         _fail(exc)
     for f, n in written:
@@ -251,7 +298,7 @@ def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
 @app.command()
 def show(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
-    out_file: Path = typer.Option(Path("map.png"), "--out", help="PNG to write."),
+    out_file: str = typer.Option("map.png", "--out", callback=_path, help="Image to write: .png, .pdf or .svg."),
 ):
     """Draw a scenario: the map with every sign and its number, the start and the goals."""
 
@@ -271,7 +318,7 @@ def generate_building(
     layout: str = typer.Option(..., "--layout", help="grid, wings, angled or single."),
     numbering: str = typer.Option(..., "--numbering", help=", ".join(SCHEMES) + "."),
     seed: int = typer.Option(0, "--seed", help="Seed of the layout's variations (and of random numbering)."),
-    out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
     spacing: float = typer.Option(2.5, "--spacing", min=0.5, help="m between door slots along a wall."),
     signs: Optional[int] = typer.Option(None, "--signs", min=1, help="Keep exactly this many signs (doors trimmed at random, numbers kept)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
@@ -280,7 +327,7 @@ def generate_building(
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
         path = gen_building(layout, numbering, seed, out_dir, spacing=spacing, signs=signs,
-                   goals=_split([goals]) if goals else None, name=name)
+                   goals=_split([goals], "--goals") if goals is not None else None, name=name)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
@@ -298,7 +345,7 @@ def _choices(text: Optional[str], valid: tuple, flag: str) -> tuple:
 
 @generate_app.command("batch")
 def generate_batch(
-    out_dir: Path = typer.Option(..., "--out", help="Folder for the buildings (one sub-folder each) and index.txt."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for the buildings (one sub-folder each) and index.txt."),
     seeds: int = typer.Option(3, "--seeds", min=1, help="Buildings per layout and numbering scheme."),
     runs: int = typer.Option(3, "--runs", min=1, help="Runs per goal and planner in each scenario."),
     layouts: Optional[str] = typer.Option(None, "--layouts", help="Comma-separated layouts (default: all)."),
@@ -318,7 +365,7 @@ def generate_batch(
 def generate_rooms(
     n: int = typer.Option(20, "--n", min=1, max=10000, help="How many rooms."),
     seed: int = typer.Option(0, "--seed", min=0, help="Seed (room k is the same whatever --n)."),
-    out_dir: Path = typer.Option(..., "--out", help="Folder for rooms.yaml."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for rooms.yaml."),
     size: str = typer.Option("6,6", "--size", help="W,D: the room's width and depth in metres."),
     obstacles: int = typer.Option(0, "--obstacles", min=0, max=20, help="Boxes per room (the paper's rooms have none)."),
 ):
@@ -341,7 +388,7 @@ def generate_rooms(
 def import_mobilesim(
     map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),
     doors_file: Path = typer.Argument(..., help=".doors file: x y number facing (m, degrees)."),
-    out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
     resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
     start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
@@ -350,7 +397,7 @@ def import_mobilesim(
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
         path, notes = imp_mobilesim(map_file, doors_file, out_dir, resolution, _xy(start, "--start"),
-                             _split([goals]) if goals else None, density_delta)
+                             _split([goals], "--goals") if goals is not None else None, density_delta)
     except ScenarioError as exc:
         _fail(exc)
     out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
@@ -371,14 +418,14 @@ def _xy(value: str | None, flag: str) -> tuple[float, float] | None:
 def import_ros(
     map_file: Path = typer.Argument(..., help="ROS map YAML (map_server / map_saver: a PGM or PNG beside it)."),
     doors_file: Path = typer.Argument(..., help="Door signs: CSV with columns number,x,y,facing (m, degrees) in the map's frame."),
-    out_dir: Path = typer.Option(..., "--out", help="Folder for map.yaml (and its image), doors.csv and scenario.yaml."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.yaml (and its image), doors.csv and scenario.yaml."),
     start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
     density_delta: float = typer.Option(2.5, "--density-delta", help="m^2, segmentation delta (Eq. 4.4)."),
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
-        path, notes = imp_ros(map_file, doors_file, out_dir, _xy(start, "--start"), _split([goals]) if goals else None,
+        path, notes = imp_ros(map_file, doors_file, out_dir, _xy(start, "--start"), _split([goals], "--goals") if goals is not None else None,
                        density_delta=density_delta)
     except ScenarioError as exc:
         _fail(exc)
@@ -388,7 +435,7 @@ def import_ros(
 @import_app.command("kth")
 def import_kth(
     xml_file: Path = typer.Argument(..., help="KTH campus floor-plan XML file."),
-    out_dir: Path = typer.Option(..., "--out", help="Folder for map.png, doors.csv and scenario.yaml."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
     resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance, among readable signs)."),
     corridor_types: str = typer.Option(",".join(KTH_CORRIDOR_TYPES), "--corridor-types",
@@ -397,7 +444,7 @@ def import_kth(
     """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
         types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
-        path, notes = imp_kth(xml_file, out_dir, resolution, _split([goals]) if goals else None, corridor_types=types)
+        path, notes = imp_kth(xml_file, out_dir, resolution, _split([goals], "--goals") if goals is not None else None, corridor_types=types)
     except ScenarioError as exc:
         _fail(exc)
     out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))

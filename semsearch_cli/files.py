@@ -1,11 +1,20 @@
-"""Writing files atomically: every write goes to a temporary file beside its target, unique to the
+"""Files the user gives and files we write.
+
+Reading: a user's file is checked before it is read (it exists, is a regular file, not a folder or
+a device, is readable, not too large, and is UTF-8 text), so that every problem is one
+:class:`~semsearch_cli.errors.ScenarioError` naming the file.
+
+Writing atomically: every write goes to a temporary file beside its target, unique to the
 writing process, and is then renamed over it, so a reader never sees half a file and two
 processes writing the same file never share a temporary name."""
 
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
+
+from .errors import ScenarioError
 
 
 def temp_path(path: Path) -> Path:
@@ -13,3 +22,89 @@ def temp_path(path: Path) -> Path:
     with the same suffix (libraries that pick a format from it still do)."""
     path = Path(path)
     return path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+
+
+MAX_TEXT_BYTES = 64 * 2**20  # a scenario, doors or log file larger than this is not one
+
+
+def user_file(path: str | Path, what: str, owner: str | None = None, field: str = "") -> Path:
+    """``path`` when it is an existing regular file that can be read, else a
+    :class:`ScenarioError` that names it: missing, a folder, a device or a pipe (``/dev/zero``),
+    or unreadable. The error is the file's own, or, with ``owner`` (the scenario that named it),
+    the owner's ``field``."""
+    path = Path(path)
+    file, where = (owner, f"{what} {path}") if owner else (str(path), what)
+    try:
+        st = path.stat()
+    except (FileNotFoundError, NotADirectoryError):
+        raise ScenarioError(file, field, f"{where} not found") from None
+    except OSError as exc:
+        raise ScenarioError(file, field, f"{where} cannot be read ({exc.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ScenarioError(file, field, f"{where} is a folder, not a file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ScenarioError(file, field, f"{where} is not a regular file (a device, a pipe or a socket)")
+    if not os.access(path, os.R_OK):
+        raise ScenarioError(file, field, f"{where} cannot be read (permission denied)")
+    return path
+
+
+def read_user_text(path: str | Path, what: str, owner: str | None = None, field: str = "",
+                   limit: int = MAX_TEXT_BYTES) -> str:
+    """The text of a user's file (UTF-8, a byte-order mark allowed), or a :class:`ScenarioError`
+    naming it (see :func:`user_file`): too large, or not UTF-8 (UTF-16, Latin-1, binary), with
+    the offending byte."""
+    path = user_file(path, what, owner, field)
+    file = owner or str(path)
+    where = f"{what} {path}" if owner else what
+    size = path.stat().st_size
+    if size > limit:
+        raise ScenarioError(file, field, f"{where} is {size / 2**20:.0f} MB; a text file over {limit // 2**20} MB is not one semsearch reads")
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(file, field, f"{where} cannot be read ({exc.strerror})") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        kind = "UTF-16 text" if data[:2] in (b"\xff\xfe", b"\xfe\xff") else "not UTF-8 text"
+        if b"\x00" in data[:1024] and kind != "UTF-16 text":
+            kind = "binary, not text"
+        raise ScenarioError(file, field, f"{where} is {kind} (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+                            "save it as UTF-8") from None
+
+
+def output_folder(out: str | Path, flag: str = "--out") -> Path:
+    """The output folder ``out``, created if needed, or a :class:`ScenarioError` for ``flag`` that
+    says why it cannot be: empty, a file, under a file, or on a file system that refuses it
+    (read-only, no permission, /proc)."""
+    if str(out).strip() == "":
+        raise ScenarioError("<command line>", flag, "an empty folder name; give a folder (it is created if needed)")
+    out = Path(out)
+    for p in (out, *out.parents):
+        if p.exists() and not p.is_dir():
+            what = "is a file" if p == out else f"lies under {p}, which is a file"
+            raise ScenarioError("<command line>", flag, f"{out} {what}; give a folder (it is created if needed)")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ScenarioError("<command line>", flag, f"cannot create the folder {out}: {exc.strerror or exc}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise ScenarioError("<command line>", flag, f"cannot write into {out}: permission denied")
+    return out
+
+
+def output_file(path: str | Path, flag: str, suffixes: tuple[str, ...]) -> Path:
+    """``path`` for a file to write, its folder created: refused (a :class:`ScenarioError` for
+    ``flag``) when empty, a folder, of a type not among ``suffixes``, or in a folder that cannot
+    be made or written (see :func:`output_folder`)."""
+    if str(path).strip() == "":
+        raise ScenarioError("<command line>", flag, "an empty file name")
+    path = Path(path)
+    if path.is_dir():
+        raise ScenarioError("<command line>", flag, f"{path} is a folder; give a file name ending in {', '.join(suffixes)}")
+    if path.suffix.lower() not in suffixes:
+        raise ScenarioError("<command line>", flag, f"cannot write {path.suffix or 'a file without an extension'}; "
+                            f"give a file name ending in {', '.join(suffixes)}")
+    output_folder(path.parent, flag)
+    return path

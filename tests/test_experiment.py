@@ -61,7 +61,7 @@ def test_interrupted_batch_resumes(demo_loaded, tmp_path):
     with open(out / "runs.csv", "a") as fh:
         fh.write("demo,greedy,{},304,1,fou")  # a row torn by an interruption
     seen = []
-    runs = run_batch(demo_loaded, specs, out, progress=seen.append)
+    runs = run_batch(demo_loaded, specs, out, progress=lambda row, done, total: seen.append(row))
     assert len(seen) == len(specs) - 3  # only the missing runs were run
     assert len(runs) == len(specs)
     assert sorted(map(tuple, runs[KEY].astype(str).values)) == sorted((s.variant.label, str(s.goal), str(s.seed)) for s in specs)

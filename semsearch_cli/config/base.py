@@ -1,15 +1,27 @@
 """The sections every scenario shares: map, start, door signs, planners, robot, sensors, belief,
 navigation, experiment (SPEC 1). Lengths are metres, angles degrees; every model forbids unknown
-keys, so a misspelt key is an error naming the field."""
+keys, so a misspelt key is an error naming the field, and refuses NaN and infinity, so a number
+is always a number. Sizes have upper bounds (``LIMITS`` in the README) so that no value makes an
+array too big for memory or a loop that never ends."""
 
 from __future__ import annotations
 
-from typing import Any, Literal, Union
+from typing import Annotated, Any, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+# upper bounds shared by the sections (m): far beyond any building, short of an array that fills memory
+MAX_RANGE = 50.0  # a sensor's range
+MAX_RADIUS = 20.0  # a kernel or window radius
+MAX_COORD = 1e6  # a coordinate or a distance
+MAX_SEEDS = 1_000_000  # runs per goal and planner variant
+
+Coord = Annotated[float, Field(ge=-MAX_COORD, le=MAX_COORD)]
+Angle = Annotated[float, Field(ge=-3600.0, le=3600.0, description="degrees")]
+
+
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class MapSpec(Strict):
@@ -18,8 +30,8 @@ class MapSpec(Strict):
 
     image: str | None = Field(None, description="PNG: dark (<100) wall, light (>=200) free, gray between = outside")
     ros: str | None = Field(None, description="a ROS map_server / map_saver YAML (PGM or PNG image)")
-    resolution: float = Field(0.1, gt=0.0, le=1.0, description="m/cell")
-    origin: tuple[float, float] = Field((0.0, 0.0), description="world (x, y) m of the image's bottom-left corner")
+    resolution: float = Field(0.1, ge=0.005, le=1.0, description="m/cell")
+    origin: tuple[Coord, Coord] = Field((0.0, 0.0), description="world (x, y) m of the image's bottom-left corner")
 
     @model_validator(mode="after")
     def _one_source(self):
@@ -31,16 +43,16 @@ class MapSpec(Strict):
 
 
 class StartSpec(Strict):
-    x: float
-    y: float
-    heading: Union[float, Literal["random"]] = Field("random", description="degrees, or random")
+    x: Coord
+    y: Coord
+    heading: Union[Angle, Literal["random"]] = Field("random", description="degrees, or random")
 
 
 class DoorSpec(Strict):
     number: Union[int, str]
-    x: float
-    y: float
-    facing: float = Field(description="degrees, the direction the sign faces")
+    x: Coord
+    y: Coord
+    facing: Angle = Field(description="degrees, the direction the sign faces")
 
 
 class PlannerSpec(BaseModel):
@@ -55,28 +67,28 @@ class PlannerSpec(BaseModel):
 
 
 class RobotSpec(Strict):
-    radius: float = Field(0.25, gt=0.0, description="m, disk robot")
-    step: float = Field(0.1, gt=0.0, le=1.0, description="m travelled per simulation step")
+    radius: float = Field(0.25, gt=0.0, le=5.0, description="m, disk robot")
+    step: float = Field(0.1, ge=0.01, le=1.0, description="m travelled per simulation step")
 
 
 class LaserSpec(Strict):
     fov: float = Field(180.0, gt=0.0, le=360.0, description="degrees")
     beams: int = Field(181, ge=2, le=2000)
-    range: float = Field(10.0, gt=0.0, description="m")
-    noise_std: float = Field(0.0, ge=0.0, description="m, Gaussian range noise")
+    range: float = Field(10.0, gt=0.0, le=MAX_RANGE, description="m")
+    noise_std: float = Field(0.0, ge=0.0, le=10.0, description="m, Gaussian range noise")
 
 
 class DoorCameraSpec(Strict):
     fov: float = Field(60.0, gt=0.0, le=180.0, description="degrees, each of the left and right cameras")
-    range: float = Field(3.0, gt=0.0, description="m")
+    range: float = Field(3.0, gt=0.0, le=MAX_RANGE, description="m")
     p_read: float = Field(0.95, ge=0.0, le=1.0, description="probability a visible sign is read")
     p_misread: float = Field(0.0, ge=0.0, le=1.0, description="probability a read replaces one digit")
 
 
 class BeliefSpec(Strict):
-    visited_radius: float = Field(1.2, gt=0.0, description="m, kernel of the visited region")
-    density_radius: float = Field(2.4, gt=0.0, description="m, uniform kernel radius r of Eq. 4.2 (Manhattan)")
-    density_delta: float = Field(2.5, gt=0.0, description="m^2, delta of Eq. 4.4")
+    visited_radius: float = Field(1.2, gt=0.0, le=MAX_RADIUS, description="m, kernel of the visited region")
+    density_radius: float = Field(2.4, gt=0.0, le=MAX_RADIUS, description="m, uniform kernel radius r of Eq. 4.2 (Manhattan)")
+    density_delta: float = Field(2.5, gt=0.0, le=1e4, description="m^2, delta of Eq. 4.4")
     min_reads: int = Field(3, ge=1, description="reads before a sign feeds the planner's factors")
     himm_inc: int = Field(3, ge=1, le=15)
     himm_dec: int = Field(1, ge=1, le=15)
@@ -86,14 +98,14 @@ class BeliefSpec(Strict):
 
 class NavigationSpec(Strict):
     navigator: Literal["geodesic", "harmonic"] = "geodesic"
-    replan_every: float = Field(1.0, gt=0.0, description="m travelled between periodic re-plans")
+    replan_every: float = Field(1.0, gt=0.0, le=MAX_COORD, description="m travelled between periodic re-plans")
 
 
 class ExperimentSpec(Strict):
-    seeds: int = Field(10, ge=1)
-    base_seed: int = Field(0, ge=0)
-    max_distance: float = Field(2000.0, gt=0.0, description="m, budget per run")
-    max_steps: int | None = Field(None, ge=1)
+    seeds: int = Field(10, ge=1, le=MAX_SEEDS, description="runs per goal and planner variant")
+    base_seed: int = Field(0, ge=0, le=2**31)
+    max_distance: float = Field(2000.0, gt=0.0, le=MAX_COORD, description="m, budget per run")
+    max_steps: int | None = Field(None, ge=1, le=10**9)
     out: str | None = Field(None, description="output folder (default results/<name>)")
 
 

@@ -8,11 +8,13 @@ silent the choice is ours and the field's description says so.
 
 from __future__ import annotations
 
-from typing import Literal, Union
+from typing import Annotated, Literal, Union
 
 from pydantic import Field, field_validator, model_validator
 
-from .base import Strict
+from .base import MAX_RANGE, Strict
+
+Length = Annotated[float, Field(gt=0.0, le=MAX_RANGE)]
 
 CATEGORIES = ("VN", "N", "F", "VF")  # very near, near, far, very far (paper 3.2)
 
@@ -49,7 +51,7 @@ class RoomsGenSpec(Strict):
 
     count: int = Field(20, ge=1, le=10000)
     seed: int = Field(0, ge=0)
-    size: tuple[float, float] = Field((6.0, 6.0), description="m, the room's width and depth")
+    size: tuple[Length, Length] = Field((6.0, 6.0), description="m, the room's width and depth")
     obstacles: int = Field(0, ge=0, le=20, description="boxes standing in the room (ours: the paper has none)")
 
 
@@ -58,13 +60,13 @@ class SemanticCameraSpec(Strict):
 
     hfov: float = Field(75.0, gt=0.0, le=180.0)
     vfov: float = Field(45.6, gt=0.0, le=180.0)
-    min_depth: float = Field(0.3, ge=0.0)
-    secondary_range: float = Field(2.5, gt=0.0, description="m, how far the secondary objects are detected")
-    height: float = Field(1.0, gt=0.0, description="m, the camera above the floor")
+    min_depth: float = Field(0.3, ge=0.0, le=10.0)
+    secondary_range: float = Field(2.5, gt=0.0, le=MAX_RANGE, description="m, how far the secondary objects are detected")
+    height: float = Field(1.0, gt=0.0, le=10.0, description="m, the camera above the floor")
     pitch: float = Field(30.0, ge=0.0, lt=90.0, description="degrees down (ours: the paper gives none; at 0 nothing "
                          "nearer than 1.2 m is in the vertical field, so view scale 1.0 could never see A)")
     fps: float = Field(3.0, gt=0.0, le=30.0)
-    diameters: dict[str, float] = Field(
+    diameters: dict[str, Annotated[float, Field(gt=0.0, le=10.0)]] = Field(
         default_factory=lambda: {"monitor": 0.5, "keyboard": 0.45, "system_unit": 0.45, "router": 0.25},
         description="m, each class's sphere for occlusion (Algorithm 4; ours: the paper gives no sizes)")
     detection: dict[str, list[list[float]]] | None = Field(
@@ -92,9 +94,9 @@ class SemanticCameraSpec(Strict):
 class MasksSpec(Strict):
     """The basic spatial-relation masks (Eqs. 18-27), Section 4.4's thresholds."""
 
-    u1: float = Field(0.60, gt=0.0)
-    u2: float = Field(1.00, gt=0.0)
-    u3: float = Field(1.50, gt=0.0)
+    u1: float = Field(0.60, gt=0.0, le=MAX_RANGE)
+    u2: float = Field(1.00, gt=0.0, le=MAX_RANGE)
+    u3: float = Field(1.50, gt=0.0, le=MAX_RANGE)
     gap: float = Field(0.20, ge=0.0, description="delta of the soft masks")
 
     @model_validator(mode="after")
@@ -112,7 +114,7 @@ class IndirectRobotSpec(Strict):
 
     speed: float = Field(0.15, gt=0.0, le=2.0, description="m/s (ours)")
     turn_rate: float = Field(30.0, gt=0.0, le=360.0, description="degrees/s (ours)")
-    radius: float = Field(0.2, gt=0.0, description="m, for paths around obstacles")
+    radius: float = Field(0.2, gt=0.0, le=2.0, description="m, for paths around obstacles")
 
 
 class IndirectSpec(Strict):
@@ -121,12 +123,12 @@ class IndirectSpec(Strict):
     relations: dict[str, tuple[float, float, float, float]] = Field(
         default_factory=lambda: dict(TABLE2),
         description="per secondary class, co-occurrences VN, N, F, VF (Table 2); each row sums to 1")
-    view_scales: list[float] = Field(default_factory=lambda: [1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5],
+    view_scales: list[Length] = Field(default_factory=lambda: [1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5],
                                      min_length=1, description="m, how far A can be detected (Table 3's columns)")
-    resolution: float = Field(0.06, gt=0.0, le=0.5, description="m, the probability map's cells (the paper's 100 x 100 "
+    resolution: float = Field(0.06, ge=0.01, le=0.5, description="m, the probability map's cells (the paper's 100 x 100 "
                               "for 6 m)")
-    time_limit: float = Field(300.0, gt=0.0, description="s of simulated time per search")
-    replan_every: float = Field(6.0, gt=0.0, description="s between re-plans")
+    time_limit: float = Field(300.0, gt=0.0, le=3600.0, description="s of simulated time per search")
+    replan_every: float = Field(6.0, gt=0.0, le=3600.0, description="s between re-plans")
     p_outside: float | None = Field(None, ge=0.0, lt=1.0, description="prior that A is outside the room (the outside "
                                     "cell); default one cell's share: uniform over the room's cells and the outside cell")
     coarse: int = Field(2, ge=1, le=4, description="the secondary objects' non-detections (PN) are convolved on a "

@@ -7,16 +7,17 @@ from typing import Annotated, Union
 
 from pydantic import ConfigDict, Field, model_validator
 
-from .base import Strict
+from .base import MAX_RANGE, Angle, Coord, Strict
 
 NAME = r"^[A-Za-z0-9_\-]+$"
+Hour = Annotated[float, Field(ge=0.0, lt=24.0, description="hour of the day, 0 <= h < 24")]
 
 
 class PlaceSpec(Strict):
     name: str = Field(pattern=NAME, description="a place where objects stand, e.g. A")
-    x: float
-    y: float
-    facing: float = Field(0.0, description="degrees, the direction the objects there face (for angle tables)")
+    x: Coord
+    y: Coord
+    facing: Angle = Field(0.0, description="degrees, the direction the objects there face (for angle tables)")
     room: Union[int, str, None] = Field(None, description="number of the door sign of the room holding the place (chains)")
 
 
@@ -27,8 +28,8 @@ class DetectTable(Strict):
     to the camera, 0 = seen from the front) takes the nearest tabulated angle. Without ``angles``,
     ``p`` is one row."""
 
-    distances: list[float] = Field(min_length=1, description="m, increasing")
-    angles: list[float] | None = Field(None, description="degrees")
+    distances: list[Annotated[float, Field(ge=0.0, le=MAX_RANGE)]] = Field(min_length=1, description="m, increasing")
+    angles: list[Angle] | None = Field(None, description="degrees")
     p: list[list[float]] = Field(min_length=1)
 
     @model_validator(mode="after")
@@ -48,7 +49,7 @@ Probability = Annotated[float, Field(ge=0.0, le=1.0)]
 
 class ClassCameraSpec(Strict):
     fov: float | None = Field(None, gt=0.0, le=360.0)
-    range: float | None = Field(None, gt=0.0)
+    range: float | None = Field(None, gt=0.0, le=MAX_RANGE)
     p_detect: Union[Probability, DetectTable, None] = None
 
 
@@ -57,7 +58,7 @@ class ObjectCameraSpec(Strict):
     a :class:`DetectTable`, with per-class overrides under ``classes``."""
 
     fov: float = Field(60.0, gt=0.0, le=360.0, description="degrees, centred on the heading")
-    range: float = Field(3.0, gt=0.0, description="m")
+    range: float = Field(3.0, gt=0.0, le=MAX_RANGE, description="m")
     p_detect: Union[Probability, DetectTable] = Field(0.9, description="probability a visible object is detected in one frame")
     classes: dict[str, ClassCameraSpec] = Field(default_factory=dict, description="class -> fov / range / p_detect")
 
@@ -81,7 +82,7 @@ class ObjectCameraSpec(Strict):
 class RequestSpec(Strict):
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
     cls: str = Field(alias="class", pattern=NAME, description="object class to find")
-    hour: float = Field(ge=0.0, lt=24.0)
+    hour: Hour
     at: list[str] | None = Field(None, description="places holding the class at the request (ground truth); "
                                                    "default: the case's truth timeline at that hour")
 
@@ -94,7 +95,7 @@ class CaseSpec(Strict):
     requests: list[RequestSpec] | None = Field(None, description="default: objects.requests")
 
 
-Timeline = dict[str, dict[float, Union[str, list[str], None]]]
+Timeline = dict[str, dict[Hour, Union[str, list[str], None]]]
 
 
 class ObjectsSpec(Strict):
@@ -105,7 +106,7 @@ class ObjectsSpec(Strict):
     route: list[str] | None = Field(None, description="patrol order of the places (default: as listed)")
     timelines: dict[str, Timeline] = Field(default_factory=dict,
                                            description="pattern -> class -> {hour: place(s) from that hour on}")
-    recording_hours: list[float] = Field(default_factory=lambda: [3, 5, 7, 9, 11, 15, 17, 19, 21, 23])
+    recording_hours: list[Hour] = Field(default_factory=lambda: [3, 5, 7, 9, 11, 15, 17, 19, 21, 23])
     requests: list[RequestSpec] = Field(default_factory=list)
     cases: list[CaseSpec] | None = Field(None, description="default: one case per timeline, recorded from it")
     camera: ObjectCameraSpec = ObjectCameraSpec()

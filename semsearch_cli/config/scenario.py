@@ -18,6 +18,7 @@ import yaml
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import ScenarioError
+from ..files import read_user_text
 from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
 from .chain import ChainSpec
@@ -34,7 +35,8 @@ ROOMS_OF_THEIR_OWN = {"indirect"}  # kinds that bring their own rooms instead of
 
 
 class Scenario(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-][A-Za-z0-9_.\-]*$", max_length=200,
+                      description="letters, digits, _ - . (not first): it names the output folder")
     map: MapSpec | None = None
     start: StartSpec | None = None
     doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
@@ -132,17 +134,21 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
 
 
 def read_yaml(path: str | Path, what: str = "file", owner: str | None = None, field: str = "") -> Any:
-    """A YAML file's contents; a missing file or bad YAML is a :class:`ScenarioError` naming the
-    file (or ``owner`` and ``field``, the scenario that named it) and the line."""
+    """A YAML file's contents; a file that is missing, not a file, not UTF-8 text (see
+    :func:`~semsearch_cli.files.read_user_text`) or not YAML is a :class:`ScenarioError` naming the
+    file (or ``owner`` and ``field``, the scenario that named it) and the line. Only plain YAML
+    is read (``yaml.safe_load``: a ``!!python`` tag is refused, never executed)."""
     path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(owner or str(path), field, f"{what} {path} not found" if owner else f"{what} not found")
+    text = read_user_text(path, what, owner, field)
     try:
-        return yaml.safe_load(path.read_text())
+        return yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ScenarioError(str(path), "", f"not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+        raise ScenarioError(str(path), "", f"not valid YAML{where}: {getattr(exc, 'problem', None) or exc}") from None
+    except RecursionError:
+        raise ScenarioError(str(path), "", "nested too deeply to be a scenario (brackets or indents inside one another "
+                            "hundreds of times)") from None
 
 
 def load_scenario(path: str | Path) -> Scenario:

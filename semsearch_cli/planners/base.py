@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import itertools
+import math
 import sys
 import traceback
 from dataclasses import dataclass, field
@@ -171,6 +172,7 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
     An entry with ``module`` first loads that file (relative to ``base``, the scenario's folder);
     a name nothing registered is looked for among the installed entry points."""
     out: list[Variant] = []
+    seen: set[tuple] = set()
     for i, spec in enumerate(specs):
         name, params = spec.name, spec.params()
         module = None
@@ -190,6 +192,10 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                                 f"a {kind(task, task)}-search scenario; valid: {', '.join(valid)}")
         keys = sorted(params)
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]
+        for k, vs in zip(keys, values):
+            bad = [v for v in vs if isinstance(v, float) and not math.isfinite(v)]
+            if bad:
+                raise ScenarioError(file, f"planners[{i}].{k}", f"expected a finite number, got {bad[0]!r}")
         for combo in itertools.product(*values):
             p = tuple(zip(keys, combo))
             try:
@@ -199,6 +205,8 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                 loc = ".".join(str(x) for x in e["loc"])
                 raise ScenarioError(file, f"planners[{i}].{loc}", e["msg"] if e["type"] != "extra_forbidden" else f"unknown parameter for planner {name!r}") from None
             v = Variant(name, p, module)
-            if v not in out:
+            key = (v.label, module)  # rows name a variant by its label; a set keeps a big sweep linear
+            if key not in seen:
+                seen.add(key)
                 out.append(v)
     return out

@@ -68,9 +68,9 @@ def patrol_targets(ctx: ObjectContext, skip_seen: bool = False):
 
 class LsosParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
-    radius: float = Field(1.5, gt=0.0, description="m, kernel radius r of Eq. 5.4")
+    radius: float = Field(1.5, gt=0.0, le=20.0, description="m, kernel radius r of Eq. 5.4")
     sector: float = Field(45.0, gt=0.0, le=180.0, description="degrees, half-angle of the kernel toward the robot pose")
-    window: float | None = Field(None, gt=0.0, description="m, radius of the window T of Eq. 5.6 (default: the kernel radius)")
+    window: float | None = Field(None, gt=0.0, le=100.0, description="m, radius of the window T of Eq. 5.6 (default: the kernel radius)")
     max_goals: int = Field(10, ge=1, description="heat-map goals before the patrol fallback")
 
 

@@ -18,6 +18,7 @@ import pandas as pd
 
 from .. import __version__
 from ..errors import ScenarioError
+from ..files import read_user_text
 from ..runner import Loaded, read_runs
 from . import chain, doors, indirect, objects
 from .document import Code, Document, atomic_text
@@ -30,13 +31,32 @@ def write_meta(out_dir: Path, scenario: Path) -> None:
     """Record, beside runs.csv, the scenario and the command that produced (or extended) it."""
     out_dir.mkdir(parents=True, exist_ok=True)
     f = out_dir / "meta.json"
-    meta = json.loads(f.read_text()) if f.is_file() else {"commands": []}
+    meta = read_meta(out_dir)
+    meta.setdefault("commands", [])
     meta["scenario"] = str(Path(scenario).resolve())
     meta["semsearch"] = __version__
     cmd = "semsearch " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if Path(sys.argv[0]).name == "semsearch" else " ".join(sys.argv)
     if cmd not in meta["commands"]:
         meta["commands"].append(cmd)
     atomic_text(f, json.dumps(meta, indent=2))
+
+
+def read_meta(folder: Path) -> dict:
+    """A results folder's meta.json ({} when there is none); a :class:`ScenarioError` when it is
+    not a JSON object with a list of commands (it is ours: a damaged one is for the user to move
+    away, not for us to overwrite)."""
+    f = Path(folder) / "meta.json"
+    if not f.exists():
+        return {}
+    try:
+        meta = json.loads(read_user_text(f, "meta.json"))
+    except json.JSONDecodeError as exc:
+        meta = exc
+    if not isinstance(meta, dict) or not isinstance(meta.get("commands", []), list) \
+            or not isinstance(meta.get("scenario", ""), str):
+        raise ScenarioError(str(f), "", "not the JSON semsearch writes (the scenario's path and the commands run here); "
+                            "move it away or delete it, and run again")
+    return meta
 
 
 @dataclass
@@ -79,7 +99,7 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
         runs = read_runs(folder / "runs.csv")
         if runs.empty:
             raise ScenarioError(str(folder / "runs.csv"), "", "no finished runs to report (is this a semsearch results folder?)")
-        meta = json.loads((folder / "meta.json").read_text()) if (folder / "meta.json").is_file() else {}
+        meta = read_meta(folder)
         total += len(runs)
         for kind, rows in runs.groupby("kind", sort=False):
             if kind not in SECTIONS:
@@ -100,15 +120,14 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     notes: list[str] = []
     for kind, parts in parts_by_kind.items():
         SECTIONS[kind].section(doc, parts, out, formats, replay, notes)
-    for folder, meta in {str(f): json.loads((f / "meta.json").read_text()) if (f / "meta.json").is_file() else {}
-                         for f in folders}.items():
+    for folder, meta in {str(f): read_meta(f) for f in folders}.items():
         doc.heading(2, f"How {folder} was produced")
         if meta.get("commands"):
             doc.code("\n".join(meta["commands"]))
         doc.para("Rebuild this report: ", Code("semsearch report " + " ".join(shlex.quote(str(f)) for f in folders)))
         if meta.get("scenario") and Path(meta["scenario"]).is_file():
             doc.para("Scenario ", Code(meta["scenario"]), ":")
-            doc.code(Path(meta["scenario"]).read_text().strip(), "yaml")
+            doc.code(Path(meta["scenario"]).read_text(errors="replace").strip(), "yaml")
     for n in notes:
         doc.note(n)
     files = []

@@ -4,7 +4,7 @@ finishes, so an interrupted batch keeps every finished run and resumes where it 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 import pandas as pd
 
@@ -35,12 +35,15 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False) -> pd.DataFrame
     return done
 
 
-def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
-              progress: Callable[[dict], None] | None = None, trace: bool = False,
+def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,
+              progress: Callable[[dict, int, int], None] | None = None, trace: bool = False,
               start_method: str | None = None, force: bool = False) -> pd.DataFrame:
     """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
     With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
-    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`).
+    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`). ``progress(row,
+    done, total)`` is called as each run finishes, with the runs finished so far and the runs
+    this batch has to do. The specs are streamed to the executor, never listed whole (a
+    :class:`~semsearch_cli.runner.specs.RunList` of any length costs no memory).
 
     The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's
     fingerprint (:attr:`Loaded.fingerprint`); rows of another scenario (or an edited one) in the
@@ -51,16 +54,20 @@ def run_batch(loaded: Loaded, specs: list[RunSpec], out: Path, workers: int = 1,
     with folder_lock(out):
         done = check_folder(loaded, out, force)
         have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
-        todo = [s for s in specs if s.key not in have]
-        executor = make_executor(workers, start_method) if len(todo) > 1 else SerialExecutor()
+        has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
+        total = len(specs) - sum(1 for k in have if has(k))
+        todo = (s for s in specs if s.key not in have)
+        executor = make_executor(workers, start_method) if total > 1 else SerialExecutor()
         writer = RowWriter(runs_csv)
+        n = 0
         try:
             for rows in executor.rows(loaded, todo, out, trace):
                 for r in rows:
                     r["fingerprint"] = fp
                 writer.write(rows)
+                n += 1
                 if progress:
-                    progress(rows[0])
+                    progress(rows[0], n, total)
         finally:
             writer.close()
         return read_runs(runs_csv)

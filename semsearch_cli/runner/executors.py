@@ -4,12 +4,14 @@ worker processes that each receive the loaded scenario once."""
 
 from __future__ import annotations
 
+import itertools
 import math
 import multiprocessing
+import signal
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
-from typing import Iterator
+from typing import Iterable, Iterator
 
 import numpy as np
 
@@ -44,7 +46,7 @@ class SerialExecutor:
     def __init__(self, workers: int = 1):
         self.workers = 1
 
-    def rows(self, loaded: Loaded, specs: list[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
         for spec in specs:
             yield _run_and_save(loaded, spec, out, trace)
 
@@ -53,6 +55,9 @@ _CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process 
 
 
 def _worker_init(loaded: Loaded) -> None:
+    # Ctrl-C reaches every process of the terminal's group: the batch (the parent) handles it and
+    # stops the workers, which would otherwise each print a KeyboardInterrupt traceback
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _CACHE["loaded"] = loaded
 
 
@@ -64,23 +69,36 @@ class ProcessExecutor:
     """A pool of ``workers`` processes; the loaded scenario is sent to each once. ``start_method``
     (``fork``, ``spawn``, ``forkserver``; default: Python's for the platform) is how they start: a
     spawned worker unpickles the scenario in a fresh interpreter, and a planner from the user's
-    own file is loaded there again by its path when its variant is built."""
+    own file is loaded there again by its path when its variant is built.
+
+    Runs are handed out as workers free up, a few per worker ahead, so the list of runs is
+    streamed, never held whole. When the batch stops early (Ctrl-C, an error in the parent), the
+    workers are stopped at once and their unfinished runs dropped."""
 
     def __init__(self, workers: int, start_method: str | None = None):
         self.workers = workers
         self.context = multiprocessing.get_context(start_method)
 
-    def rows(self, loaded: Loaded, specs: list[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
-        with ProcessPoolExecutor(max_workers=self.workers, mp_context=self.context, initializer=_worker_init,
-                                 initargs=(loaded,)) as pool:
-            futs = [pool.submit(_worker_run, spec, str(out), trace) for spec in specs]
-            try:
-                for f in as_completed(futs):
+    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+        specs = iter(specs)
+        ahead = 2 * self.workers
+        pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=self.context, initializer=_worker_init,
+                                   initargs=(loaded,))
+        running = {pool.submit(_worker_run, s, str(out), trace) for s in itertools.islice(specs, ahead)}
+        try:
+            while running:
+                finished, running = wait(running, return_when=FIRST_COMPLETED)
+                running |= {pool.submit(_worker_run, s, str(out), trace) for s in itertools.islice(specs, len(finished))}
+                for f in finished:
                     yield f.result()
-            except BaseException:
-                for f in futs:
-                    f.cancel()
-                raise
+        except BaseException:
+            for f in running:
+                f.cancel()
+            for proc in list((getattr(pool, "_processes", None) or {}).values()):  # no public call stops them (3.14 adds one)
+                proc.terminate()
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown()
 
 
 def make_executor(workers: int, start_method: str | None = None):

@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..errors import ScenarioError
+from ..files import output_folder
 
 LOCK_NAME = ".semsearch.lock"
 _HELD: dict[str, int] = {}  # folder -> depth, for the locks this process holds
@@ -23,11 +24,8 @@ _HELD: dict[str, int] = {}  # folder -> depth, for the locks this process holds
 def folder_lock(out: Path):
     """Hold the output folder ``out`` (created if needed) for this process; a
     :class:`ScenarioError` naming the holder when another process has it."""
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        key = str(out.resolve())
-    except OSError as exc:
-        raise ScenarioError(str(out), "--out", f"cannot use this output folder: {exc.strerror or exc}") from None
+    out = output_folder(out)
+    key = str(out.resolve())
     if key in _HELD:
         _HELD[key] += 1
         try:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 import hashlib
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -120,11 +121,45 @@ def _files_by_content(d, base: Path):
     return d
 
 
-def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> list[RunSpec]:
-    """goals x planner variants x seeds, in that nesting order."""
+class RunList(Sequence):
+    """goals x planner variants x seeds, in that nesting order, as a sequence computed on demand:
+    its length and any item come from arithmetic, so a list of a billion runs costs no memory
+    (a batch streams it to the workers)."""
+
+    def __init__(self, goals: list, variants: list[Variant], seeds: int):
+        self.goals, self.variants, self.seeds = list(goals), list(variants), int(seeds)
+        self._labels = {v.label for v in self.variants}
+        self._goal_keys = {str(g) for g in self.goals}
+
+    def __len__(self) -> int:
+        return len(self.goals) * len(self.variants) * self.seeds
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(i)
+        i %= n
+        per_goal = len(self.variants) * self.seeds
+        return RunSpec(self.goals[i // per_goal], self.variants[(i // self.seeds) % len(self.variants)], i % self.seeds)
+
+    def __iter__(self):
+        for g in self.goals:
+            for v in self.variants:
+                for s in range(self.seeds):
+                    yield RunSpec(g, v, s)
+
+    def has_key(self, key: tuple) -> bool:
+        """Whether the run ``(label, goal, seed)`` (:attr:`RunSpec.key`) is in the list."""
+        label, goal, seed = key
+        return label in self._labels and str(goal) in self._goal_keys and 0 <= int(seed) < self.seeds
+
+
+def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> RunList:
+    """goals x planner variants x seeds, in that nesting order (a :class:`RunList`)."""
     variants = loaded.task.variants()
     if planners:
         variants = [v for v in variants if v.name in planners or v.label in planners]
     gl = [g for g in loaded.goals if goals is None or str(g) in {str(x) for x in goals}]
-    n = seeds or loaded.sc.experiment.seeds
-    return [RunSpec(g, v, s) for g in gl for v in variants for s in range(n)]
+    return RunList(gl, variants, seeds or loaded.sc.experiment.seeds)

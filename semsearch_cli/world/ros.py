@@ -14,12 +14,12 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-import cv2
 import numpy as np
 import yaml
 
 from ..config import read_yaml
 from ..errors import ScenarioError
+from .images import read_gray
 
 WALL, UNKNOWN, FREE = 0, 128, 255
 
@@ -36,17 +36,20 @@ def read_ros_yaml(path: Path, owner: str | None = None) -> dict:
     try:
         res = float(d["resolution"])
         ox, oy, yaw = (float(v) for v in d["origin"])
+        occupied, free = float(d.get("occupied_thresh", 0.65)), float(d.get("free_thresh", 0.196))
     except (TypeError, ValueError):
         raise ScenarioError(str(path), "origin", "expected resolution (m/cell) and origin [x, y, yaw]") from None
-    if res <= 0:
-        raise ScenarioError(str(path), "resolution", f"must be positive (got {res})")
+    if not 0.005 <= res <= 1.0:
+        raise ScenarioError(str(path), "resolution", f"expected 0.005 to 1 m per cell (got {res})")
+    if not (np.isfinite([ox, oy, yaw]).all() and max(abs(ox), abs(oy)) <= 1e6):
+        raise ScenarioError(str(path), "origin", f"expected finite numbers within 1e6 m (got {d['origin']!r})")
     if abs(yaw) > 1e-9:
         raise ScenarioError(str(path), "origin", f"a rotated map (yaw {yaw}) is not supported; save it with yaw 0")
     mode = str(d.get("mode", "trinary"))
     if mode not in ("trinary", "scale", "raw"):
         raise ScenarioError(str(path), "mode", f"trinary, scale or raw (got {mode!r})")
     return {"image": str(d["image"]), "resolution": res, "origin": (ox, oy), "negate": bool(int(d.get("negate", 0))),
-            "occupied_thresh": float(d.get("occupied_thresh", 0.65)), "free_thresh": float(d.get("free_thresh", 0.196)),
+            "occupied_thresh": occupied, "free_thresh": free,
             "mode": mode}
 
 
@@ -56,9 +59,7 @@ def read_ros_map(path: Path, owner: str | None = None) -> tuple[np.ndarray, floa
     path = Path(path)
     meta = read_ros_yaml(path, owner)
     img_path = (path.parent / meta["image"])
-    raw = cv2.imread(str(img_path), cv2.IMREAD_GRAYSCALE)
-    if raw is None:
-        raise ScenarioError(str(path), "image", f"{img_path} is missing or not a readable PGM/PNG image")
+    raw = read_gray(img_path, "map image", str(path), "image")
     v = raw.astype(np.float64)
     out = np.full(raw.shape, UNKNOWN, np.uint8)
     if meta["mode"] == "raw":

@@ -7,19 +7,21 @@ blocks beams like a wall). The world is immutable once built and shared by every
 from __future__ import annotations
 
 import csv
+import io
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
 import cv2
 import numpy as np
-import yaml
 
-from ..config import DoorSpec, Scenario
+from ..config import DoorSpec, Scenario, read_yaml
 from ..errors import ScenarioError
+from ..files import read_user_text
 from ..geometry import GridFrame
 from ..kernels.grid import dijkstra
 from ..kernels.raycast import line_of_sight
+from .images import read_gray
 from .ros import read_ros_map
 
 WALL_BELOW = 100
@@ -65,20 +67,21 @@ def _as_label(v):
 
 def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> list[DoorSpec]:
     """Door signs from a CSV (columns number,x,y,facing) or YAML list file."""
-    if not path.is_file():
-        raise ScenarioError(owner or str(path), field, f"door file {path} not found")
     rows: list[dict]
     if path.suffix.lower() in (".yaml", ".yml"):
-        rows = yaml.safe_load(path.read_text()) or []
+        rows = read_yaml(path, "door file", owner, field) or []
+        if not isinstance(rows, list):
+            raise ScenarioError(str(path), "", "expected a YAML list of signs, each {number, x, y, facing}")
     else:
-        with path.open(newline="") as fh:
-            reader = csv.DictReader(fh)
-            need = {"number", "x", "y", "facing"}
-            if reader.fieldnames is None or not need <= set(reader.fieldnames):
-                raise ScenarioError(str(path), field, f"expected CSV columns number,x,y,facing (got {reader.fieldnames})")
-            rows = list(reader)
+        reader = csv.DictReader(io.StringIO(read_user_text(path, "door file", owner, field), newline=""))
+        need = {"number", "x", "y", "facing"}
+        if reader.fieldnames is None or not need <= set(reader.fieldnames):
+            raise ScenarioError(str(path), field, f"expected CSV columns number,x,y,facing (got {reader.fieldnames})")
+        rows = list(reader)
     out = []
     for i, row in enumerate(rows):
+        if not isinstance(row, dict):
+            raise ScenarioError(str(path), f"row {i + 1}", f"expected a sign {{number, x, y, facing}}, got {row!r}")
         try:
             out.append(DoorSpec(number=_as_label(row["number"]), x=float(row["x"]), y=float(row["y"]), facing=float(row["facing"])))
         except (KeyError, ValueError, TypeError) as exc:
@@ -87,13 +90,8 @@ def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> li
 
 
 def load_map(path: Path, field: str = "map.image", owner: str | None = None) -> np.ndarray:
-    """Gray image (H, W) uint8 of a map file."""
-    if not path.is_file():
-        raise ScenarioError(owner or str(path), field, f"map image {path} not found")
-    img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
-    if img is None:
-        raise ScenarioError(owner or str(path), field, f"{path} is not a readable image (expected a PNG: dark = wall, light = free)")
-    return img
+    """Gray image (H, W) uint8 of a map file (see :func:`~semsearch_cli.world.images.read_gray`)."""
+    return read_gray(path, "map image", owner, field)
 
 
 @dataclass(frozen=True)
@@ -239,11 +237,18 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
         return None
     if sc.map.ros is not None:
         img, res, origin = read_ros_map(base / sc.map.ros, owner=file)
+        map_field = "map.ros"
     else:
         img, res, origin = load_map(base / sc.map.image, owner=file), sc.map.resolution, sc.map.origin
+        map_field = "map.image"
     free = img >= FREE_FROM
     H, W = free.shape
     frame = GridFrame(res, origin[0], origin[1], H, W)
+    if not free.any():
+        raise ScenarioError(file, map_field, f"the map has no free cells (light pixels, >= {FREE_FROM} of 255; a 16-bit image "
+                            "is scaled to 8 bits): is it inverted, or all dark?")
+    extent = (f"the map spans x {origin[0]:g} to {origin[0] + W * res:g} m and y {origin[1]:g} to {origin[1] + H * res:g} m "
+              f"({W} x {H} cells of {res:g} m" + (", map.resolution" if sc.map.image is not None else "") + ")")
 
     doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
     dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file
@@ -252,24 +257,32 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     signs = Signs(
         number=tuple(labels),
         value=np.array([lab if isinstance(lab, int) else -1 for lab in labels], np.int64),
-        x=np.array([d.x for d in doors]),
-        y=np.array([d.y for d in doors]),
-        facing=np.radians([d.facing for d in doors]),
+        x=np.array([d.x for d in doors], np.float64),
+        y=np.array([d.y for d in doors], np.float64),
+        facing=np.radians(np.array([d.facing for d in doors], np.float64)),
     )
-    # every sign must sit next to free space
     r, c = frame.to_index(signs.x, signs.y)
+    inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+    sr, scc = frame.to_index(sc.start.x, sc.start.y)
+    if not (0 <= sr < H and 0 <= scc < W):
+        # start and signs off the map together: the map's scale or origin is wrong, not each position
+        blame = "map.resolution" if sc.map.image is not None and not inside.all() else "start"
+        raise ScenarioError(file, blame, f"start ({sc.start.x:g}, {sc.start.y:g}) m lies outside the map"
+                            + (f", and so do {int((~inside).sum())} of the {len(signs)} signs" if not inside.all() else "")
+                            + f": {extent}; check map.resolution and map.origin" + (" (or the start)" if blame == "map.resolution" else ""))
+    # every sign must sit next to free space
     pad = np.pad(free, 2)
     for k in range(len(signs)):
         rr, cc = r[k] + 2, c[k] + 2
-        if not (0 <= r[k] < H and 0 <= c[k] < W) or not pad[rr - 2 : rr + 3, cc - 2 : cc + 3].any():
+        if not inside[k]:
+            raise ScenarioError(dfile, f"doors[{k}]", f"sign {signs.number[k]} at ({signs.x[k]:.2f}, {signs.y[k]:.2f}) m lies outside "
+                                f"the map: {extent}")
+        if not pad[rr - 2 : rr + 3, cc - 2 : cc + 3].any():
             raise ScenarioError(dfile, f"doors[{k}]", f"sign {signs.number[k]} at ({signs.x[k]:.2f}, {signs.y[k]:.2f}) m is not next to free space (within 2 cells)")
 
     heading = None if sc.start.heading == "random" else float(np.radians(sc.start.heading))
     world = World(frame, free, signs, (sc.start.x, sc.start.y), heading, sc.robot.radius, sc.door_camera.range,
                   float(np.radians(sc.door_camera.fov)), duplicates)
-    sr, scc = world.start_cell
-    if not (0 <= sr < H and 0 <= scc < W):
-        raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m lies outside the map")
     if not world.cspace[sr, scc]:
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m is inside a wall or closer than the robot radius ({sc.robot.radius} m) to one")
     return world

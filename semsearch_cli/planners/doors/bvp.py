@@ -26,7 +26,7 @@ from .greedy import nearest_candidate
 
 class BVPParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
-    window: float = Field(15.0, gt=1.0, description="m, half-size of the square solved around the robot")
+    window: float = Field(15.0, gt=1.0, le=100.0, description="m, half-size of the square solved around the robot")
     coarsen: int = Field(2, ge=1, le=8, description="cells of the map per cell of the potential's grid")
 
 
