@@ -36,20 +36,34 @@ def default_out(loaded: Loaded, out: str | Path | None) -> Path:
     return Path("results") / loaded.sc.name
 
 
-def default_workers() -> int:
-    return max(1, min(4, os.cpu_count() or 1))
+MAX_WORKERS = 512  # even with --oversubscribe
+
+
+def workers_for(workers: int | None, oversubscribe: bool = False) -> int:
+    """The number of worker processes: by default the CPU count, at most 4; more workers than
+    CPUs only slow each run down and multiply memory, so they are refused unless
+    ``oversubscribe`` (never more than :data:`MAX_WORKERS`)."""
+    cpus = os.cpu_count() or 1
+    if workers is None:
+        return max(1, min(4, cpus))
+    if workers < 1 or workers > MAX_WORKERS or (workers > cpus and not oversubscribe):
+        limit = f"at most {cpus} (the CPU count)" + (f", or up to {MAX_WORKERS} with --oversubscribe" if workers <= MAX_WORKERS else "")
+        raise ScenarioError("<command line>", "--workers", f"{workers} workers on {cpus} CPUs: {limit}")
+    return workers
 
 
 def run(scenario: str | Path, seeds: int | None = None, workers: int | None = None, goals=None,
         planners=None, out: str | Path | None = None, progress=None, plots: bool = True,
-        trace: bool = False, planner_specs=None, force: bool = False) -> RunOutput:
+        trace: bool = False, planner_specs=None, force: bool = False, oversubscribe: bool = False) -> RunOutput:
     """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/.
 
     ``planner_specs`` (a list of :class:`~semsearch_cli.config.PlannerSpec`) replaces the
     scenario's planners; ``trace`` writes each run's decisions to traces/<run>.jsonl. The
     output folder is locked for the command; rows of another (or an edited) scenario in it are
-    refused unless ``force`` (see :func:`~semsearch_cli.runner.run_batch`).
+    refused unless ``force`` (see :func:`~semsearch_cli.runner.run_batch`). ``workers`` is
+    checked by :func:`workers_for`.
     """
+    workers = workers_for(workers, oversubscribe)
     loaded = Loaded.load(Path(scenario))
     if planner_specs is not None:
         loaded = loaded.with_planners(planner_specs)
@@ -66,7 +80,7 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
         check_folder(loaded, out_dir, force)
         report_build.write_meta(out_dir, loaded.path)
         loaded.task.write_inputs(out_dir)
-        runs = run_batch(loaded, specs, out_dir, workers or default_workers(), progress, trace)
+        runs = run_batch(loaded, specs, out_dir, workers, progress, trace)
         summary = write_summary(runs, out_dir)
         if plots:
             report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
@@ -85,14 +99,16 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
 
 
 def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
-                goals=None, out: str | Path | None = None, progress=None, trace: bool = False, force: bool = False) -> RunOutput:
+                goals=None, out: str | Path | None = None, progress=None, trace: bool = False, force: bool = False,
+                oversubscribe: bool = False) -> RunOutput:
     """nsos at each alpha with greedy beside it: the rows and summary of :func:`run`, plus
     ``plots/alpha_sweep.png``. Other nsos parameters come from the scenario's first nsos entry."""
     sc = load_scenario(scenario)
     base = next((p.params() for p in sc.planners if p.name == "nsos"), {})
     base.pop("alpha", None)
     specs = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[float(a) for a in alphas], **base)]
-    res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs, force=force)
+    res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs, force=force,
+              oversubscribe=oversubscribe)
     labels = {v.label for v in expand_variants(specs, str(scenario))}
     (res.out / "plots").mkdir(parents=True, exist_ok=True)
     plot_alpha_sweep(run_rows(res.runs)[run_rows(res.runs)["planner"].isin(labels)], res.out / "plots" / "alpha_sweep.png")
@@ -123,11 +139,12 @@ def parse_param(text: str) -> tuple[str, list]:
 
 def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = None, workers: int | None = None,
           goals=None, planners=None, out: str | Path | None = None, progress=None, trace: bool = False,
-          force: bool = False) -> SweepOutput:
+          force: bool = False, oversubscribe: bool = False) -> SweepOutput:
     """Run a scenario once per value of one parameter (see
     :func:`~semsearch_cli.config.with_param`): each value's rows go to ``out/<param>=<value>/``
     (resumable, as :func:`run`), then ``sweep.csv``, ``sweep.md`` and ``sweep.png`` compare them.
     Every value is checked before anything runs."""
+    workers = workers_for(workers, oversubscribe)
     path = Path(scenario)
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
@@ -144,7 +161,7 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
             with folder_lock(sub):
                 report_build.write_meta(sub, ld.path)
                 ld.task.write_inputs(sub)
-                runs = run_batch(ld, specs, sub, workers or default_workers(), progress, trace, force=force)
+                runs = run_batch(ld, specs, sub, workers, progress, trace, force=force)
                 write_summary(runs, sub)
             frames.append(run_rows(runs).assign(value=v))
         runs = pd.concat(frames, ignore_index=True)

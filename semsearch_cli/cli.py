@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from pathlib import Path
@@ -15,6 +16,7 @@ from rich.table import Table
 
 from . import __version__, api
 from .belief.presence import presence_scores, read_counts
+from .config.base import MAX_SEEDS
 from .config.indirect import IndirectSpec
 from .errors import ScenarioError
 from .report.build import console_tables
@@ -27,7 +29,7 @@ from .world.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
 from .world.kth import import_kth as imp_kth
 from .world.mobilesim import import_mobilesim as imp_mobilesim
 from .world.ros_import import import_ros as imp_ros
-from .files import temp_path
+from .files import output_folder, temp_path
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
@@ -51,6 +53,13 @@ def _path(value: Optional[str]) -> Optional[Path]:
     return Path(value)
 
 
+def _finite(value: Optional[float]) -> Optional[float]:
+    """A number option: NaN and infinity are refused (click's ranges let NaN through)."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"expected a finite number, got {value}")
+    return value
+
+
 def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
     """Repeated or comma-separated values of ``flag`` (numbers as int); None when not given."""
     if values is None or values == []:
@@ -64,31 +73,33 @@ def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
 @app.command()
 def run(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and planner variant (default: the scenario's experiment.seeds)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Runs per goal and planner variant (default: the scenario's experiment.seeds)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate)."),
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
+    oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
 ):
     """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
     _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir, progress=tick, trace=trace,
-                                force=force))
+                                force=force, oversubscribe=oversubscribe))
 
 
 @app.command("sweep-alpha")
 def sweep_alpha(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
     alphas: str = typer.Option("0,0.5,0.8,0.9,1.0", "--alphas", help="Comma-separated alpha values for nsos."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and variant (default: the scenario's)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Runs per goal and variant (default: the scenario's)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
+    oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
 ):
     """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
     plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
@@ -100,7 +111,7 @@ def sweep_alpha(
     if not values or any(not 0.0 <= a <= 1.0 for a in values):
         _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
     res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal, "--goal"), out_dir, progress=tick, trace=trace,
-                                                     force=force))
+                                                     force=force, oversubscribe=oversubscribe))
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
 
@@ -109,13 +120,14 @@ def sweep(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
     param: str = typer.Option(..., "--param", help="SECTION.FIELD=V1,V2,... e.g. door_camera.p_misread=0,0.02,0.05,0.1, "
                               "or PLANNER.PARAM=... e.g. nsos.alpha=0.8,0.9,1.0."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, help="Runs per goal and variant (default: the scenario's)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4)."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Runs per goal and variant (default: the scenario's)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label."),
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>-sweep-<param>)."),
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
+    oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
 ):
     """Run a scenario once per value of one parameter: each value's rows in <out>/<param>=<value>/
     (resumable), then sweep.csv, sweep.md and sweep.png (mean ratio to the shortest path and success
@@ -126,7 +138,7 @@ def sweep(
     except ScenarioError as exc:
         _fail(exc)
     res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir,
-                                                progress=tick, trace=trace, force=force))
+                                                progress=tick, trace=trace, force=force, oversubscribe=oversubscribe))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
     out.print(escape(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv"))
@@ -275,7 +287,7 @@ def record(
     with `record: path/to/log.csv` in its case."""
 
     try:
-        written = api.record(scenario, out_dir, _split(cases, "--case"))
+        written = api.record(scenario, output_folder(out_dir), _split(cases, "--case"))
     except ScenarioError as exc:
         _fail(exc)
     for f, n in written:
@@ -319,14 +331,14 @@ def generate_building(
     numbering: str = typer.Option(..., "--numbering", help=", ".join(SCHEMES) + "."),
     seed: int = typer.Option(0, "--seed", help="Seed of the layout's variations (and of random numbering)."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
-    spacing: float = typer.Option(2.5, "--spacing", min=0.5, help="m between door slots along a wall."),
+    spacing: float = typer.Option(2.5, "--spacing", callback=_finite, min=0.5, max=50.0, help="m between door slots along a wall."),
     signs: Optional[int] = typer.Option(None, "--signs", min=1, help="Keep exactly this many signs (doors trimmed at random, numbers kept)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
     name: Optional[str] = typer.Option(None, "--name", help="Scenario name (default LAYOUT-NUMBERING-SEED)."),
 ):
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
-        path = gen_building(layout, numbering, seed, out_dir, spacing=spacing, signs=signs,
+        path = gen_building(layout, numbering, seed, output_folder(out_dir), spacing=spacing, signs=signs,
                    goals=_split([goals], "--goals") if goals is not None else None, name=name)
     except ScenarioError as exc:
         _fail(exc)
@@ -355,7 +367,7 @@ def generate_batch(
     try:
         lays = _choices(layouts, LAYOUTS, "--layouts")
         schs = _choices(schemes, SCHEMES, "--schemes")
-        paths = gen_batch(out_dir, seeds=seeds, runs=runs, layouts=lays, schemes=schs)
+        paths = gen_batch(output_folder(out_dir), seeds=seeds, runs=runs, layouts=lays, schemes=schs)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {len(paths)} scenarios under {out_dir} (listed in {out_dir / 'index.txt'})")
@@ -372,15 +384,17 @@ def generate_rooms(
     """Rooms for indirect search as the paper's (Loncomilla et al. 2018, Section 4.5): the monitor
     uniform, each secondary object in a ring drawn from its co-occurrences (Table 2)."""
     try:
-        w, d = (float(v) for v in size.split(","))
-    except ValueError:
-        _fail(ScenarioError("--size", "", f"expected W,D in metres (got {size!r})"))
-    spec = IndirectSpec()
-    try:
-        rooms = gen_rooms(n, seed, spec.relations, spec.masks, spec.target, (w, d), obstacles)
-    except ValueError as exc:
-        _fail(ScenarioError("--obstacles", "", str(exc)))
-    path = write_rooms(out_dir / "rooms.yaml", rooms)
+        w, d = _xy(size, "--size", "W,D in metres")
+        if not (1.0 <= w <= 50.0 and 1.0 <= d <= 50.0):
+            raise ScenarioError("<command line>", "--size", f"W and D must lie between 1 and 50 m (got {size!r})")
+        spec = IndirectSpec()
+        try:
+            rooms = gen_rooms(n, seed, spec.relations, spec.masks, spec.target, (w, d), obstacles)
+        except ValueError as exc:
+            raise ScenarioError("<command line>", "--obstacles", str(exc)) from None
+        path = write_rooms(output_folder(out_dir) / "rooms.yaml", rooms)
+    except ScenarioError as exc:
+        _fail(exc)
     out.print(f"wrote {len(rooms)} rooms of {w:g} x {d:g} m to {path}")
 
 
@@ -389,29 +403,32 @@ def import_mobilesim(
     map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),
     doors_file: Path = typer.Argument(..., help=".doors file: x y number facing (m, degrees)."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
-    resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
+    resolution: float = typer.Option(0.1, "--resolution", callback=_finite, min=0.01, max=1.0, help="m per cell."),
     start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
-    density_delta: float = typer.Option(2.5, "--density-delta", help="m^2, segmentation delta (Eq. 4.4)."),
+    density_delta: float = typer.Option(2.5, "--density-delta", callback=_finite, min=0.01, max=1e4, help="m^2, segmentation delta (Eq. 4.4)."),
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
-        path, notes = imp_mobilesim(map_file, doors_file, out_dir, resolution, _xy(start, "--start"),
+        path, notes = imp_mobilesim(map_file, doors_file, output_folder(out_dir), resolution, _xy(start, "--start"),
                              _split([goals], "--goals") if goals is not None else None, density_delta)
     except ScenarioError as exc:
         _fail(exc)
     out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
 
 
-def _xy(value: str | None, flag: str) -> tuple[float, float] | None:
-    """``X,Y`` in metres from the command line, or None."""
+def _xy(value: str | None, flag: str, what: str = "X,Y in metres") -> tuple[float, float] | None:
+    """Two finite numbers ``A,B`` from the command line, or None."""
     if not value:
         return None
     try:
         xs, ys = value.split(",")
-        return float(xs), float(ys)
+        x, y = float(xs), float(ys)
     except ValueError:
-        raise ScenarioError("<command line>", flag, f"expected X,Y in metres, got {value!r}") from None
+        x = y = math.nan
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ScenarioError("<command line>", flag, f"expected {what}, got {value!r}")
+    return x, y
 
 
 @import_app.command("ros")
@@ -421,11 +438,11 @@ def import_ros(
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.yaml (and its image), doors.csv and scenario.yaml."),
     start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
-    density_delta: float = typer.Option(2.5, "--density-delta", help="m^2, segmentation delta (Eq. 4.4)."),
+    density_delta: float = typer.Option(2.5, "--density-delta", callback=_finite, min=0.01, max=1e4, help="m^2, segmentation delta (Eq. 4.4)."),
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
-        path, notes = imp_ros(map_file, doors_file, out_dir, _xy(start, "--start"), _split([goals], "--goals") if goals is not None else None,
+        path, notes = imp_ros(map_file, doors_file, output_folder(out_dir), _xy(start, "--start"), _split([goals], "--goals") if goals is not None else None,
                        density_delta=density_delta)
     except ScenarioError as exc:
         _fail(exc)
@@ -436,7 +453,7 @@ def import_ros(
 def import_kth(
     xml_file: Path = typer.Argument(..., help="KTH campus floor-plan XML file."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
-    resolution: float = typer.Option(0.1, "--resolution", min=0.01, max=1.0, help="m per cell."),
+    resolution: float = typer.Option(0.1, "--resolution", callback=_finite, min=0.01, max=1.0, help="m per cell."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance, among readable signs)."),
     corridor_types: str = typer.Option(",".join(KTH_CORRIDOR_TYPES), "--corridor-types",
                                        help="Comma-separated space types the robot drives in (untyped spaces joined to several others count too)."),
@@ -444,7 +461,7 @@ def import_kth(
     """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
         types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
-        path, notes = imp_kth(xml_file, out_dir, resolution, _split([goals], "--goals") if goals is not None else None, corridor_types=types)
+        path, notes = imp_kth(xml_file, output_folder(out_dir), resolution, _split([goals], "--goals") if goals is not None else None, corridor_types=types)
     except ScenarioError as exc:
         _fail(exc)
     out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))

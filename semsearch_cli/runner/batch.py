@@ -57,7 +57,7 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
-        executor = make_executor(workers, start_method) if total > 1 else SerialExecutor()
+        executor = make_executor(min(workers, total), start_method) if total > 1 else SerialExecutor()
         writer = RowWriter(runs_csv)
         n = 0
         try:

@@ -261,30 +261,31 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
         y=np.array([d.y for d in doors], np.float64),
         facing=np.radians(np.array([d.facing for d in doors], np.float64)),
     )
-    r, c = frame.to_index(signs.x, signs.y)
-    inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
-    sr, scc = frame.to_index(sc.start.x, sc.start.y)
-    if not (0 <= sr < H and 0 <= scc < W):
-        # start and signs off the map together: the map's scale or origin is wrong, not each position
-        blame = "map.resolution" if sc.map.image is not None and not inside.all() else "start"
-        raise ScenarioError(file, blame, f"start ({sc.start.x:g}, {sc.start.y:g}) m lies outside the map"
-                            + (f", and so do {int((~inside).sum())} of the {len(signs)} signs" if not inside.all() else "")
-                            + f": {extent}; check map.resolution and map.origin" + (" (or the start)" if blame == "map.resolution" else ""))
-    # every sign must sit next to free space
-    pad = np.pad(free, 2)
-    for k in range(len(signs)):
-        rr, cc = r[k] + 2, c[k] + 2
-        if not inside[k]:
-            raise ScenarioError(dfile, f"doors[{k}]", f"sign {signs.number[k]} at ({signs.x[k]:.2f}, {signs.y[k]:.2f}) m lies outside "
-                                f"the map: {extent}")
-        if not pad[rr - 2 : rr + 3, cc - 2 : cc + 3].any():
-            raise ScenarioError(dfile, f"doors[{k}]", f"sign {signs.number[k]} at ({signs.x[k]:.2f}, {signs.y[k]:.2f}) m is not next to free space (within 2 cells)")
-
     heading = None if sc.start.heading == "random" else float(np.radians(sc.start.heading))
     world = World(frame, free, signs, (sc.start.x, sc.start.y), heading, sc.robot.radius, sc.door_camera.range,
                   float(np.radians(sc.door_camera.fov)), duplicates)
-    if not world.cspace[sr, scc]:
+    # every sign must sit next to free space, and the start where the robot fits
+    r, c = frame.to_index(signs.x, signs.y)
+    pad = np.pad(free, 2)
+    bad = [k for k in range(len(signs)) if not (0 <= r[k] < H and 0 <= c[k] < W)
+           or not pad[r[k] : r[k] + 5, c[k] : c[k] + 5].any()]
+    sr, scc = world.start_cell
+    start_in = 0 <= sr < H and 0 <= scc < W
+    start_ok = start_in and bool(world.cspace[sr, scc])
+    if not start_ok and bad:
+        # start and signs wrong together: the map's scale or origin is wrong, not each position
+        raise ScenarioError(file, "map.resolution" if sc.map.image is not None else map_field,
+                            f"neither the start ({sc.start.x:g}, {sc.start.y:g}) m nor {len(bad)} of the {len(signs)} signs "
+                            f"(e.g. {signs.number[bad[0]]} at ({signs.x[bad[0]]:g}, {signs.y[bad[0]]:g}) m) lie in free space: "
+                            f"{extent}; check map.resolution and map.origin")
+    if not start_in:
+        raise ScenarioError(file, "start", f"start ({sc.start.x:g}, {sc.start.y:g}) m lies outside the map: {extent}")
+    if not start_ok:
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m is inside a wall or closer than the robot radius ({sc.robot.radius} m) to one")
+    if bad:
+        k = bad[0]
+        where = "is not next to free space (within 2 cells)" if 0 <= r[k] < H and 0 <= c[k] < W else f"lies outside the map: {extent}"
+        raise ScenarioError(dfile, f"doors[{k}]", f"sign {signs.number[k]} at ({signs.x[k]:.2f}, {signs.y[k]:.2f}) m {where}")
     return world
 
 
