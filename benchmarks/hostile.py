@@ -6,7 +6,8 @@ Usage:
 
 Outcomes: ``refused`` (exit 2, no traceback), ``accepted`` (exit 0), ``traceback`` (a Python
 traceback on stderr, whatever the status), ``other`` (another status) and ``hang`` (killed at the
-time limit). A case accepted where it should be refused is ``garbage accepted``; one refused
+time limit); ``warnings`` counts cases that printed a numpy, OpenCV or libpng warning (a defect:
+the user should see one paragraph). A case accepted where it should be refused is ``garbage accepted``; one refused
 where it should be accepted is ``wrongly refused``. Exits 1 when any case is a defect.
 """
 
@@ -44,8 +45,10 @@ def run_case(case, timeout: float, cwd: Path) -> dict:
     defect = outcome in ("traceback", "other", "hang") or (case.expect == "refuse" and outcome == "accepted") \
         or (case.expect == "accept" and outcome == "refused")
     lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+    warned = any(w in ln for ln in lines for w in ("Warning:", "[ WARN", "libpng", "RuntimeWarning"))
+    defect = defect or warned
     return {"category": case.category, "case": case.name, "expect": case.expect, "outcome": outcome, "status": status,
-            "defect": defect, "issue_14": case.issue, "seconds": round(time.perf_counter() - t0, 2),
+            "defect": defect, "warned": warned, "issue_14": case.issue, "seconds": round(time.perf_counter() - t0, 2),
             "message": " ".join(" ".join(lines[-3:]).split())[:300]}
 
 
@@ -75,6 +78,7 @@ def main() -> int:
         accepted=("outcome", lambda s: int((s == "accepted").sum())),
         traceback=("outcome", lambda s: int((s == "traceback").sum())),
         hang=("outcome", lambda s: int((s == "hang").sum())), other=("outcome", lambda s: int((s == "other").sum())),
+        warnings=("warned", "sum"),
         garbage_accepted=("defect", lambda s: int((s & (df.loc[s.index, "outcome"] == "accepted")).sum())),
         wrongly_refused=("defect", lambda s: int((s & (df.loc[s.index, "outcome"] == "refused")).sum()))).reset_index()
     total = table.drop(columns="category").sum().to_frame().T.assign(category="all")[table.columns]

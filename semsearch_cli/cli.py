@@ -13,6 +13,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
+from rich.text import Text
 
 from . import __version__, api
 from .belief.presence import presence_scores, read_counts
@@ -35,12 +36,13 @@ app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
 import_app = typer.Typer(no_args_is_help=True, help="Convert maps from other tools into scenarios.")
 app.add_typer(import_app, name="import")
-out = Console() if sys.stdout.isatty() else Console(width=200)
-err = Console(stderr=True) if sys.stderr.isatty() else Console(stderr=True, width=200)
+# markup off: file names, planner names and goals are printed as they are, never read as [style] tags
+out = Console(markup=False) if sys.stdout.isatty() else Console(markup=False, width=200)
+err = Console(stderr=True, markup=False) if sys.stderr.isatty() else Console(stderr=True, markup=False, width=200)
 
 
 def _fail(exc: ScenarioError) -> None:
-    err.print("[bold red]error:[/] " + escape(str(exc)), highlight=False, soft_wrap=True)
+    err.print(Text.assemble(("error:", "bold red"), " " + str(exc)), highlight=False, soft_wrap=True)
     raise typer.Exit(2)
 
 
@@ -141,7 +143,7 @@ def sweep(
                                                 progress=tick, trace=trace, force=force, oversubscribe=oversubscribe))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
-    out.print(escape(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv"))
+    out.print(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv")
 
 
 class _Lines:
@@ -157,8 +159,8 @@ class _Lines:
             self.step = max(1, total // 10)
         if done == total or done % self.step == 0 or now - self.last >= self.every:
             self.last = now
-            err.print(escape(f"runs: {done} of {total} done, {now - self.t0:.0f} s; last {row['planner']} goal {row['goal']} "
-                             f"seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m"), highlight=False, soft_wrap=True)
+            err.print(f"runs: {done} of {total} done, {now - self.t0:.0f} s; last {row['planner']} goal {row['goal']} "
+                             f"seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m", highlight=False, soft_wrap=True)
 
 
 def _with_progress(call):
@@ -200,8 +202,8 @@ def _with_progress(call):
 def _warn_errors(runs) -> None:
     errors = runs[runs["outcome"] == "error"]
     if len(errors):
-        err.print(escape(f"warning: {len(errors)} run(s) raised an error (outcome error in runs.csv), e.g. "
-                         f"{errors['planner'].iloc[0]}: {errors['message'].iloc[0]}"), highlight=False)
+        err.print(f"warning: {len(errors)} run(s) raised an error (outcome error in runs.csv), e.g. "
+                         f"{errors['planner'].iloc[0]}: {errors['message'].iloc[0]}", highlight=False)
 
 
 def _batch(call):
@@ -210,18 +212,18 @@ def _batch(call):
     for title, df in console_tables(res.runs):
         _print_table(title, df)
     _warn_errors(res.runs)
-    out.print(escape(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {res.out / 'figures'}  "
-                     f"report: {res.out / 'report.md'}"))
+    out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {res.out / 'figures'}  "
+                     f"report: {res.out / 'report.md'}")
     return res
 
 
 def _print_table(title: str, df) -> None:
     """A DataFrame as a console table; text columns left-aligned, numbers right."""
-    t = Table(title=escape(title))
+    t = Table(title=title)
     for col in df.columns:
-        t.add_column(escape(str(col)), justify="left" if df[col].dtype == object else "right")
+        t.add_column(str(col), justify="left" if df[col].dtype == object else "right")
     for r in df.itertuples(index=False):  # not iterrows: it upcasts a row of ints and floats to floats
-        t.add_row(*[escape(str(v)) for v in r])
+        t.add_row(*[str(v) for v in r])
     out.print(t)
 
 
@@ -264,7 +266,7 @@ def presence(
     t = Table(title="presence score per place (sum of counts x W, Eq. 5.3), * = highest")
     t.add_column("hour", justify="right")
     for c in scores.columns:
-        t.add_column(escape(str(c)), justify="right")
+        t.add_column(str(c), justify="right")
     for rh, row in scores.iterrows():
         best = row.idxmax()
         t.add_row(f"{rh:g}", *[f"{v:.2f}" + ("*" if c == best else "") for c, v in row.items()])
@@ -304,7 +306,7 @@ def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
         _fail(exc)
     out.print(f"{scenario}: ok")
     for k, v in info.items():
-        out.print(escape(f"  {k}: {v}"))
+        out.print(f"  {k}: {v}")
 
 
 @app.command()
@@ -414,7 +416,7 @@ def import_mobilesim(
                              _split([goals], "--goals") if goals is not None else None, density_delta)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
+    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
 
 
 def _xy(value: str | None, flag: str, what: str = "X,Y in metres") -> tuple[float, float] | None:
@@ -446,7 +448,7 @@ def import_ros(
                        density_delta=density_delta)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(escape(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
+    out.print(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
 
 
 @import_app.command("kth")
@@ -464,7 +466,7 @@ def import_kth(
         path, notes = imp_kth(xml_file, output_folder(out_dir), resolution, _split([goals], "--goals") if goals is not None else None, corridor_types=types)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(escape(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes)))
+    out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
 
 
 @app.command()

@@ -32,6 +32,7 @@ class Case:
     args: list[str]
     expect: str = "refuse"  # refuse | accept | either (no traceback, no hang)
     issue: bool = False  # a defect listed in issue 14 (the tests run these)
+    says: tuple = ()  # text the output must hold (the field or flag blamed, the file named)
     cwd: Path | None = field(default=None, repr=False)
 
 
@@ -80,8 +81,8 @@ def build_cases(root: Path) -> list[Case]:
     def scen(name: str, data, **kw) -> Path:
         return _dump(root / "scen" / f"{name}.yaml", data)
 
-    def add(category, name, args, expect="refuse", issue=False):
-        cases.append(Case(category, name, [str(a) for a in args], expect, issue))
+    def add(category, name, args, expect="refuse", issue=False, says=()):
+        cases.append(Case(category, name, [str(a) for a in args], expect, issue, tuple(says)))
 
     # -- numbers: every numeric field of the three kinds of search, given garbage
     office = yaml.safe_load((REPO / "configs" / "office.yaml").read_text())
@@ -116,17 +117,22 @@ def build_cases(root: Path) -> list[Case]:
                 doc2 = doc
             for vname, v, expect in values:
                 p = scen(f"{f}={vname}", _set(doc2, keys, v))
-                add("numbers", f"{f}: {vname}", ["validate", p], expect, issue=f in issue_numbers and vname in ("inf", "nan", "1e9"))
+                field = ".".join(f"[{k}]" if isinstance(k, int) else k for k in keys).replace(".[", "[")
+                issue = f in issue_numbers and vname in ("inf", "nan", "1e9")
+                add("numbers", f"{f}: {vname}", ["validate", p], "refuse" if issue else expect, issue, says=[f"field '{field}'"] if issue else ())
     step = scen("robot.step=1e-7", _set(base, ["robot", "step"], 1e-7))
-    add("numbers", "robot.step: 1e-7", ["validate", step], issue=True)
-    add("numbers", "recording_hours: [25]", ["validate", scen("hours25", _set(office, ["objects", "recording_hours"], [25]))], issue=True)
-    add("numbers", "recording_hours: [-1]", ["validate", scen("hours-1", _set(office, ["objects", "recording_hours"], [-1]))], issue=True)
+    add("numbers", "robot.step: 1e-7", ["validate", step], issue=True, says=["robot.step"])
+    add("numbers", "recording_hours: [25]", ["validate", scen("hours25", _set(office, ["objects", "recording_hours"], [25]))], issue=True,
+        says=["objects.recording_hours[0]"])
+    add("numbers", "recording_hours: [-1]", ["validate", scen("hours-1", _set(office, ["objects", "recording_hours"], [-1]))], issue=True,
+        says=["objects.recording_hours[0]"])
     add("numbers", "timeline hour 30", ["validate", scen("tl30", _set(office, ["objects", "timelines", "Static", "mug"], {30: "A"}))])
     for name, planner in (("nsos alpha nan", {"name": "nsos", "alpha": NAN}), ("bvp window inf", {"name": "bvp", "window": INF}),
                           ("bvp window 1e9", {"name": "bvp", "window": 1e9}), ("nsos w_g inf", {"name": "nsos", "w_g": INF})):
-        add("numbers", name, ["validate", scen(name.replace(" ", "_"), _set(base, ["planners"], [planner]))], issue="window" in name)
+        add("numbers", name, ["validate", scen(name.replace(" ", "_"), _set(base, ["planners"], [planner]))], issue="window" in name,
+            says=["planners[0]"])
     lsos = _set(office, ["planners"], [{"name": "lsos", "radius": INF}])
-    add("numbers", "lsos radius inf", ["validate", scen("lsos_inf", lsos)], issue=True)
+    add("numbers", "lsos radius inf", ["validate", scen("lsos_inf", lsos)], issue=True, says=["planners[0].radius"])
     # extreme but valid: accepted, and a run finishes
     for name, keys, v in (("laser.range 50", ["laser", "range"], 50.0), ("belief.visited_radius 20", ["belief", "visited_radius"], 20.0),
                           ("experiment.max_distance 1e6", ["experiment", "max_distance"], 1e6), ("robot.step 0.01", ["robot", "step"], 0.01)):
@@ -152,11 +158,13 @@ def build_cases(root: Path) -> list[Case]:
                        ("crlf_bom.yaml", b"\xef\xbb\xbf" + text.encode().replace(b"\n", b"\r\n"))):
         expect = "accept" if name == "crlf_bom.yaml" else "refuse"
         add("files", f"scenario {name}", ["validate", raw(name, data)], expect,
-            issue=name in ("utf16.yaml", "latin1.yaml", "binary.yaml", "nested.yaml"))
+            issue=name in ("utf16.yaml", "latin1.yaml", "binary.yaml", "nested.yaml"),
+            says={"utf16.yaml": ["UTF-16"], "latin1.yaml": ["UTF-8"], "binary.yaml": ["UTF-8"], "nested.yaml": ["nested"]}.get(name, ()))
     (root / "files" / "folder.yaml").mkdir(parents=True, exist_ok=True)
     for name, path in (("/dev/null", "/dev/null"), ("/dev/zero", "/dev/zero"), ("a folder", root / "files" / "folder.yaml"),
                        ("missing", root / "files" / "missing.yaml")):
-        add("files", f"scenario {name}", ["validate", path], issue=name != "missing")
+        add("files", f"scenario {name}", ["validate", path], issue=name != "missing",
+            says=["not found"] if name == "missing" else ["is a folder"] if name == "a folder" else ["not a regular file"])
     # doors files
     dtext = (demo / "doors.csv").read_text()
     doors_cases = [("doors.csv utf16", "csv", dtext.encode("utf-16"), True), ("doors.csv latin1", "csv", (dtext + "999,1,1,\u00e9\n").encode("latin-1"), True),
@@ -169,9 +177,12 @@ def build_cases(root: Path) -> list[Case]:
                    ("doors.yaml nested", "yaml", b"[" * 5000 + b"]" * 5000, True)]
     for name, ext, data, issue in doors_cases:
         p = raw(name.replace(" ", "_").replace(".", "_") + "." + ext, data)
-        add("files", name, ["validate", scen(name.replace(" ", "_"), _set(base, ["doors"], str(p)))], issue=issue)
+        add("files", name, ["validate", scen(name.replace(" ", "_"), _set(base, ["doors"], str(p)))], issue=issue,
+            says=["UTF-16"] if "utf16" in name else ["finite"] if "nan x" in name or "inf facing" in name else
+            ["not valid YAML"] if "syntax" in name or "tag" in name else ["nested"] if "nested" in name else ())
     for name, path in (("doors /dev/zero", "/dev/zero"), ("doors folder", str(root / "files")), ("doors missing", str(root / "nope.csv"))):
-        add("files", name, ["validate", scen(name.replace(" ", "_").replace("/", ""), _set(base, ["doors"], path))], issue=name != "doors missing")
+        add("files", name, ["validate", scen(name.replace(" ", "_").replace("/", ""), _set(base, ["doors"], path))], issue=name != "doors missing",
+            says={"doors /dev/zero": ["not a regular file"], "doors folder": ["is a folder"]}.get(name, ["not found"]))
     # maps
     img = cv2.imread(str(demo / "map.png"), cv2.IMREAD_GRAYSCALE)
     maps = root / "maps"
@@ -192,10 +203,12 @@ def build_cases(root: Path) -> list[Case]:
                                    ("text as PNG", "text.png", "refuse", False), ("map /dev/zero", "/dev/zero", "refuse", True),
                                    ("map folder", str(maps), "refuse", True)):
         path = f if f.startswith("/") else str(maps / f)
-        add("files", name, ["validate", scen(name.replace(" ", "_").replace("/", ""), _set(base, ["map", "image"], path))], expect, issue)
+        add("files", name, ["validate", scen(name.replace(" ", "_").replace("/", ""), _set(base, ["map", "image"], path))], expect, issue,
+            says=[] if expect == "accept" else ["field 'map.image'"] + ({"map /dev/zero": ["not a regular file"], "map folder": ["is a folder"],
+                                                                         "PNG header 100000 x 100000": ["100000 x 100000"]}.get(name, [])))
     for name, res in (("resolution 0.01 (map too small for its signs)", 0.01), ("resolution 1.0", 1.0), ("resolution 0", 0), ("resolution 1e-9", 1e-9)):
         p = scen(name.split(" (")[0].replace(" ", "_"), _set(base, ["map", "resolution"], res))
-        add("files", f"map {name}", ["validate", p], issue=res in (0.01, 1.0))
+        add("files", f"map {name}", ["validate", p], issue=res in (0.01, 1.0), says=["map.resolution"])
     ros = {"image": str(demo / "map.png"), "resolution": INF, "origin": [0, 0, 0]}
     add("files", "ROS map resolution inf", ["validate", scen("ros_inf", {**{k: v for k, v in base.items() if k != "map"},
                                                                            "map": {"ros": str(_dump(maps / "ros_inf.yaml", ros))}})])
@@ -209,18 +222,19 @@ def build_cases(root: Path) -> list[Case]:
                           ("name empty", ["name"], ""), ("goal not a sign", ["goals"], [99999]), ("duplicates bogus", ["duplicates"], "sometimes"),
                           ("kind bogus", ["kind"], "cats"), ("map both sources", ["map", "ros"], "x.yaml"), ("start in a wall", ["start"], {"x": 0.5, "y": 0.5}),
                           ("beams 1e6", ["laser", "beams"], 10**6), ("seeds 1e9", ["experiment", "seeds"], 10**9)):
-        add("structure", name, ["validate", scen("s_" + name.replace(" ", "_"), _set(base, keys, v))], issue=name == "name ..")
+        add("structure", name, ["validate", scen("s_" + name.replace(" ", "_"), _set(base, keys, v))], issue=name == "name ..",
+            says=["field '" + ".".join(map(str, keys)) + "'"] if keys[0] in ("name", "robot", "laser", "experiment") else ())
 
     # -- output folders and files
     afile = root / "a_file.txt"
     afile.write_text("x")
     for name, out in (("--out a file", afile), ("--out under a file", afile / "sub"), ("--out in /proc", "/proc/semsearch"),
                       ("--out in /sys", "/sys/semsearch"), ('--out ""', "")):
-        add("output", f"run {name}", ["run", good, "--seeds", "1", "--out", out], issue=True)
+        add("output", f"run {name}", ["run", good, "--seeds", "1", "--out", out], issue=True, says=["--out"])
     add("output", 'name: ".." writes into the working folder', ["run", scen("dotdot", _set(base, ["name"], "..")), "--seeds", "1"], issue=True)
     for name, out in (("show --out .xyz", root / "m.xyz"), ("show --out no extension", root / "m"), ("show --out a folder", root),
                       ("show --out under a file", afile / "m.png"), ('show --out ""', "")):
-        add("output", name, ["show", good, "--out", out], issue=name == "show --out .xyz")
+        add("output", name, ["show", good, "--out", out], issue=name == "show --out .xyz", says=["--out"])
     add("output", "show --out .svg", ["show", good, "--out", root / "m.svg"], "accept")
     add("output", "report --out a file", ["report", root / "nofolder", "--out", afile])
     add("output", "record --out a file", ["record", good, "--out", afile])
@@ -238,16 +252,20 @@ def build_cases(root: Path) -> list[Case]:
         if meta is not None:
             (folder / "meta.json").write_bytes(meta)
         issue = name in ("runs.csv binary garbage", "runs.csv wrong columns", "meta.json garbage")
-        add("output", f"run into {name}", ["run", good, "--seeds", "1", "--out", folder], "either" if name == "runs.csv empty" else "refuse", issue)
+        add("output", f"run into {name}", ["run", good, "--seeds", "1", "--out", folder], "either" if name == "runs.csv empty" else "refuse", issue,
+            says=[] if name == "runs.csv empty" else [name.split()[0]])
         if runs is not None:
             shutil.copytree(folder, folder.with_name(folder.name + "_report"))
-            add("output", f"report of {name}", ["report", folder.with_name(folder.name + "_report"), "--no-replay"], issue=issue)
+            add("output", f"report of {name}", ["report", folder.with_name(folder.name + "_report"), "--no-replay"], issue=issue,
+                says=["runs.csv"])
 
     # -- user text read as console markup
-    add("markup", "planner named [/x]", ["validate", scen("mk_planner", _set(base, ["planners"], [{"name": "[/x]"}]))], issue=True)
-    add("markup", "scenario file [/a].yaml", ["validate", _dump(root / "[" / "a].yaml", base)], "accept", issue=True)
-    add("markup", "map path with brackets", ["validate", scen("mk_map", _set(base, ["map", "image"], str(root / "[bold]" / "[/x]map.png")))], issue=True)
-    add("markup", "goal [bold]", ["run", good, "--goal", "[bold]", "--out", root / "out" / "mk"], issue=True)
+    add("markup", "planner named [/x]", ["validate", scen("mk_planner", _set(base, ["planners"], [{"name": "[/x]"}]))], issue=True,
+        says=["'[/x]'"])
+    add("markup", "scenario file [/a].yaml", ["validate", _dump(root / "[" / "a].yaml", base)], "accept", issue=True, says=["[/a].yaml: ok"])
+    add("markup", "map path with brackets", ["validate", scen("mk_map", _set(base, ["map", "image"], str(root / "[bold]" / "[/x]map.png")))], issue=True,
+        says=["[bold]/[/x]map.png"])
+    add("markup", "goal [bold]", ["run", good, "--goal", "[bold]", "--out", root / "out" / "mk"], issue=True, says=["goal [bold]"])
 
     # -- the command line
     for name, args, issue in (('--goal ""', ["run", good, "--goal", "", "--out", root / "out" / "g"], True),
@@ -270,13 +288,14 @@ def build_cases(root: Path) -> list[Case]:
                                                                    "--out", root / "out" / "b", "--spacing", "inf"], False),
                               ("import mobilesim --start nan", ["import", "mobilesim", root / "a_file.txt", root / "a_file.txt", "--out", root / "out" / "m",
                                                                 "--start", "nan,1"], False)):
-        add("command line", name, args, issue=issue)
+        add("command line", name, args, issue=issue, says=[name.split()[0]] if name.startswith("--") else ())
 
     # -- resources
     sweep = _set(base, ["planners"], [{"name": "nsos", "alpha": [round(0.1 * k, 1) for k in range(6)], "w_g": list(range(1, 7)),
                                        "w_p": list(range(1, 7)), "door_bins": list(range(1, 7)), "robot_bins": list(range(1, 7)),
                                        "hysteresis": [0.0, 0.01, 0.02, 0.03, 0.04, 0.05]}])
-    add("resources", "a 46,656-variant planner sweep validates", ["validate", scen("sweep46656", sweep)], "accept", issue=True)
+    add("resources", "a 46,656-variant planner sweep validates", ["validate", scen("sweep46656", sweep)], "accept", issue=True,
+        says=["46656 variants"])
     big = np.full((2000, 2000), 160, np.uint8)
     big[900:1100, 100:1900] = 255
     big[899, 100:1900] = big[1100, 100:1900] = 0

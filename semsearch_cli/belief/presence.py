@@ -7,12 +7,14 @@ with W(rh, h) = 1 - dh / 12 and dh the hour difference on the 24-hour clock (23:
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError
+from ..files import read_user_text
 
 
 def hour_difference(a, b):
@@ -29,11 +31,10 @@ def hour_weight(rh, h):
 def read_counts(path: Path) -> pd.DataFrame:
     """Hourly counts per place: first column the hour (0-23), one column per place. Rows whose
     first cell is not a number (a "Total" row) are ignored."""
-    if not path.is_file():
-        raise ScenarioError(str(path), "", "counts file not found")
+    text = read_user_text(path, "counts file")
     try:
-        df = pd.read_csv(path)
-    except (pd.errors.ParserError, UnicodeDecodeError, pd.errors.EmptyDataError) as exc:
+        df = pd.read_csv(io.StringIO(text))
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
         raise ScenarioError(str(path), "", f"not a readable CSV: {exc}") from None
     if df.shape[1] < 2:
         raise ScenarioError(str(path), "", "expected a first column with the hour and one column per place")

@@ -31,6 +31,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..belief import Belief, Candidates
 from ..errors import ScenarioError
+from ..files import user_file
 
 
 class NoParams(BaseModel):
@@ -117,8 +118,7 @@ def load_planner_file(path: str | Path) -> list[str]:
     key = str(path)
     if key in _LOADED_FILES:
         return _LOADED_FILES[key]
-    if not path.is_file():
-        raise ScenarioError(key, "", "planner file not found")
+    user_file(path, "planner file")
     mod_name = f"semsearch_user_planners.{path.stem}_{hashlib.sha1(key.encode()).hexdigest()[:8]}"
     spec = importlib.util.spec_from_file_location(mod_name, path)
     module = importlib.util.module_from_spec(spec)

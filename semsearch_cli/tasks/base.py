@@ -113,6 +113,13 @@ class Task:
         """The scenario's planner entries (or ``specs``) as variants, checked for this kind."""
         return expand_variants(self.sc.planners if specs is None else specs, self.file, self.planner_kind, self.path.parent)
 
+    def planner_labels(self, most: int = 12):
+        """The variants' labels for `validate`; a long sweep as its count and its first and last."""
+        labels = [v.label for v in self.variants()]
+        if len(labels) <= most:
+            return labels
+        return f"{len(labels)} variants: {', '.join(labels[:3])}, ..., {labels[-1]}"
+
     def goal_value(self, label):
         """The goal as the scenario wrote it (an int door number stays an int)."""
         for g in self.goals:
@@ -165,7 +172,7 @@ class Task:
         """What ``semsearch validate`` prints."""
         w = self.world
         return {"name": self.sc.name, "kind": self.kind, "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
-                "planners": [v.label for v in self.variants()]}
+                "planners": self.planner_labels()}
 
 
 def build_task(sc: Scenario, world: World, path: Path) -> Task:

@@ -190,7 +190,7 @@ class ChainTask(Task):
         w = self.world
         return {"name": self.sc.name, "kind": self.kind, "signs": len(w.signs),
                 "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
-                "planners": [v.label for v in self.variants()],
+                "planners": self.planner_labels(),
                 "chains (shortest m)": {n: f"{' -> '.join(s.label for s in st)}: {self.shortest[n]:.2f}"
                                         for n, st in self.stages.items()}}
 

@@ -294,5 +294,5 @@ class DoorTask(Task):
         return {"name": self.sc.name, "kind": self.kind, "signs": len(w.signs), "readable_signs": readable,
                 f"duplicated numbers ({self.sc.duplicates})": dup or "none",
                 "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
-                "planners": [v.label for v in self.variants()],
+                "planners": self.planner_labels(),
                 "shortest_m": {str(k): round(v, 2) for k, v in self.shortest.items()}}

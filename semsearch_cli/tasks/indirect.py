@@ -404,4 +404,4 @@ class IndirectTask(Task):
                 "rooms where no reachable pose can detect A (their searches cannot succeed)": blind or "none",
                 "grid": f"{self.grids[0].frame.height} x {self.grids[0].frame.width} cells at {spec.resolution} m",
                 "view scales (m)": spec.view_scales, "target": spec.target, "secondary": spec.secondary,
-                "planners": [v.label for v in self.variants()]}
+                "planners": self.planner_labels()}

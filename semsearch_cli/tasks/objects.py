@@ -30,6 +30,7 @@ Choices the seeds leave open (also in the README):
 
 from __future__ import annotations
 
+import io
 import zlib
 from dataclasses import dataclass
 from functools import cached_property
@@ -48,7 +49,7 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from .base import Outcome, RobotState, Task, register_task
 from .loop import run_loop
-from ..files import temp_path
+from ..files import read_user_text, temp_path, user_file
 
 LOG_COLUMNS = ["day", "hour", "class", "x", "y", "robot_x", "robot_y", "place"]
 
@@ -273,7 +274,7 @@ class ObjectTask(Task):
         return {"name": self.sc.name, "kind": self.kind, "places": len(self.places), "route": " ".join(self.route),
                 "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
                 "cases": {c.name: f"{len(self.logs[c.name])} detections recorded" for c in self.cases},
-                "planners": [v.label for v in self.variants()],
+                "planners": self.planner_labels(),
                 "requests (ground truth: shortest m)": {r.label: f"{','.join(r.truth) or 'absent'}: {self.shortest[r.label]:.2f}"
                                                         for r in self.requests}}
 
@@ -296,8 +297,7 @@ class ObjectTask(Task):
         """A ``record`` entry (timeline names, or a detection-log CSV path), checked:
         (timeline names or (csv path,), csv path or None)."""
         if isinstance(record, str):
-            if not (self.base / record).is_file():
-                raise ScenarioError(self.file, field, f"detection log {self.base / record} not found")
+            user_file(self.base / record, "detection log", self.file, field)
             return (record,), record
         for n in record:
             if n not in self.spec.timelines:
@@ -412,9 +412,10 @@ class ObjectTask(Task):
 
 def read_log(path: Path) -> pd.DataFrame:
     """A detection log CSV: class, x, y, hour, robot_x, robot_y (day and place optional)."""
+    text = read_user_text(path, "detection log")
     try:
-        df = pd.read_csv(path)
-    except (pd.errors.ParserError, UnicodeDecodeError, pd.errors.EmptyDataError) as exc:
+        df = pd.read_csv(io.StringIO(text))
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
         raise ScenarioError(str(path), "", f"not a readable CSV: {exc}") from None
     need = {"class", "x", "y", "hour", "robot_x", "robot_y"}
     if not need <= set(df.columns):

@@ -26,6 +26,7 @@ import cv2
 import numpy as np
 
 from ..errors import ScenarioError
+from ..files import user_file
 from ..geometry import GridFrame
 from .files import map_image, scenario_dict, write_building
 from ..config import parse_scenario
@@ -61,8 +62,7 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
                density_delta: float = 2.5, corridor_types=CORRIDOR_TYPES) -> tuple[Path, list[str]]:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path
     and what happened to the signs (also in the YAML's header)."""
-    if not xml_path.is_file():
-        raise ScenarioError(str(xml_path), "", "KTH floor-plan file not found")
+    user_file(xml_path, "KTH floor-plan file")
     try:
         root = ET.parse(xml_path).getroot()
     except ET.ParseError as exc:

@@ -16,6 +16,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import ScenarioError
+from ..files import read_user_text
 from ..geometry import GridFrame
 from ..kernels.grid import dijkstra
 from .files import map_image, scenario_dict, write_building
@@ -25,10 +26,8 @@ MARGIN_M = 1.0
 
 def read_mobilesim_lines(path: Path) -> np.ndarray:
     """(n, 4) float64 wall segments in metres."""
-    if not path.is_file():
-        raise ScenarioError(str(path), "", "MobileSim map not found")
     segs, inside = [], False
-    for k, line in enumerate(path.read_text(errors="replace").splitlines()):
+    for k, line in enumerate(read_user_text(path, "MobileSim map").splitlines()):
         s = line.strip()
         if s == "LINES":
             inside = True
@@ -48,10 +47,8 @@ def read_mobilesim_lines(path: Path) -> np.ndarray:
 
 def read_mobilesim_doors(path: Path) -> list[tuple]:
     """Signs ``(label, x, y, facing_deg)`` from a ``.doors`` file."""
-    if not path.is_file():
-        raise ScenarioError(str(path), "", "door file not found")
     out = []
-    for k, line in enumerate(path.read_text().splitlines()):
+    for k, line in enumerate(read_user_text(path, "door file").splitlines()):
         parts = line.split()
         if not parts:
             continue

@@ -172,8 +172,10 @@ def read_rooms(path: Path, target: str, secondary: list[str]) -> list[Room]:
         raise ScenarioError(str(path), "rooms", "expected a list of rooms")
     try:
         w, h = (float(v) for v in data.get("size", (6.0, 6.0)))
+        if not (1.0 <= w <= 50.0 and 1.0 <= h <= 50.0):  # NaN fails too
+            raise ValueError
     except (TypeError, ValueError):
-        raise ScenarioError(str(path), "size", "expected [width, depth] in metres") from None
+        raise ScenarioError(str(path), "size", "expected [width, depth] in metres, each 1 to 50") from None
     rooms = []
     for k, d in enumerate(data["rooms"]):
         where = f"rooms[{k}]"

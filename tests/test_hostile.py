@@ -1,0 +1,48 @@
+"""Every defect of issue 14 as a case of the hostile-input catalogue (tests/hostile_inputs.py),
+run in-process: a refused input exits 2 with one paragraph naming the file and the field (or the
+flag) and no traceback; an accepted one exits 0; nothing is written into the working folder.
+``benchmarks/hostile.py`` runs the whole catalogue as real processes."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from semsearch_cli.cli import app
+
+from .hostile_inputs import build_cases
+
+_TMP = tempfile.TemporaryDirectory(prefix="semsearch-hostile-")
+CASES = [c for c in build_cases(Path(_TMP.name) / "cases") if c.issue]
+runner = CliRunner()
+
+
+def test_the_catalogue_holds_every_group_of_the_issue():
+    assert {c.category for c in CASES} == {"numbers", "files", "structure", "output", "markup", "command line", "resources"}
+    assert len(CASES) >= 80
+
+
+@pytest.mark.parametrize("case", CASES, ids=[f"{c.category}: {c.name}" for c in CASES])
+def test_hostile_input(case, tmp_path):
+    os.chdir(tmp_path)  # the working folder: nothing may be written here
+    try:
+        res = runner.invoke(app, case.args)
+    finally:
+        os.chdir(Path(__file__).resolve().parents[1])
+    assert res.exception is None or isinstance(res.exception, SystemExit), f"{type(res.exception).__name__}: {res.exception}"
+    text = " ".join(res.output.split())
+    assert "Traceback" not in text
+    if case.expect == "refuse":
+        assert res.exit_code == 2, text
+        assert "error" in text.lower() or "invalid value" in text.lower(), text
+    elif case.expect == "accept":
+        assert res.exit_code == 0, text
+    else:
+        assert res.exit_code in (0, 2), text
+    for s in case.says:
+        assert s in text, f"{s!r} not in: {text}"
+    assert list(tmp_path.iterdir()) == [] or case.expect == "accept", sorted(p.name for p in tmp_path.iterdir())
