@@ -4,8 +4,10 @@ never read as console markup (issue 14)."""
 
 import fcntl
 import os
+import signal
 import subprocess
 import sys
+import time
 
 import pandas as pd
 import pytest
@@ -15,7 +17,7 @@ from typer.testing import CliRunner
 from semsearch_cli import api
 from semsearch_cli.cli import app
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.runner import Loaded, expand, folder_lock, read_runs, run_batch
+from semsearch_cli.runner import Loaded, ProcessExecutor, expand, folder_lock, read_runs, run_batch
 
 runner = CliRunner()
 
@@ -128,3 +130,56 @@ def test_user_text_is_not_console_markup(demo_dir, tmp_path):
     p = demo_copy(demo_dir, tmp_path, "[a].yaml", name="x[/a]")
     r = runner.invoke(app, ["validate", str(p)])
     assert r.exit_code == 2 and "[a].yaml" in r.output
+
+
+def test_the_run_list_is_computed_not_stored(demo_loaded):
+    specs = expand(demo_loaded, 10**6)
+    assert len(specs) == 2 * 2 * 10**6  # goals x planners x seeds, with no list behind it
+    assert specs[-1].key == (specs.variants[-1].label, str(specs.goals[-1]), 10**6 - 1)
+    assert list(specs[:3]) == [next(iter(specs)), specs[1], specs[2]]
+    assert specs.has_key(specs[123457].key) and not specs.has_key(("greedy", "304", 10**6))
+
+
+def test_workers_are_handed_runs_as_they_free_up(demo_loaded, tmp_path):
+    pulled = []
+
+    def stream():
+        for s in expand(demo_loaded, 50):
+            pulled.append(s)
+            yield s
+
+    rows = ProcessExecutor(2).rows(demo_loaded, stream(), tmp_path, False)
+    next(rows)
+    assert len(pulled) <= 2 * 2 + 1  # a few runs per worker ahead, not the 200 of the batch
+    rows.close()  # stops the workers
+
+
+def test_progress_is_printed_as_lines_off_a_terminal(demo_dir, tmp_path):
+    child = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "run",
+                            str(demo_dir / "scenario.yaml"), "--seeds", "2", "--workers", "1", "--out", str(tmp_path / "o")],
+                           capture_output=True, text=True, timeout=300)
+    assert child.returncode == 0, child.stderr
+    lines = [ln for ln in child.stderr.splitlines() if ln.startswith("runs: ")]
+    assert lines and lines[-1].startswith("runs: 8 of 8 done"), child.stderr  # 2 goals x 2 planners x 2 seeds, counted to the end
+    assert "\r" not in child.stderr and "\x1b[" not in child.stderr  # no bar drawn into a log
+
+
+def test_ctrl_c_stops_the_batch_keeps_its_rows_and_says_how_to_resume(demo_dir, tmp_path):
+    out = tmp_path / "o"
+    cmd = [sys.executable, "-c", "from semsearch_cli.cli import main; main()", "run", str(demo_dir / "scenario.yaml"),
+           "--seeds", "100", "--workers", "2", "--out", str(out)]
+    child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and (not (out / "runs.csv").is_file() or len(read_runs(out / "runs.csv")) < 3):
+        time.sleep(0.1)
+    os.killpg(child.pid, signal.SIGINT)  # as Ctrl-C does: to the whole process group, workers too
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == 130, err
+    assert "interrupted" in err and "run the same command again to resume" in err and "Traceback" not in err
+    kept = read_runs(out / "runs.csv")
+    assert 3 <= len(kept) < 400
+    # resuming reuses every finished run: with fewer seeds, only the missing ones of those run
+    res = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, out=out, plots=False)
+    first = {(p, str(g), s) for p, g, s in zip(kept["planner"], kept["goal"], kept["seed"])}
+    assert len(res.runs) == len(kept) + len({(p, str(g), s) for p in ("greedy", "bvp") for g in (304, 452) for s in (0, 1)} - first)
