@@ -81,11 +81,13 @@ def main() -> int:
         warnings=("warned", "sum"),
         garbage_accepted=("defect", lambda s: int((s & (df.loc[s.index, "outcome"] == "accepted")).sum())),
         wrongly_refused=("defect", lambda s: int((s & (df.loc[s.index, "outcome"] == "refused")).sum()))).reset_index()
-    total = table.drop(columns="category").sum().to_frame().T.assign(category="all")[table.columns]
+    counts = table.columns.drop("category")
+    table[counts] = table[counts].astype(int)
+    total = pd.DataFrame([{"category": "all", **{c: int(table[c].sum()) for c in counts}}])
     table = pd.concat([table, total], ignore_index=True)
     bad = df[df["defect"]]
     text = [f"{len(df)} hostile inputs in {wall:.0f} s ({a.jobs} at a time, time limit {a.timeout:g} s each)", "",
-            markdown_table(table), ""]
+            markdown_table(table, fmt="{:g}"), ""]
     if len(bad):
         text += ["Defects:", "", markdown_table(bad[["category", "case", "expect", "outcome", "message"]]), ""]
     if stray:

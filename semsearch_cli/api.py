@@ -95,7 +95,7 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
     for f in folders:
         if not (Path(f) / "runs.csv").is_file():
             raise ScenarioError(str(f), "", "no runs.csv here: give a folder written by `semsearch run`")
-    return report_build.build_report([Path(f) for f in folders], Path(out) if out else None, formats, replay)
+    return report_build.build_report([Path(f) for f in folders], output_folder(out) if out is not None else None, formats, replay)
 
 
 def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
