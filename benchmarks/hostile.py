@@ -14,6 +14,8 @@ where it should be accepted is ``wrongly refused``. Exits 1 when any case is a d
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -35,12 +37,17 @@ CLI = [sys.executable, "-c", "from semsearch_cli.cli import main; main()"]
 
 def run_case(case, timeout: float, cwd: Path) -> dict:
     t0 = time.perf_counter()
+    # a session of its own, so that a hang is killed with every process it started
+    p = subprocess.Popen(CLI + case.args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd, errors="replace",
+                         start_new_session=True)
     try:
-        p = subprocess.run(CLI + case.args, capture_output=True, text=True, timeout=timeout, cwd=cwd, errors="replace")
-        status, err = p.returncode, p.stderr
+        _, err = p.communicate(timeout=timeout)
+        status = p.returncode
         outcome = ("traceback" if "Traceback (most recent call last)" in err else
                    "refused" if status == 2 else "accepted" if status == 0 else "other")
     except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.communicate()
         status, err, outcome = None, "", "hang"
     defect = outcome in ("traceback", "other", "hang") or (case.expect == "refuse" and outcome == "accepted") \
         or (case.expect == "accept" and outcome == "refused")

@@ -16,7 +16,7 @@ from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import Loaded, check_folder, expand, folder_lock, run_batch, run_rows
+from .runner import EXECUTORS, Loaded, check_folder, expand, folder_lock, run_batch, run_rows
 from .tasks.objects import write_log
 from .files import output_file, output_folder, temp_path
 
@@ -52,18 +52,36 @@ def workers_for(workers: int | None, oversubscribe: bool = False) -> int:
     return workers
 
 
+def check_executor(executor: str, scheduler: str | None, workers: int | None, oversubscribe: bool) -> int:
+    """The worker count for a batch on ``executor``; a :class:`ScenarioError` for an unknown
+    executor or a scheduler given to the process pool. With a scheduler, the cluster's own
+    workers run the batch and ``workers`` is not checked."""
+    if executor not in EXECUTORS:
+        raise ScenarioError("<command line>", "--executor", f"unknown executor {executor!r}; valid: {', '.join(EXECUTORS)}")
+    if scheduler is not None and executor != "dask":
+        raise ScenarioError("<command line>", "--scheduler", "a scheduler address goes with --executor dask")
+    if scheduler is not None and not scheduler.strip():
+        raise ScenarioError("<command line>", "--scheduler", "an empty address; give tcp://HOST:PORT")
+    if scheduler:
+        return workers or 1
+    return workers_for(workers, oversubscribe)
+
+
 def run(scenario: str | Path, seeds: int | None = None, workers: int | None = None, goals=None,
         planners=None, out: str | Path | None = None, progress=None, plots: bool = True,
-        trace: bool = False, planner_specs=None, force: bool = False, oversubscribe: bool = False) -> RunOutput:
+        trace: bool = False, planner_specs=None, force: bool = False, oversubscribe: bool = False,
+        executor: str = "processes", scheduler: str | None = None) -> RunOutput:
     """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/.
 
     ``planner_specs`` (a list of :class:`~semsearch_cli.config.PlannerSpec`) replaces the
     scenario's planners; ``trace`` writes each run's decisions to traces/<run>.jsonl. The
     output folder is locked for the command; rows of another (or an edited) scenario in it are
     refused unless ``force`` (see :func:`~semsearch_cli.runner.run_batch`). ``workers`` is
-    checked by :func:`workers_for`.
+    checked by :func:`workers_for`. ``executor`` (``processes`` or ``dask``) and ``scheduler``
+    (a Dask scheduler's address; without one, a local cluster of ``workers``) say where the runs
+    run (see :func:`~semsearch_cli.runner.make_executor`).
     """
-    workers = workers_for(workers, oversubscribe)
+    workers = check_executor(executor, scheduler, workers, oversubscribe)
     loaded = Loaded.load(Path(scenario))
     if planner_specs is not None:
         loaded = loaded.with_planners(planner_specs)
@@ -80,7 +98,7 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
         check_folder(loaded, out_dir, force)
         report_build.write_meta(out_dir, loaded.path)
         loaded.task.write_inputs(out_dir)
-        runs = run_batch(loaded, specs, out_dir, workers, progress, trace)
+        runs = run_batch(loaded, specs, out_dir, workers, progress, trace, executor=executor, scheduler=scheduler)
         summary = write_summary(runs, out_dir)
         if plots:
             report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
@@ -100,7 +118,7 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
 
 def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
                 goals=None, out: str | Path | None = None, progress=None, trace: bool = False, force: bool = False,
-                oversubscribe: bool = False) -> RunOutput:
+                oversubscribe: bool = False, executor: str = "processes", scheduler: str | None = None) -> RunOutput:
     """nsos at each alpha with greedy beside it: the rows and summary of :func:`run`, plus
     ``plots/alpha_sweep.png``. Other nsos parameters come from the scenario's first nsos entry."""
     sc = load_scenario(scenario)
@@ -108,7 +126,7 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = N
     base.pop("alpha", None)
     specs = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[float(a) for a in alphas], **base)]
     res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs, force=force,
-              oversubscribe=oversubscribe)
+              oversubscribe=oversubscribe, executor=executor, scheduler=scheduler)
     labels = {v.label for v in expand_variants(specs, str(scenario))}
     (res.out / "plots").mkdir(parents=True, exist_ok=True)
     plot_alpha_sweep(run_rows(res.runs)[run_rows(res.runs)["planner"].isin(labels)], res.out / "plots" / "alpha_sweep.png")
@@ -139,12 +157,13 @@ def parse_param(text: str) -> tuple[str, list]:
 
 def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = None, workers: int | None = None,
           goals=None, planners=None, out: str | Path | None = None, progress=None, trace: bool = False,
-          force: bool = False, oversubscribe: bool = False) -> SweepOutput:
+          force: bool = False, oversubscribe: bool = False, executor: str = "processes",
+          scheduler: str | None = None) -> SweepOutput:
     """Run a scenario once per value of one parameter (see
     :func:`~semsearch_cli.config.with_param`): each value's rows go to ``out/<param>=<value>/``
     (resumable, as :func:`run`), then ``sweep.csv``, ``sweep.md`` and ``sweep.png`` compare them.
     Every value is checked before anything runs."""
-    workers = workers_for(workers, oversubscribe)
+    workers = check_executor(executor, scheduler, workers, oversubscribe)
     path = Path(scenario)
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
@@ -161,7 +180,8 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
             with folder_lock(sub):
                 report_build.write_meta(sub, ld.path)
                 ld.task.write_inputs(sub)
-                runs = run_batch(ld, specs, sub, workers, progress, trace, force=force)
+                runs = run_batch(ld, specs, sub, workers, progress, trace, force=force, executor=executor,
+                                 scheduler=scheduler)
                 write_summary(runs, sub)
             frames.append(run_rows(runs).assign(value=v))
         runs = pd.concat(frames, ignore_index=True)

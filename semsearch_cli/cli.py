@@ -83,12 +83,14 @@ def run(
     trace: bool = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
     oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
+    executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
 ):
     """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
     _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir, progress=tick, trace=trace,
-                                force=force, oversubscribe=oversubscribe))
+                                force=force, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler))
 
 
 @app.command("sweep-alpha")
@@ -102,6 +104,8 @@ def sweep_alpha(
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
     oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
+    executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
 ):
     """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
     plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
@@ -113,7 +117,7 @@ def sweep_alpha(
     if not values or any(not 0.0 <= a <= 1.0 for a in values):
         _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
     res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal, "--goal"), out_dir, progress=tick, trace=trace,
-                                                     force=force, oversubscribe=oversubscribe))
+                                                     force=force, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler))
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
 
@@ -130,6 +134,8 @@ def sweep(
     trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
     force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
     oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
+    executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
 ):
     """Run a scenario once per value of one parameter: each value's rows in <out>/<param>=<value>/
     (resumable), then sweep.csv, sweep.md and sweep.png (mean ratio to the shortest path and success
@@ -140,7 +146,7 @@ def sweep(
     except ScenarioError as exc:
         _fail(exc)
     res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir,
-                                                progress=tick, trace=trace, force=force, oversubscribe=oversubscribe))
+                                                progress=tick, trace=trace, force=force, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
     out.print(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv")

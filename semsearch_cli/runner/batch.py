@@ -37,10 +37,14 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False) -> pd.DataFrame
 
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,
               progress: Callable[[dict, int, int], None] | None = None, trace: bool = False,
-              start_method: str | None = None, force: bool = False) -> pd.DataFrame:
+              start_method: str | None = None, force: bool = False, executor: str = "processes",
+              scheduler: str | None = None) -> pd.DataFrame:
     """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
     With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
-    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`). ``progress(row,
+    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`); ``executor`` is
+    ``processes`` or ``dask`` (on the scheduler at ``scheduler``, or a local cluster of
+    ``workers``), see :func:`make_executor`: rows do not depend on it, and a batch started on one
+    resumes on another. ``progress(row,
     done, total)`` is called as each run finishes, with the runs finished so far and the runs
     this batch has to do. The specs are streamed to the executor, never listed whole (a
     :class:`~semsearch_cli.runner.specs.RunList` of any length costs no memory).
@@ -57,11 +61,14 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
-        executor = make_executor(min(workers, total), start_method) if total > 1 else SerialExecutor()
+        if total == 0 or (executor == "processes" and total == 1):
+            runner = SerialExecutor()
+        else:
+            runner = make_executor(max(1, min(workers, total)), start_method, executor, scheduler)
         writer = RowWriter(runs_csv)
         n = 0
         try:
-            for rows in executor.rows(loaded, todo, out, trace):
+            for rows in runner.rows(loaded, todo, out, trace):
                 for r in rows:
                     r["fingerprint"] = fp
                 writer.write(rows)

@@ -15,6 +15,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
+from ..errors import ScenarioError
 from ..tasks import RunResult
 from .specs import Loaded, RunSpec
 from .store import save_run_files
@@ -101,6 +102,22 @@ class ProcessExecutor:
         pool.shutdown()
 
 
-def make_executor(workers: int, start_method: str | None = None):
-    """The process pool for more than one worker, else the serial executor."""
+EXECUTORS = ("processes", "dask")
+
+
+def make_executor(workers: int, start_method: str | None = None, kind: str = "processes", address: str | None = None,
+                  chunk: int = 4):
+    """An executor: ``processes`` (the default) is a process pool for more than one worker, else
+    the serial executor; ``dask`` runs on the Dask scheduler at ``address``, or on a local
+    cluster of ``workers`` processes (see :class:`~semsearch_cli.runner.cluster.DaskExecutor`)."""
+    if kind == "dask":
+        # distributed is an optional dependency (pip install 'semsearch[dask]'): imported only when asked for
+        try:
+            from .cluster import DaskExecutor
+        except ImportError:
+            raise ScenarioError("<command line>", "--executor", "dask needs the distributed package: "
+                                "pip install 'semsearch[dask]'") from None
+        return DaskExecutor(workers, address, chunk)
+    if kind != "processes":
+        raise ScenarioError("<command line>", "--executor", f"unknown executor {kind!r}; valid: {', '.join(EXECUTORS)}")
     return ProcessExecutor(workers, start_method) if workers > 1 else SerialExecutor()

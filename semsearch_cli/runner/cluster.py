@@ -1,0 +1,80 @@
+"""The Dask executor: runs on a Dask cluster (the ``distributed`` package), a lab's machines or a
+SLURM allocation through dask-jobqueue, or a local cluster started for the batch.
+
+The loaded scenario is scattered to every worker once (``broadcast``), and runs travel in chunks
+of a few, so that scheduling costs little next to a run. Workers send back each run's rows and
+its path; the client (this process) writes the path files and appends the rows to runs.csv as
+chunks finish, exactly as with the process pool, so the output folder needs no file system shared
+with the workers. A worker that dies loses nothing: the scheduler re-runs its chunks elsewhere,
+and a chunk's rows are written only when it comes back, so each run lands in runs.csv once.
+"""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+from typing import Iterable, Iterator
+
+from distributed import Client, LocalCluster, as_completed
+
+from .executors import execute
+from .specs import Loaded, RunSpec
+from .store import save_run_files
+
+
+def _run_chunk(loaded: Loaded, specs: list[RunSpec], trace: bool) -> list[tuple]:
+    """On a worker: (spec stem, rows, result) of each run of a chunk."""
+    out = []
+    for spec in specs:
+        rows, res = execute(loaded, spec, trace)
+        out.append((spec.stem, rows, res))
+    return out
+
+
+class DaskExecutor:
+    """Runs on the Dask scheduler at ``address`` (``tcp://HOST:PORT``), or, without one, on a
+    local cluster of ``workers`` single-threaded worker processes started for the batch.
+    ``chunk`` runs travel together; at most two chunks per worker thread are in flight, so the
+    list of runs is streamed, never held whole."""
+
+    def __init__(self, workers: int = 2, address: str | None = None, chunk: int = 4):
+        self.workers, self.address, self.chunk = workers, address, max(1, int(chunk))
+
+    def _client(self):
+        if self.address:
+            return Client(self.address, set_as_default=False), None
+        cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=40)
+        return Client(cluster, set_as_default=False), cluster
+
+    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+        client, cluster = self._client()
+        pending = as_completed(loop=client.loop)
+        try:
+            shared = client.scatter(loaded, broadcast=True)  # once per worker, not with every run
+            specs = iter(specs)
+            ahead = 2 * max(1, sum(client.nthreads().values()))
+
+            def submit(n: int):
+                for _ in range(n):
+                    part = list(itertools.islice(specs, self.chunk))
+                    if not part:
+                        return
+                    pending.add(client.submit(_run_chunk, shared, part, trace, pure=False))
+
+            submit(ahead)
+            for fut in pending:
+                done = fut.result()
+                fut.release()
+                submit(1)
+                for stem, rows, res in done:
+                    if res.outcome != "error":
+                        save_run_files(out, stem, res)
+                    yield rows
+        except BaseException:
+            client.cancel(list(pending.futures))
+            raise
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()

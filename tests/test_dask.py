@@ -1,0 +1,102 @@
+"""The Dask executor on a real cluster on this machine: a `dask scheduler` and two `dask worker`
+processes on 127.0.0.1. Rows match the process pool's (wall time aside), a worker killed with
+SIGKILL mid-batch loses no run and duplicates none, and a batch resumes across executors."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from semsearch_cli import api
+from semsearch_cli.runner import read_runs
+
+distributed = pytest.importorskip("distributed")
+
+DASK = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
+SAME = ["kind", "scenario", "planner", "params", "goal", "seed", "outcome", "success", "distance_m", "shortest_m", "ratio",
+        "spl", "steps", "decisions", "navigator", "message", "fingerprint"]  # every column but wall_s
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    """(scheduler address, {pid: worker process}) of a scheduler and two single-threaded workers."""
+    d = tmp_path_factory.mktemp("dask")
+    file = d / "scheduler.json"
+    env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
+    procs = [subprocess.Popen(DASK + ["--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(file), "--no-dashboard"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=d)]
+    deadline = time.monotonic() + 60
+    while not file.is_file() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    address = json.loads(file.read_text())["address"]
+    workers = {}
+    for k in range(2):
+        p = subprocess.Popen(WORKER + ["--scheduler-file", str(file), "--nthreads", "1", "--no-nanny", "--host", "127.0.0.1",
+                                       "--no-dashboard", "--name", f"w{k}"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=d)
+        procs.append(p)
+        workers[p.pid] = p
+    with distributed.Client(address, set_as_default=False, timeout=60) as c:
+        c.wait_for_workers(2, timeout=60)
+    yield address, workers
+    for p in procs:
+        p.kill()
+        p.wait()
+
+
+def _rows(folder: Path) -> pd.DataFrame:
+    df = read_runs(folder / "runs.csv")[SAME]
+    return df.sort_values(["planner", "goal", "seed"]).reset_index(drop=True)
+
+
+def test_rows_on_the_cluster_match_the_process_pool(cluster, demo_dir, tmp_path):
+    address, _ = cluster
+    pool = api.run(demo_dir / "scenario.yaml", seeds=3, workers=2, out=tmp_path / "pool", plots=False)
+    dask = api.run(demo_dir / "scenario.yaml", seeds=3, out=tmp_path / "dask", plots=False, executor="dask", scheduler=address)
+    assert len(pool.runs) == len(dask.runs) == 12
+    pd.testing.assert_frame_equal(_rows(tmp_path / "pool"), _rows(tmp_path / "dask"))
+    assert len(list((tmp_path / "dask" / "paths").glob("*.npz"))) == 12  # written by the client: no shared folder needed
+
+
+def test_a_worker_killed_mid_batch_loses_and_duplicates_no_run(cluster, demo_dir, tmp_path):
+    address, workers = cluster
+    victim = next(iter(workers.values()))
+    killed = []
+
+    def tick(row, done, total):
+        if done == 3 and not killed:
+            os.kill(victim.pid, signal.SIGKILL)  # mid-batch: the other chunks of that worker are lost with it
+            killed.append(done)
+
+    res = api.run(demo_dir / "scenario.yaml", seeds=10, out=tmp_path / "o", plots=False, executor="dask", scheduler=address,
+                  progress=tick)
+    assert killed and victim.wait(timeout=10) == -signal.SIGKILL
+    runs = read_runs(tmp_path / "o" / "runs.csv")
+    keys = list(zip(runs["planner"], runs["goal"].astype(str), runs["seed"]))
+    assert len(runs) == len(res.runs) == 40 and len(set(keys)) == 40  # every run exactly once
+    pool = api.run(demo_dir / "scenario.yaml", seeds=10, workers=2, out=tmp_path / "pool", plots=False)
+    pd.testing.assert_frame_equal(_rows(tmp_path / "o"), _rows(tmp_path / "pool"))
+    assert len(pool.runs) == 40
+
+
+def test_a_batch_resumes_across_executors(demo_dir, tmp_path):
+    out = tmp_path / "o"
+    api.run(demo_dir / "scenario.yaml", seeds=1, workers=2, out=out, plots=False)  # the process pool starts it
+    shutil.copy(out / "runs.csv", tmp_path / "first.csv")
+    res = api.run(demo_dir / "scenario.yaml", seeds=2, workers=2, out=out, plots=False, executor="dask")  # a local cluster ends it
+    assert len(res.runs) == 8
+    first = pd.read_csv(tmp_path / "first.csv")
+    assert res.runs.head(len(first))["wall_s"].tolist() == first["wall_s"].tolist()  # the first rows were kept, not re-run
+    whole = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, out=tmp_path / "one", plots=False)
+    pd.testing.assert_frame_equal(_rows(out), _rows(tmp_path / "one"))
+    assert len(whole.runs) == 8
