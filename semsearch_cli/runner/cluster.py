@@ -15,6 +15,7 @@ import itertools
 from pathlib import Path
 from typing import Iterable, Iterator
 
+import dask
 from distributed import Client, LocalCluster, as_completed
 
 from .executors import execute
@@ -43,8 +44,12 @@ class DaskExecutor:
     def _client(self):
         if self.address:
             return Client(self.address, set_as_default=False), None
-        cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                               silence_logs=40)
+        # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which fixes glibc's mmap threshold
+        # so that every grid-sized temporary is mapped and unmapped: runs took 1.45x as long (28.3 s vs
+        # 19.6 s of run time for 40 Hotel runs). Unset here; README "Running on a cluster" for your own.
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                   silence_logs=50)  # CRITICAL: no heartbeat noise when the cluster closes
         return Client(cluster, set_as_default=False), cluster
 
     def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
