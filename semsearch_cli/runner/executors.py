@@ -4,6 +4,8 @@ worker processes that each receive the loaded scenario once."""
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
 import itertools
 import math
 import multiprocessing
@@ -103,6 +105,9 @@ class ProcessExecutor:
 
 
 EXECUTORS = ("processes", "dask")
+# executors on optional dependencies, by name: the module holding each (imported on demand, so
+# that a command that does not use Dask does not pay for importing it) and its class
+OPTIONAL = {"dask": ("semsearch_cli.runner.cluster", "DaskExecutor", "distributed", "dask")}
 
 
 def make_executor(workers: int, start_method: str | None = None, kind: str = "processes", address: str | None = None,
@@ -110,14 +115,12 @@ def make_executor(workers: int, start_method: str | None = None, kind: str = "pr
     """An executor: ``processes`` (the default) is a process pool for more than one worker, else
     the serial executor; ``dask`` runs on the Dask scheduler at ``address``, or on a local
     cluster of ``workers`` processes (see :class:`~semsearch_cli.runner.cluster.DaskExecutor`)."""
-    if kind == "dask":
-        # distributed is an optional dependency (pip install 'semsearch[dask]'): imported only when asked for
-        try:
-            from .cluster import DaskExecutor
-        except ImportError:
-            raise ScenarioError("<command line>", "--executor", "dask needs the distributed package: "
-                                "pip install 'semsearch[dask]'") from None
-        return DaskExecutor(workers, address, chunk)
+    if kind in OPTIONAL:
+        module, cls, package, extra = OPTIONAL[kind]
+        if importlib.util.find_spec(package) is None:
+            raise ScenarioError("<command line>", "--executor", f"{kind} needs the {package} package: "
+                                f"pip install 'semsearch[{extra}]'")
+        return getattr(importlib.import_module(module), cls)(workers, address, chunk)
     if kind != "processes":
         raise ScenarioError("<command line>", "--executor", f"unknown executor {kind!r}; valid: {', '.join(EXECUTORS)}")
     return ProcessExecutor(workers, start_method) if workers > 1 else SerialExecutor()
