@@ -99,7 +99,7 @@ class ProcessExecutor:
                 f.cancel()
             for proc in list((getattr(pool, "_processes", None) or {}).values()):  # no public call stops them (3.14 adds one)
                 proc.terminate()
-            pool.shutdown(wait=False, cancel_futures=True)
+            pool.shutdown(wait=True, cancel_futures=True)  # joins the manager thread: nothing left to wake at exit
             raise
         pool.shutdown()
 
