@@ -343,11 +343,13 @@ def generate_building(
     signs: Optional[int] = typer.Option(None, "--signs", min=1, help="Keep exactly this many signs (doors trimmed at random, numbers kept)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
     name: Optional[str] = typer.Option(None, "--name", help="Scenario name (default LAYOUT-NUMBERING-SEED)."),
+    scale: float = typer.Option(1.0, "--scale", callback=_finite, min=0.5, max=4.0,
+                                help="Stretch the layout this many times in x and y (scale^2 the area), corridors as wide."),
 ):
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
         path = gen_building(layout, numbering, seed, output_folder(out_dir), spacing=spacing, signs=signs,
-                   goals=_split([goals], "--goals") if goals is not None else None, name=name)
+                   goals=_split([goals], "--goals") if goals is not None else None, name=name, scale=scale)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")

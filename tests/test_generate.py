@@ -2,6 +2,7 @@
 
 import csv
 
+import cv2
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -125,3 +126,13 @@ def test_generate_batch_picks_layouts_and_schemes(tmp_path):
     assert (tmp_path / "index.txt").read_text().split() == ["single-corridor-parity-0/scenario.yaml", "single-floor-0/scenario.yaml"]
     r = CliRunner().invoke(app, ["generate", "batch", "--out", str(tmp_path / "x"), "--schemes", "parity"])
     assert r.exit_code == 2 and "--schemes" in r.output and "corridor-parity" in r.output
+
+
+def test_a_scaled_building_is_larger_with_corridors_as_wide(tmp_path):
+    imgs = {}
+    for k in (1.0, 2.0):
+        p = generate_building("single", "odd-even-out", 0, tmp_path / f"x{k:g}", scale=k)
+        imgs[k] = cv2.imread(str(p.parent / "map.png"), cv2.IMREAD_GRAYSCALE) >= 200
+    (h1, w1), (h2, w2) = imgs[1.0].shape, imgs[2.0].shape
+    assert abs(w2 - 2 * w1) <= 2 and abs(h2 - 2 * h1) <= 2
+    assert imgs[1.0][:, w1 // 2].sum() == imgs[2.0][:, w2 // 2].sum() > 0  # the 2 m corridor, as many cells across

@@ -62,6 +62,16 @@ class Plan:
     start: tuple[float, float]  # m
 
 
+def scaled(plan: Plan, k: float) -> Plan:
+    """The plan stretched ``k`` times in x and y (``k**2`` times the area) with its corridors as
+    wide as before: the same building at a larger scale, for costs that should grow with the
+    work and not with the map."""
+    if k == 1.0:
+        return plan
+    m = lambda p: (p[0] * k, p[1] * k)  # noqa: E731
+    return Plan(tuple(Corridor(m(c.a), m(c.b), c.width) for c in plan.corridors), m(plan.size), m(plan.start))
+
+
 def layout(name: str, rng: np.random.Generator) -> Plan:
     """The corridors of a layout; small random variations (lengths, wing positions) per seed."""
     j = lambda s: float(rng.uniform(-s, s))  # noqa: E731  (jitter)
@@ -257,13 +267,14 @@ def corridor_parity(slots: list[Slot], plan: Plan, outward: bool) -> list[int]:
 def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: float = 0.1,
                       spacing: float = 2.5, signs: int | None = None, goals: list | None = None,
                       name: str | None = None, density_delta: float = 2.5, planners: list | None = None,
-                      floor: int = 2) -> Path:
+                      floor: int = 2, scale: float = 1.0) -> Path:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path.
 
-    ``signs`` trims the doors (not the numbers) at random to that count, keeping ``goals``.
+    ``signs`` trims the doors (not the numbers) at random to that count, keeping ``goals``;
+    ``scale`` stretches the layout (see :func:`scaled`), corridors keeping their width.
     """
     rng = np.random.default_rng(seed)
-    plan = layout(layout_name, rng)
+    plan = scaled(layout(layout_name, rng), scale)
     img, frame = rasterise(plan, res)
     slots = door_slots(plan, img, frame, spacing)
     nums = number_slots(slots, plan, scheme, img, frame, rng, floor)
