@@ -135,6 +135,7 @@ class Belief:
         self.skeleton = np.zeros((H, W), bool)
         self.passable = np.zeros((H, W), bool)
         self.skel_band = np.zeros((H, W), bool)
+        self._search_mask = np.zeros((H, W), bool)  # skel_band, plus a search's joins while it runs
         self.cost = np.ones((H, W), np.float32)
         self.search_state = GridSearch((H, W))
         self.version = 0  # bumped whenever passable/cost change
@@ -246,6 +247,7 @@ class Belief:
         g0, g1, g2, g3 = max(0, w0 - 1), min(H, w1 + 1), max(0, w2 - 1), min(W, w3 + 1)
         band = cv2.dilate(self.skeleton[g0:g1, g2:g3].astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
         self.skel_band[win] = band[w0 - g0 : w1 - g0, w2 - g2 : w3 - g2] & self.passable[win]
+        self._search_mask[win] = self.skel_band[win]
         _grow(self.cdirty, (w0, w1 - 1, w2, w3 - 1))
         self.version += 1
         d[:] = (H, -1, W, -1)
@@ -423,20 +425,26 @@ class Belief:
         t_cols = np.asarray(t_cols, np.int64)
         need = n_stop if n_stop > 0 else len(t_rows)
         rad = CONNECT_M / self.frame.res
-        mask = self.skel_band.copy()
-        for tr, tc in zip(t_rows.tolist(), t_cols.tolist()):
-            pr, pc = local_reach(self.passable, tr, tc, rad, False)
-            mask[pr, pc] = True
+        joins = [local_reach(self.passable, tr, tc, rad, False) for tr, tc in zip(t_rows.tolist(), t_cols.tolist())]
         passable = self.passable
         if not passable[r, c]:  # robot squeezed near a wall: let it leave
             passable = passable.copy()
             pr, pc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
             passable[pr, pc] = True
-        pr, pc = local_reach(passable, r, c, rad, False)
-        mask[pr, pc] = True
+        joins.append(local_reach(passable, r, c, rad, False))
+        jr = np.concatenate([j[0] for j in joins])
+        jc = np.concatenate([j[1] for j in joins])
+        # the band with the joins, set in place and undone after (a copy of the band per search cost
+        # as much as the search itself on a large map)
+        mask = self._search_mask
+        mask[jr, jc] = True
         gs = self.search_state
         self._search_key = (r, c, self.version)
-        if gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop) < need:
+        try:
+            settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop)
+        finally:
+            mask[jr, jc] = self.skel_band[jr, jc]
+        if settled < need:
             gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop)
         return gs
 
