@@ -19,7 +19,7 @@ from ..config import DoorSpec, Scenario, read_yaml
 from ..errors import ScenarioError
 from ..files import read_user_text
 from ..geometry import GridFrame
-from ..kernels.grid import dijkstra
+from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from .images import read_gray
 from .ros import read_ros_map
@@ -222,12 +222,14 @@ class World:
         """Ground-truth geodesic (m), with the robot's clearance, from ``cell`` to the nearest cell
         of ``target``, and that cell; (inf, None) when none is reachable."""
         r, c = cell
-        _, length, _ = dijkstra(self.reach, np.ones((1, 1), np.float32), np.array([r]), np.array([c]), target, 1, np.inf)
-        masked = np.where(target, length, np.inf)
-        k = int(np.argmin(masked))
-        if not np.isfinite(masked.flat[k]):
+        tr, tc = np.nonzero(target)  # row-major, as the first nearest target was picked before
+        gs = GridSearch(self.reach.shape)  # read at the targets only: no map-sized result arrays
+        gs.run(self.reach, np.ones((1, 1), np.float32), r, c, tr, tc, 1, np.inf)
+        lengths = gs.lengths(tr, tc)
+        if not lengths.size or not np.isfinite(lengths.min()):
             return float("inf"), None
-        return float(masked.flat[k] * self.frame.res), (k // masked.shape[1], k % masked.shape[1])
+        k = int(np.argmin(lengths))
+        return float(lengths[k] * self.frame.res), (int(tr[k]), int(tc[k]))
 
 
 def build_world(sc: Scenario, base: Path, file: str) -> World | None:
