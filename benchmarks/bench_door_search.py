@@ -162,7 +162,7 @@ def main() -> int:
     tables = {"bvp": [PlannerSpec(name="greedy"), PlannerSpec(name="bvp")],
               "nsos": [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[0.8, 0.9, 1.0])]}
     for key in [t for t in a.tables.split(",") if t in tables]:
-        L.sc = L.sc.model_copy(update={"planners": tables[key]})
+        L = L.with_planners(tables[key])  # the task's own planners (setting L.sc alone left them as they were)
         specs = expand(L, 10)
         t0 = time.perf_counter()
         runs = run_batch(L, specs, tmp / f"table-{key}", workers=2)
