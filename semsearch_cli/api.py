@@ -16,7 +16,7 @@ from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import EXECUTORS, Loaded, check_folder, expand, folder_lock, run_batch, run_rows
+from .runner import Loaded, check_folder, check_kind, expand, folder_lock, run_batch, run_rows
 from .tasks.objects import write_log
 from .files import output_file, output_folder, temp_path
 
@@ -56,8 +56,7 @@ def check_executor(executor: str, scheduler: str | None, workers: int | None, ov
     """The worker count for a batch on ``executor``; a :class:`ScenarioError` for an unknown
     executor or a scheduler given to the process pool. With a scheduler, the cluster's own
     workers run the batch and ``workers`` is not checked."""
-    if executor not in EXECUTORS:
-        raise ScenarioError("<command line>", "--executor", f"unknown executor {executor!r}; valid: {', '.join(EXECUTORS)}")
+    check_kind(executor)
     if scheduler is not None and executor != "dask":
         raise ScenarioError("<command line>", "--scheduler", "a scheduler address goes with --executor dask")
     if scheduler is not None and not scheduler.strip():

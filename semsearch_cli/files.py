@@ -27,13 +27,20 @@ def temp_path(path: Path) -> Path:
 MAX_TEXT_BYTES = 64 * 2**20  # a scenario, doors or log file larger than this is not one
 
 
+def blame(path: Path, what: str, owner: str | None = None) -> tuple[str, str]:
+    """(the file an error about ``path`` names, how its message names ``path``): the file itself,
+    or, with ``owner`` (the scenario that named it), the owner, the message then saying which
+    ``what`` it was."""
+    return (owner, f"{what} {path}") if owner else (str(path), what)
+
+
 def user_file(path: str | Path, what: str, owner: str | None = None, field: str = "") -> Path:
     """``path`` when it is an existing regular file that can be read, else a
     :class:`ScenarioError` that names it: missing, a folder, a device or a pipe (``/dev/zero``),
     or unreadable. The error is the file's own, or, with ``owner`` (the scenario that named it),
     the owner's ``field``."""
     path = Path(path)
-    file, where = (owner, f"{what} {path}") if owner else (str(path), what)
+    file, where = blame(path, what, owner)
     try:
         st = path.stat()
     except (FileNotFoundError, NotADirectoryError):
@@ -55,8 +62,7 @@ def read_user_text(path: str | Path, what: str, owner: str | None = None, field:
     naming it (see :func:`user_file`): too large, or not UTF-8 (UTF-16, Latin-1, binary), with
     the offending byte."""
     path = user_file(path, what, owner, field)
-    file = owner or str(path)
-    where = f"{what} {path}" if owner else what
+    file, where = blame(path, what, owner)
     size = path.stat().st_size
     if size > limit:
         raise ScenarioError(file, field, f"{where} is {size / 2**20:.0f} MB; a text file over {limit // 2**20} MB is not one semsearch reads")

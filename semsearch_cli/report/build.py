@@ -94,12 +94,13 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     folders = [Path(f) for f in folders]
     out = Path(out) if out is not None else folders[0] if len(folders) == 1 else Path("results") / "report"
     parts_by_kind: dict[str, list[Part]] = {}
+    metas = {str(f): read_meta(f) for f in folders}
     total = 0
     for folder in folders:
         runs = read_runs(folder / "runs.csv")
         if runs.empty:
             raise ScenarioError(str(folder / "runs.csv"), "", "no finished runs to report (is this a semsearch results folder?)")
-        meta = read_meta(folder)
+        meta = metas[str(folder)]
         total += len(runs)
         for kind, rows in runs.groupby("kind", sort=False):
             if kind not in SECTIONS:
@@ -120,7 +121,7 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     notes: list[str] = []
     for kind, parts in parts_by_kind.items():
         SECTIONS[kind].section(doc, parts, out, formats, replay, notes)
-    for folder, meta in {str(f): read_meta(f) for f in folders}.items():
+    for folder, meta in metas.items():
         doc.heading(2, f"How {folder} was produced")
         if meta.get("commands"):
             doc.code("\n".join(meta["commands"]))

@@ -2,9 +2,9 @@
 
 from .batch import check_folder, run_batch
 from .lock import folder_lock
-from .executors import EXECUTORS, ProcessExecutor, SerialExecutor, execute, make_executor
+from .executors import EXECUTORS, ProcessExecutor, SerialExecutor, check_kind, execute, make_executor
 from .specs import Loaded, RunSpec, expand, file_stem
 from .store import RowWriter, read_runs, run_rows, save_run_files
 
-__all__ = ["EXECUTORS", "Loaded", "check_folder", "ProcessExecutor", "RowWriter", "RunSpec", "SerialExecutor", "execute", "expand", "file_stem", "folder_lock",
+__all__ = ["EXECUTORS", "Loaded", "check_folder", "check_kind", "ProcessExecutor", "RowWriter", "RunSpec", "SerialExecutor", "execute", "expand", "file_stem", "folder_lock",
            "make_executor", "read_runs", "run_batch", "run_rows", "save_run_files"]

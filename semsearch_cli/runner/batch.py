@@ -44,9 +44,8 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
     ``start_method`` is the worker processes' (see :class:`ProcessExecutor`); ``executor`` is
     ``processes`` or ``dask`` (on the scheduler at ``scheduler``, or a local cluster of
     ``workers``), see :func:`make_executor`: rows do not depend on it, and a batch started on one
-    resumes on another. ``progress(row,
-    done, total)`` is called as each run finishes, with the runs finished so far and the runs
-    this batch has to do. The specs are streamed to the executor, never listed whole (a
+    resumes on another. ``progress(row, done, total)`` is called as each run finishes, with the
+    runs finished so far and the runs this batch has to do. The specs are streamed to the executor, never listed whole (a
     :class:`~semsearch_cli.runner.specs.RunList` of any length costs no memory).
 
     The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's

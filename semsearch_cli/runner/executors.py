@@ -110,17 +110,22 @@ EXECUTORS = ("processes", "dask")
 OPTIONAL = {"dask": ("semsearch_cli.runner.cluster", "DaskExecutor", "distributed", "dask")}
 
 
+def check_kind(kind: str) -> None:
+    """A :class:`ScenarioError` for ``--executor`` unless ``kind`` is one of :data:`EXECUTORS`."""
+    if kind not in EXECUTORS:
+        raise ScenarioError("<command line>", "--executor", f"unknown executor {kind!r}; valid: {', '.join(EXECUTORS)}")
+
+
 def make_executor(workers: int, start_method: str | None = None, kind: str = "processes", address: str | None = None,
                   chunk: int = 4):
     """An executor: ``processes`` (the default) is a process pool for more than one worker, else
     the serial executor; ``dask`` runs on the Dask scheduler at ``address``, or on a local
     cluster of ``workers`` processes (see :class:`~semsearch_cli.runner.cluster.DaskExecutor`)."""
+    check_kind(kind)
     if kind in OPTIONAL:
         module, cls, package, extra = OPTIONAL[kind]
         if importlib.util.find_spec(package) is None:
             raise ScenarioError("<command line>", "--executor", f"{kind} needs the {package} package: "
                                 f"pip install 'semsearch[{extra}]'")
         return getattr(importlib.import_module(module), cls)(workers, address, chunk)
-    if kind != "processes":
-        raise ScenarioError("<command line>", "--executor", f"unknown executor {kind!r}; valid: {', '.join(EXECUTORS)}")
     return ProcessExecutor(workers, start_method) if workers > 1 else SerialExecutor()

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 
 from ..errors import ScenarioError
-from ..files import user_file
+from ..files import blame, user_file
 
 MAX_CELLS = 25_000_000  # 5000 x 5000: the largest map accepted (memory per run, README "Limits")
 MIN_SIDE = 3  # cells: a map narrower than this holds no free cell inside a wall
@@ -32,7 +32,7 @@ def read_gray(path: str | Path, what: str, owner: str | None = None, field: str 
     unreadable file, an image of more than :data:`MAX_CELLS` cells or narrower than
     :data:`MIN_SIDE`, a file no image decoder reads."""
     path = user_file(path, what, owner, field)
-    file, where = (owner, f"{what} {path}") if owner else (str(path), what)
+    file, where = blame(path, what, owner)
     size = _png_size(path)
     if size is not None and size[0] * size[1] > MAX_CELLS:
         raise ScenarioError(file, field, f"{where} is {size[0]} x {size[1]} pixels; at most {MAX_CELLS:,} cells "
