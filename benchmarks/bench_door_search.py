@@ -30,7 +30,6 @@ from semsearch_cli.tasks import build_task
 from semsearch_cli.navigation import GeodesicNavigator, HarmonicNavigator
 from semsearch_cli.planners import Variant
 from semsearch_cli.sensors.devices import DoorCamera, Laser
-from semsearch_cli.kernels.raycast import himm_update
 from semsearch_cli.world.mobilesim import import_mobilesim
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
@@ -42,17 +41,13 @@ def sensing_only(L: Loaded, path: np.ndarray) -> float:
     b = Belief(w.frame, sc.belief, sc.robot.radius)
     laser, cam = Laser(w, sc.laser), DoorCamera(w, sc.door_camera)
     rng = np.random.default_rng(0)
-    bbox = np.empty(4, np.int64)
     t0 = time.perf_counter()
     prev = path[0]
     for x, y in path[1:]:
         heading = float(np.arctan2(y - prev[1], x - prev[0])) if (x, y) != tuple(prev) else 0.0
         prev = (x, y)
         v, u = w.frame.to_cell(x, y)
-        th, d, h = laser.scan(float(v), float(u), heading, rng)
-        bbox[:] = (10**9, -1, 10**9, -1)
-        himm_update(b.cv, b.seen, float(v), float(u), th, d, h, 3, 1, 15, bbox)
-        b.refresh_free(bbox)
+        b.fold_scan(float(v), float(u), *laser.scan(float(v), float(u), heading, rng))
         cam.read(float(x), float(y), heading, rng)
         b.visit(int(np.floor(v)), int(np.floor(u)))
     return time.perf_counter() - t0

@@ -3,7 +3,7 @@ import numpy as np
 from semsearch_cli.belief import Belief
 from semsearch_cli.config import BeliefSpec
 from semsearch_cli.geometry import GridFrame
-from semsearch_cli.kernels.grid import dijkstra, local_reach
+from semsearch_cli.kernels.grid import GridSearch, dijkstra, local_reach
 
 
 def make_belief(free):
@@ -126,3 +126,44 @@ def test_door_lists_count_min_reads_and_follow_segments():
     seg_i, seg_lists = b.segment_door_lists(np.array([30, 30, 30, 0]), np.array([30, 55, 50, 0]))
     assert seg_i.tolist() == [0, 1, 1, -1]
     assert seg_lists == [lists[sj], lists[se]]
+
+
+def test_segments_kept_while_visiting_match_labelling_the_map():
+    # a walk through a grid of corridors and rooms: the union-find segments kept by visit() are
+    # exactly the connected components of each density class (what segment_labels labels)
+    rng = np.random.default_rng(3)
+    free = np.zeros((90, 120), bool)
+    free[10:16, 5:115] = True
+    free[50:58, 5:115] = True
+    free[5:85, 20:26] = True
+    free[5:85, 80:95] = True  # a wide corridor: another density class
+    free[62:80, 40:70] = True  # a room off the lower corridor
+    free[58:62, 50:53] = True
+    b = make_belief(free)
+    rr, cc = np.nonzero(free)
+    for i in rng.choice(len(rr), 60, replace=False):
+        b.visit(int(rr[i]), int(cc[i]))
+    lab = b.segment_labels()
+    vr, vc = np.nonzero(b.visited)
+    seg, _ = b.segment_door_lists(vr, vc)
+    assert (seg >= 0).all()
+    # one segment index per label and one label per segment index
+    pairs = set(zip(seg.tolist(), lab[vr, vc].tolist()))
+    assert len(pairs) == len(set(seg.tolist())) == len(set(lab[vr, vc].tolist())) > 3
+
+
+def test_search_heap_grows_without_changing_the_result():
+    rng = np.random.default_rng(0)
+    p = rng.random((80, 80)) > 0.2
+    p[0, 0] = True
+    cost = (1 + rng.random((80, 80))).astype(np.float32)
+    tr, tc = np.nonzero(p)
+    small, big = GridSearch(p.shape), GridSearch(p.shape)
+    small._hk, small._hi = np.empty(2), np.empty(2, np.int64)  # full at once: grown and searched again
+    assert small.run(p, cost, 0, 0, tr, tc) == big.run(p, cost, 0, 0, tr, tc)
+    assert small._hk.size > 2
+    assert np.array_equal(small.costs(tr, tc), big.costs(tr, tc))
+    assert np.array_equal(small.lengths(tr, tc), big.lengths(tr, tc))
+    far = int(np.argmax(np.where(np.isfinite(big.costs(tr, tc)), big.costs(tr, tc), -1)))
+    assert big.costs(tr, tc)[far] > 50
+    assert np.array_equal(np.stack(small.path(int(tr[far]), int(tc[far]))), np.stack(big.path(int(tr[far]), int(tc[far]))))

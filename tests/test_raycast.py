@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 
-from semsearch_cli.kernels.raycast import cast_ray, cast_rays, himm_update, line_of_sight
+from semsearch_cli.kernels.raycast import cast_ray, cast_rays, fold_free, himm_update, line_of_sight, scan_cells
 
 
 def slow_ray(occ, v0, u0, theta, max_cells, step=1e-4):
@@ -51,16 +51,16 @@ def test_himm_update_exact():
     cv = np.zeros((5, 8), np.uint8)
     cv[2, 3] = 5  # a stale obstacle belief on the beam
     seen = np.zeros((5, 8), bool)
-    bbox = np.array([99, -1, 99, -1])
     th = np.array([0.0])
     d, h = cast_rays(occ, 2.5, 1.5, th, 10.0)
-    himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, bbox)
+    touched = np.zeros(scan_cells(1, 10.0), np.int64)
+    n = himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, touched)
     assert cv[2].tolist() == [0, 0, 0, 4, 0, 0, 3, 0]
     assert seen[2].tolist() == [False, True, True, True, True, True, True, False]
     assert not seen[[0, 1, 3, 4]].any()
-    assert bbox.tolist() == [2, 2, 1, 6]
+    assert touched[:n].tolist() == [2 * 8 + c for c in range(1, 7)]  # flat indices, beam order
     for _ in range(10):  # saturates at cv_max
-        himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, bbox)
+        himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, touched)
     assert cv[2, 6] == 15 and cv[2, 3] == 0
 
 
@@ -70,3 +70,22 @@ def test_line_of_sight_stops_short_of_wall_target():
     assert line_of_sight(occ, 2.5, 0.5, 2.5, 4.0, 0.75)  # sign on the wall face
     occ[2, 2] = True
     assert not line_of_sight(occ, 2.5, 0.5, 2.5, 4.0, 0.75)
+
+
+def test_fold_free_matches_refresh_over_the_box():
+    # a cell freed, a cell made occupied, and one that flips and flips back within the batch:
+    # only the two net changes grow the dirty box, as refresh_free over the scan's box does
+    free = np.zeros((6, 6), bool)
+    seen = np.zeros((6, 6), bool)
+    cv = np.zeros((6, 6), np.uint8)
+    seen[1, 1] = seen[4, 5] = seen[3, 2] = True
+    cv[4, 5] = 7
+    free[3, 2] = True  # seen, cv 0: free already
+    dirty = np.array([6, -1, 6, -1])
+    cells = np.array([1 * 6 + 1, 4 * 6 + 5, 3 * 6 + 2, 1 * 6 + 1])
+    fold_free(free, seen, cv, 3, cells, 4, dirty)
+    assert free[1, 1] and not free[4, 5] and free[3, 2]
+    assert dirty.tolist() == [1, 1, 1, 1]  # (4, 5) was not free and still is not
+    cv[3, 2] = 9
+    fold_free(free, seen, cv, 3, cells, 3, dirty)
+    assert not free[3, 2] and dirty.tolist() == [1, 3, 1, 2]

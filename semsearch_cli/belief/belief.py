@@ -15,8 +15,8 @@ from skimage.morphology import skeletonize
 
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
-from ..kernels.grid import GridSearch, branch_walk, local_reach, segment_flood
-from ..kernels.raycast import mark_viewed
+from ..kernels.grid import GridSearch, branch_walk, local_reach, mark_visited, segment_roots, set_joins
+from ..kernels.raycast import fold_free, himm_update, mark_viewed, scan_cells
 
 CLEARANCE_CAP_M = 1.0
 CONNECT_M = 1.5
@@ -143,9 +143,7 @@ class Belief:
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
-        self._seg_stamp = np.zeros((H, W), np.int64)
-        self._seg_gen = 0
-        self._queue = np.empty(H * W, np.int64)
+        self._seg_parent = np.zeros(H * W, np.int32)  # segments as a union-find forest (see kernels.grid.mark_visited)
         self.vbox = [H, -1, W, -1]
         self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
         self._cands = None
@@ -155,8 +153,21 @@ class Belief:
         self.examined = None  # (H, W) bool: wall faces given up on after a look from close by (lazy)
         self._view_stamp = None  # (H, W) int64: the last pose that counted for each cell
         self._n_views = 0
+        self._touched = np.empty(0, np.int64)  # cells the last scan touched (flat indices)
+        self._joins = np.empty(0, np.int64)  # cells a search added to the skeleton band (flat indices)
 
     # ---- per-step updates -------------------------------------------------------------
+    def fold_scan(self, v: float, u: float, thetas: np.ndarray, dist: np.ndarray, hit: np.ndarray) -> None:
+        """Fold one laser scan from continuous cell position (v, u) into HIMM (``cv``, ``seen``),
+        re-derive ``free`` at the cells it touched and grow the dirty box by those that changed
+        (what :meth:`refresh_free` does over a box, at the touched cells only)."""
+        sp = self.spec
+        need = scan_cells(thetas.shape[0], float(dist.max()) if dist.size else 0.0)
+        if self._touched.shape[0] < need:
+            self._touched = np.empty(need, np.int64)
+        n = himm_update(self.cv, self.seen, v, u, thetas, dist, hit, sp.himm_inc, sp.himm_dec, sp.himm_max, self._touched)
+        fold_free(self.free, self.seen, self.cv, sp.occupied_threshold, self._touched, n, self.dirty)
+
     def refresh_free(self, bbox: np.ndarray) -> None:
         """Re-derive ``free`` inside a scan's bounding box and grow the dirty box by the cells
         whose state changed (so the derived maps are refreshed where the map changed, not
@@ -190,18 +201,10 @@ class Belief:
         back and forth keeps it going back and forth.
         """
         res = self.frame.res
-        vr, vc = local_reach(self.free, r, c, self.spec.visited_radius / res + 1e-6, False)
-        if vr.size == 0:
+        n, *box = mark_visited(self.free, self.visited, self.seg_class, self._seg_parent, r, c, self.spec.visited_radius / res + 1e-6,
+                               self.spec.density_radius / res + 1e-6, res, self.spec.density_delta)
+        if n == 0:
             return
-        new = ~self.visited[vr, vc]
-        if not new.any():
-            return
-        vr, vc = vr[new], vc[new]
-        dr, dc = local_reach(self.free, r, c, self.spec.density_radius / res + 1e-6, True)
-        cls = int(np.floor(dr.shape[0] * res * res / self.spec.density_delta))
-        self.visited[vr, vc] = True
-        self.seg_class[vr, vc] = cls
-        box = (int(vr.min()), int(vr.max()), int(vc.min()), int(vc.max()))
         _grow(self.vbox, box)
         _grow(self.cdirty, box)
         self._seg_labels = None
@@ -425,25 +428,25 @@ class Belief:
         t_cols = np.asarray(t_cols, np.int64)
         need = n_stop if n_stop > 0 else len(t_rows)
         rad = CONNECT_M / self.frame.res
-        joins = [local_reach(self.passable, tr, tc, rad, False) for tr, tc in zip(t_rows.tolist(), t_cols.tolist())]
         passable = self.passable
         if not passable[r, c]:  # robot squeezed near a wall: let it leave
             passable = passable.copy()
             pr, pc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
             passable[pr, pc] = True
-        joins.append(local_reach(passable, r, c, rad, False))
-        jr = np.concatenate([j[0] for j in joins])
-        jc = np.concatenate([j[1] for j in joins])
-        # the band with the joins, set in place and undone after (a copy of the band per search cost
-        # as much as the search itself on a large map)
+        # the band joined to each target and to the robot, set in place and undone after (a copy of
+        # the band per search cost as much as the search itself on a large map)
+        side = 2 * int(np.ceil(rad)) + 1
+        if self._joins.shape[0] < (len(t_rows) + 1) * side * side:
+            self._joins = np.empty((len(t_rows) + 1) * side * side, np.int64)
         mask = self._search_mask
-        mask[jr, jc] = True
+        n = set_joins(self.passable, mask, t_rows, t_cols, rad, self._joins)
+        n += set_joins(passable, mask, np.array([r], np.int64), np.array([c], np.int64), rad, self._joins[n:])
         gs = self.search_state
         self._search_key = (r, c, self.version)
         try:
             settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop)
         finally:
-            mask[jr, jc] = self.skel_band[jr, jc]
+            mask.ravel()[self._joins[:n]] = False
         if settled < need:
             gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop)
         return gs
@@ -476,29 +479,27 @@ class Belief:
     def segment_door_lists(self, rows: np.ndarray, cols: np.ndarray, min_reads: int | None = None):
         """Door lists of the segments of the given visited cells, without labelling the map.
 
-        Each segment is flood-filled once (cost: its size), so this is what planners use at
-        re-plan time. Returns (``seg`` (k,) int64 segment index per cell, -1 when the cell is not
-        visited; ``lists``, one ``{label: (count, x, y)}`` per segment index), as
+        Segments are kept up to date as cells are visited (a union-find forest), so this costs
+        the number of cells and reads, not the segments' size; planners use it at re-plan time.
+        Returns (``seg`` (k,) int64 segment index per cell, in order of first appearance, -1 when
+        the cell is not visited; ``lists``, one ``{label: (count, x, y)}`` per segment index), as
         :meth:`door_lists`.
         """
         min_reads = self.spec.min_reads if min_reads is None else min_reads
         rd = self.reads
-        read_cells = rd.cell[: rd.n]
-        base = self._seg_gen
-        seg = np.full(len(rows), -1, np.int64)
-        lists = []
-        for i, (r, c) in enumerate(zip(rows, cols)):
-            st = int(self._seg_stamp[r, c])
-            if st > base:
-                seg[i] = st - base - 1
+        W = self.visited.shape[1]
+        roots = segment_roots(self._seg_parent, self.visited, np.asarray(rows, np.int64) * W + np.asarray(cols, np.int64))
+        read_roots = segment_roots(self._seg_parent, self.visited, rd.cell[: rd.n])
+        seg = np.full(len(roots), -1, np.int64)
+        lists, index = [], {}
+        for i, root in enumerate(roots.tolist()):
+            if root < 0:
                 continue
-            if not self.visited[r, c]:
-                continue
-            self._seg_gen += 1
-            segment_flood(self.seg_class, self.visited, int(r), int(c), self._seg_stamp, self._seg_gen, self._queue)
-            seg[i] = len(lists)
-            inside = self._seg_stamp.ravel()[read_cells] == self._seg_gen
-            lists.append(rd.lists(np.flatnonzero(inside), min_reads))
+            j = index.get(root)
+            if j is None:
+                j = index[root] = len(lists)
+                lists.append(rd.lists(np.flatnonzero(read_roots == root), min_reads))
+            seg[i] = j
         return seg, lists
 
     def segment_labels(self) -> np.ndarray:

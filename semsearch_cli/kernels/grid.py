@@ -7,7 +7,6 @@ cutting). All distances are in cells unless a name says otherwise.
 
 from __future__ import annotations
 
-import heapq
 import math
 
 import numpy as np
@@ -79,7 +78,140 @@ def local_reach(free, r0, c0, radius, manhattan):
 
 
 @njit(cache=True)
-def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, length, parent, touched, closed, gen):
+def set_joins(passable, mask, rows, cols, radius, out):
+    """Set ``mask`` at the cells of ``passable`` 4-connected to each (rows[i], cols[i]) within
+    ``radius`` cells (see :func:`local_reach`); the flat indices of the cells it set (those not
+    set before) go to ``out``, whose size must be at least len(rows) * (2 ceil(radius) + 1)^2.
+    Returns how many."""
+    W = mask.shape[1]
+    n = 0
+    for i in range(rows.shape[0]):
+        jr, jc = local_reach(passable, rows[i], cols[i], radius, False)
+        for k in range(jr.shape[0]):
+            if not mask[jr[k], jc[k]]:
+                mask[jr[k], jc[k]] = True
+                out[n] = jr[k] * W + jc[k]
+                n += 1
+    return n
+
+
+@njit(cache=True)
+def mark_visited(free, visited, seg_class, seg_parent, r0, c0, radius, density_radius, res, delta):
+    """Mark visited the free cells 4-connected to (r0, c0) within ``radius`` cells (a disk) and
+    give the newly visited ones the density class ``floor(n res^2 / delta)`` (m^2 over delta), n
+    the free cells 4-connected to (r0, c0) within a Manhattan kernel of ``density_radius`` cells
+    (thesis Eqs. 4.1-4.4); cells visited before keep their class.
+
+    Segments (thesis 4.2.2: visited cells 8-connected through cells of one density class) are kept
+    as a union-find forest over flat cell indices in ``seg_parent`` (H * W,) int32: each newly
+    visited cell joins the segments of its visited neighbours of its class (see
+    :func:`segment_roots`). A cell's class never changes, so segments only ever merge.
+
+    Returns (number of cells newly visited, rmin, rmax, cmin, cmax of them).
+    """
+    H, W = free.shape
+    vr, vc = local_reach(free, r0, c0, radius, False)
+    new = np.empty(vr.shape[0], np.int64)
+    n_new = 0
+    for i in range(vr.shape[0]):
+        if not visited[vr[i], vc[i]]:
+            new[n_new] = i
+            n_new += 1
+    if n_new == 0:
+        return 0, 0, -1, 0, -1
+    dr, _ = local_reach(free, r0, c0, density_radius, True)
+    cls = math.floor(dr.shape[0] * res * res / delta)
+    rmin, rmax, cmin, cmax = H, -1, W, -1
+    for j in range(n_new):
+        r = vr[new[j]]
+        c = vc[new[j]]
+        visited[r, c] = True
+        seg_class[r, c] = cls
+        seg_parent[r * W + c] = r * W + c
+        rmin = min(rmin, r)
+        rmax = max(rmax, r)
+        cmin = min(cmin, c)
+        cmax = max(cmax, c)
+    for j in range(n_new):  # each new cell joins the segments of its neighbours of its class
+        r = vr[new[j]]
+        c = vc[new[j]]
+        for k in range(8):
+            nr = r + _DR8[k]
+            nc = c + _DC8[k]
+            if 0 <= nr < H and 0 <= nc < W and visited[nr, nc] and seg_class[nr, nc] == seg_class[r, c]:
+                a = _root(seg_parent, r * W + c)
+                b = _root(seg_parent, nr * W + nc)
+                if a != b:
+                    seg_parent[max(a, b)] = min(a, b)
+    return n_new, rmin, rmax, cmin, cmax
+
+
+@njit(cache=True, inline="always")
+def _root(parent, q):
+    while parent[q] != q:
+        parent[q] = parent[parent[q]]  # path halving
+        q = parent[q]
+    return q
+
+
+@njit(cache=True)
+def segment_roots(seg_parent, visited, cells):
+    """The segment of each flat cell index in ``cells`` (its union-find root, see
+    :func:`mark_visited`), -1 where the cell is not visited."""
+    W = visited.shape[1]
+    out = np.full(cells.shape[0], -1, np.int64)
+    for i in range(cells.shape[0]):
+        q = cells[i]
+        if visited[q // W, q % W]:
+            out[i] = _root(seg_parent, q)
+    return out
+
+
+@njit(cache=True, inline="always")
+def _before(k1, i1, k2, i2):
+    """Heap order: by cost, then by cell index (so that every heap pops cells in one order)."""
+    return k1 < k2 or (k1 == k2 and i1 < i2)
+
+
+@njit(cache=True, inline="always")
+def _heap_push(hk, hi, n, k, i):
+    """Put (k, i) into the binary heap of the first ``n`` entries of (hk, hi)."""
+    j = n
+    while j > 0:
+        p = (j - 1) >> 1
+        if not _before(k, i, hk[p], hi[p]):
+            break
+        hk[j] = hk[p]
+        hi[j] = hi[p]
+        j = p
+    hk[j] = k
+    hi[j] = i
+
+
+@njit(cache=True, inline="always")
+def _heap_drop_top(hk, hi, n):
+    """Remove the top of the heap of ``n`` entries (it then holds n - 1)."""
+    n -= 1
+    k = hk[n]
+    i = hi[n]
+    j = 0
+    while True:
+        ch = 2 * j + 1
+        if ch >= n:
+            break
+        if ch + 1 < n and _before(hk[ch + 1], hi[ch + 1], hk[ch], hi[ch]):
+            ch += 1
+        if not _before(hk[ch], hi[ch], k, i):
+            break
+        hk[j] = hk[ch]
+        hi[j] = hi[ch]
+        j = ch
+    hk[j] = k
+    hi[j] = i
+
+
+@njit(cache=True)
+def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, length, parent, touched, closed, gen, hk, hi):
     """Multi-source Dijkstra on an 8-connected grid with per-cell cost multipliers.
 
     Moving into cell q costs ``step * cost[q]`` with step 1 or sqrt(2); ``cost`` of shape (1, 1)
@@ -87,23 +219,33 @@ def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, lengt
     ``n_stop`` of them are settled (0: never) or the cost exceeds ``max_cost``. The state arrays
     are reused across searches: a value is valid only where its stamp (``touched`` / ``closed``)
     equals ``gen``, so a search costs what it explores, not the grid size.
+
+    The queue is a binary heap in (hk, hi) (cost, cell index), ordered by cost and then by cell
+    index, so ties settle in one fixed order. Returns the number of targets settled, or -1 when
+    the heap is full (the caller grows it and searches again).
     """
     H, W = passable.shape
     uniform = cost.shape[0] == 1
-    heap = [(0.0, np.int64(0))]
-    heap.pop()
-    for i in range(src_r.shape[0]):
-        r = src_r[i]
-        c = src_c[i]
+    cap = hk.shape[0]
+    n = 0
+    for s in range(src_r.shape[0]):
+        r = src_r[s]
+        c = src_c[s]
         if 0 <= r < H and 0 <= c < W and passable[r, c]:
+            if n == cap:
+                return -1
             dist[r, c] = 0.0
             length[r, c] = 0.0
             parent[r, c] = -1
             touched[r, c] = gen
-            heapq.heappush(heap, (0.0, np.int64(r * W + c)))
+            _heap_push(hk, hi, n, 0.0, r * W + c)
+            n += 1
     settled_targets = 0
-    while len(heap) > 0:
-        d, idx = heapq.heappop(heap)
+    while n > 0:
+        d = hk[0]
+        idx = hi[0]
+        _heap_drop_top(hk, hi, n)
+        n -= 1
         r = idx // W
         c = idx - r * W
         if closed[r, c] == gen:
@@ -128,11 +270,14 @@ def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, lengt
                 step = 1.0
             nd = d + (step if uniform else step * cost[nr, nc])
             if touched[nr, nc] != gen or nd < dist[nr, nc]:
+                if n == cap:
+                    return -1
                 touched[nr, nc] = gen
                 dist[nr, nc] = nd
                 length[nr, nc] = length[r, c] + step
                 parent[nr, nc] = idx
-                heapq.heappush(heap, (nd, np.int64(nr * W + nc)))
+                _heap_push(hk, hi, n, nd, nr * W + nc)
+                n += 1
     return settled_targets
 
 
@@ -151,6 +296,8 @@ class GridSearch:
         self.tmark = np.zeros(shape, np.int32)
         self.gen = 0
         self.source = None
+        self._hk = np.empty(4096)  # the search's heap (cost, cell), grown when a search fills it
+        self._hi = np.empty(4096, np.int64)
 
     def run(self, passable, cost, src_r, src_c, t_rows, t_cols, n_stop=0, max_cost=np.inf) -> int:
         """Search from the source cells; returns the number of targets settled."""
@@ -159,8 +306,14 @@ class GridSearch:
         src_r = np.atleast_1d(np.asarray(src_r, np.int64))
         src_c = np.atleast_1d(np.asarray(src_c, np.int64))
         self.source = (tuple(src_r), tuple(src_c))
-        return _dijkstra(passable, cost, src_r, src_c, self.tmark, n_stop, max_cost, self.dist, self.length_,
-                         self.parent, self.touched, self.closed, self.gen)
+        while True:
+            settled = _dijkstra(passable, cost, src_r, src_c, self.tmark, n_stop, max_cost, self.dist, self.length_,
+                                self.parent, self.touched, self.closed, self.gen, self._hk, self._hi)
+            if settled >= 0:
+                return settled
+            self._hk, self._hi = np.empty(2 * self._hk.size), np.empty(2 * self._hi.size, np.int64)
+            self.gen += 1  # search again from scratch with the larger heap
+            self.tmark[t_rows, t_cols] = self.gen
 
     def settled(self, rows, cols) -> np.ndarray:
         return self.closed[rows, cols] == self.gen
@@ -266,36 +419,3 @@ def branch_walk(skel, visited, r0, c0, depth):
     if n == 0:
         return 0.0, 0.0, 0
     return sr / n, sc / n, n
-
-
-@njit(cache=True)
-def segment_flood(seg_class, visited, r0, c0, stamp, gen, queue):
-    """Mark with ``gen`` in ``stamp`` the segment of (r0, c0): the visited cells 8-connected to it
-    through cells of the same density class (thesis 4.2.2). Returns the number of cells marked.
-
-    ``queue`` is scratch space of at least H * W int64 entries.
-    """
-    H, W = seg_class.shape
-    if not visited[r0, c0] or stamp[r0, c0] == gen:
-        return 0
-    k = seg_class[r0, c0]
-    stamp[r0, c0] = gen
-    queue[0] = r0 * W + c0
-    head = 0
-    tail = 1
-    while head < tail:
-        idx = queue[head]
-        head += 1
-        r = idx // W
-        c = idx - r * W
-        for j in range(8):
-            nr = r + _DR8[j]
-            nc = c + _DC8[j]
-            if nr < 0 or nr >= H or nc < 0 or nc >= W:
-                continue
-            if stamp[nr, nc] == gen or not visited[nr, nc] or seg_class[nr, nc] != k:
-                continue
-            stamp[nr, nc] = gen
-            queue[tail] = nr * W + nc
-            tail += 1
-    return tail

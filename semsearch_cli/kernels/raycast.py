@@ -89,21 +89,8 @@ def cast_rays(occ, v0, u0, thetas, max_cells):
     return dist, hit
 
 
-@njit(cache=True, inline="always")
-def _grow(bbox, r, c):
-    """Grow the box (r0, r1, c0, c1), inclusive, to hold cell (r, c)."""
-    if r < bbox[0]:
-        bbox[0] = r
-    if r > bbox[1]:
-        bbox[1] = r
-    if c < bbox[2]:
-        bbox[2] = c
-    if c > bbox[3]:
-        bbox[3] = c
-
-
 @njit(cache=True)
-def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
+def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, touched):
     """Histogramic in-motion mapping update (Borenstein and Koren 1991) for one scan.
 
     Cells a beam passes through before its end lose ``dec`` certainty (not below 0); the cell at
@@ -123,10 +110,18 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
         Beam angles (radians), measured ranges (cells), hit flags.
     inc, dec, cv_max : int
         HIMM increment, decrement and cap.
-    bbox : (4,) int64
-        ``[rmin, rmax, cmin, cmax]`` of touched cells, grown in place.
+    touched : (m,) int64
+        Receives the flat index ``r * W + c`` of each touched cell (a cell may appear more than
+        once); :func:`scan_cells` gives a size that always suffices.
+
+    Returns
+    -------
+    int
+        The number of entries written to ``touched``.
     """
     H, W = cv.shape
+    n = 0
+    m = touched.shape[0]
     for i in range(thetas.shape[0]):
         dv = -math.sin(thetas[i])
         du = math.cos(thetas[i])
@@ -145,7 +140,9 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
                 x = int(cv[r, c]) - dec
                 cv[r, c] = 0 if x < 0 else x
                 seen[r, c] = True
-                _grow(bbox, r, c)
+                if n < m:
+                    touched[n] = r * W + c
+                    n += 1
             if tmr < tmc:
                 t = tmr
                 tmr += tdr
@@ -158,7 +155,38 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, bbox):
             x = int(cv[hr, hc]) + inc
             cv[hr, hc] = cv_max if x > cv_max else x
             seen[hr, hc] = True
-            _grow(bbox, hr, hc)
+            if n < m:
+                touched[n] = hr * W + hc
+                n += 1
+    return n
+
+
+def scan_cells(beams: int, max_cells: float) -> int:
+    """Entries of ``touched`` that :func:`himm_update` can fill for ``beams`` beams of at most
+    ``max_cells`` cells: a beam of length R crosses at most 2 R + 2 cells, plus its end cell."""
+    return beams * (2 * int(math.ceil(max_cells)) + 4)
+
+
+@njit(cache=True)
+def fold_free(free, seen, cv, occupied, cells, n, dirty):
+    """Re-derive ``free = seen & (cv < occupied)`` at the first ``n`` flat indices of ``cells``
+    and grow ``dirty`` ``[rmin, rmax, cmin, cmax]`` (in place) by the cells whose state changed."""
+    W = free.shape[1]
+    for k in range(n):
+        q = cells[k]
+        r = q // W
+        c = q - r * W
+        new = seen[r, c] and cv[r, c] < occupied
+        if new != free[r, c]:
+            free[r, c] = new
+            if r < dirty[0]:
+                dirty[0] = r
+            if r > dirty[1]:
+                dirty[1] = r
+            if c < dirty[2]:
+                dirty[2] = c
+            if c > dirty[3]:
+                dirty[3] = c
 
 
 @njit(cache=True)

@@ -18,7 +18,6 @@ import numpy as np
 from ..belief import Belief
 from ..errors import ScenarioError
 from ..geometry import wrap_angle
-from ..kernels.raycast import himm_update
 from ..navigation import NAVIGATORS
 from ..planners import PlanContext
 from ..planners.doors.greedy import nearest_candidate
@@ -36,25 +35,21 @@ class DoorSensing:
     def __init__(self, task: "DoorTask", goal, rng: np.random.Generator):
         self.task, self.goal, self.rng = task, goal, rng
         self.goal_idx = set(task.world.signs.indices_of(goal))  # more than one under duplicates: any
-        self.bbox = np.empty(4, np.int64)
 
     def sense(self, st: RobotState) -> tuple[bool, bool]:
         """(goal read, a sign reached min_reads)."""
         t, b, fr = self.task, st.belief, self.task.world.frame
         v, u = fr.to_cell(st.x, st.y)
         r, c = int(np.floor(v)), int(np.floor(u))
-        thetas, dist, hit = t.laser.scan(float(v), float(u), st.heading, self.rng)
-        self.bbox[:] = (fr.height, -1, fr.width, -1)
-        spec = t.sc.belief
-        himm_update(b.cv, b.seen, float(v), float(u), thetas, dist, hit, spec.himm_inc, spec.himm_dec, spec.himm_max, self.bbox)
-        b.refresh_free(self.bbox)
+        b.fold_scan(float(v), float(u), *t.laser.scan(float(v), float(u), st.heading, self.rng))
+        min_reads = b.spec.min_reads
         b.views.append((float(v), float(u), st.heading))
         found = event = False
         for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
             st.read_signs.add(i)
             if i in self.goal_idx and label == self.goal:
                 found = True
-            if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == spec.min_reads:
+            if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:
                 event = True
         return found, event
 
