@@ -172,13 +172,16 @@ def fold_free(free, seen, cv, occupied, cells, n, dirty):
     """Re-derive ``free = seen & (cv < occupied)`` at the first ``n`` flat indices of ``cells``
     and grow ``dirty`` ``[rmin, rmax, cmin, cmax]`` (in place) by the cells whose state changed."""
     W = free.shape[1]
+    ff = free.ravel()
+    sf = seen.ravel()
+    cf = cv.ravel()
     for k in range(n):
         q = cells[k]
-        r = q // W
-        c = q - r * W
-        new = seen[r, c] and cv[r, c] < occupied
-        if new != free[r, c]:
-            free[r, c] = new
+        new = sf[q] and cf[q] < occupied
+        if new != ff[q]:
+            ff[q] = new
+            r = q // W
+            c = q - r * W
             if r < dirty[0]:
                 dirty[0] = r
             if r > dirty[1]:

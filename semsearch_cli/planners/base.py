@@ -40,7 +40,11 @@ class NoParams(BaseModel):
 
 @dataclass
 class PlanContext:
-    """What a planner may look at: the belief, the robot pose and history, the goal, the run's RNG."""
+    """What a planner may look at: the belief, the robot pose and history, the goal, the run's RNG.
+
+    ``explain``: whether the caller keeps the numbers behind each choice (``Decision.info``, for
+    traces and recordings); planners may skip tabulating them when it is False.
+    """
 
     belief: Belief
     row: int
@@ -51,6 +55,7 @@ class PlanContext:
     goal: Any
     rng: np.random.Generator
     headings: list = field(default_factory=list)
+    explain: bool = True
 
 
 @dataclass

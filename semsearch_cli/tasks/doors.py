@@ -135,7 +135,8 @@ class DoorSearch(DoorSensing):
                 return "found"
             b.refresh_derived()
             cands = b.candidates()
-        ctx = PlanContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings)
+        ctx = PlanContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
+                          explain=self.keep_trace or self.recorder is not None)
         for _ in range(MAX_RETRIES):
             dec = self.planner.choose(ctx, cands)
             if dec is None:

@@ -124,6 +124,8 @@ class Draft(KeepTarget):
         phi = tau + omega + p.alpha * gamma
         phi[~reach] = -np.inf
         j = pick(phi, D, keep, p.hysteresis, ctx.rng)
+        if not ctx.explain:
+            return Decision(int(cands.rows[j]), int(cands.cols[j]), {"chosen": j})
         xs_w, ys_w = b.frame.to_world(cands.rows, cands.cols)
         info = {"chosen": j, "candidates": [
             {"x": round(float(xs_w[i]), 2), "y": round(float(ys_w[i]), 2), "theta_f_deg": round(float(np.degrees(cands.theta[i])), 1),

@@ -61,11 +61,21 @@ def increasing_direction(numbers: np.ndarray, xs: np.ndarray, ys: np.ndarray) ->
 
 def growing_direction(numbers, xs, ys, goal: int, theta_f: float, w_g: float) -> tuple[float, float, float]:
     """(phi_g, zeta, gamma) of Eqs. 4.9-4.11 for one candidate."""
+    return growing_along(*segment_growth(numbers, xs, ys, goal, w_g), theta_f)
+
+
+def segment_growth(numbers, xs, ys, goal: int, w_g: float) -> tuple[float, float | None]:
+    """(zeta, theta_inc) of a segment's door list: the parts of Eqs. 4.9-4.10 that do not depend
+    on the candidate."""
     numbers = np.asarray(numbers)
     smaller = int((numbers < goal).sum())
     bigger = int((numbers > goal).sum())
     zeta = (smaller - bigger) / max(smaller + bigger, w_g)
-    th = increasing_direction(numbers, np.asarray(xs, float), np.asarray(ys, float))
+    return zeta, increasing_direction(numbers, np.asarray(xs, float), np.asarray(ys, float))
+
+
+def growing_along(zeta: float, th: float | None, theta_f: float) -> tuple[float, float, float]:
+    """(phi_g, zeta, gamma) of Eq. 4.11 for a candidate whose branch points along ``theta_f``."""
     gamma = 0.0 if th is None else 1.0 - 2.0 * abs(float(wrap_angle(theta_f - th))) / math.pi
     return (zeta * gamma + 1.0) / 2.0, zeta, gamma
 
@@ -234,20 +244,22 @@ class NSOS(KeepTarget):
         goal = ctx.goal if isinstance(ctx.goal, (int, np.integer)) else None
         if alpha > 0 and goal is not None:
             seg, lists = b.segment_door_lists(cands.seg_rows, cands.seg_cols, p.min_reads)
-            numeric = []
+            per_seg = []  # (zeta, theta_inc, phi_p) of each segment's numbered signs
             for lst in lists:
                 items = [(lab, x, y) for lab, (_, x, y) in lst.items() if isinstance(lab, (int, np.integer))]
-                numeric.append((np.array([i[0] for i in items], np.int64), np.array([i[1] for i in items]), np.array([i[2] for i in items])))
+                nums = np.array([i[0] for i in items], np.int64)
+                per_seg.append((*segment_growth(nums, [i[1] for i in items], [i[2] for i in items], goal, p.w_g), parity(nums, goal, p.w_p)))
             for i in range(k):
                 if seg[i] < 0:
                     continue
-                nums, xs, ys = numeric[seg[i]]
-                phi_g[i], zeta[i], gamma[i] = growing_direction(nums, xs, ys, goal, cands.theta[i], p.w_g)
-                phi_p[i] = parity(nums, goal, p.w_p)
+                z, th, phi_p[i] = per_seg[seg[i]]
+                phi_g[i], zeta[i], gamma[i] = growing_along(z, th, cands.theta[i])
         SF = phi_g * phi_p
         phi = alpha * SF + (1.0 - alpha) * GF
         phi[~reach] = -np.inf
         j = pick(phi, D, keep, p.hysteresis, ctx.rng)
+        if not ctx.explain:
+            return Decision(int(cands.rows[j]), int(cands.cols[j]), {"chosen": j})
         info = {"chosen": j, "candidates": [
             {"x": round(float(x), 2), "y": round(float(y), 2), "theta_f_deg": round(float(np.degrees(t)), 1),
              "segment": int(seg[i]), "D_m": round(float(D[i]) * b.frame.res, 2) if reach[i] else None,
