@@ -136,7 +136,7 @@ class Belief:
         self.passable = np.zeros((H, W), bool)
         self.skel_band = np.zeros((H, W), bool)
         self._search_mask = np.zeros((H, W), bool)  # skel_band, plus a search's joins while it runs
-        self.cost = np.ones((H, W), np.float32)
+        self.cost = np.zeros((H, W), np.float32)  # read only where passable, which refresh_derived writes with it
         self.search_state = GridSearch((H, W))
         self.version = 0  # bumped whenever passable/cost change
         self._search_key = None

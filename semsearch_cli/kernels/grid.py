@@ -288,9 +288,12 @@ class GridSearch:
     """
 
     def __init__(self, shape):
+        # zeros, not filled: a value counts only where its stamp says so, and pages never written
+        # are never resident (a search touches a band, not the map); int32 cell indices (maps are
+        # at most 25 M cells)
         self.dist = np.zeros(shape)
         self.length_ = np.zeros(shape)
-        self.parent = np.full(shape, -1, np.int64)
+        self.parent = np.zeros(shape, np.int32)
         self.touched = np.zeros(shape, np.int32)
         self.closed = np.zeros(shape, np.int32)
         self.tmark = np.zeros(shape, np.int32)
