@@ -54,13 +54,17 @@ def test_himm_update_exact():
     th = np.array([0.0])
     d, h = cast_rays(occ, 2.5, 1.5, th, 10.0)
     touched = np.zeros(scan_cells(1, 10.0), np.int64)
-    n = himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, touched)
+    free = np.zeros((5, 8), bool)
+    free[2, 2] = True  # known free already: its state does not change
+    n = himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, free, 3, touched)
     assert cv[2].tolist() == [0, 0, 0, 4, 0, 0, 3, 0]
     assert seen[2].tolist() == [False, True, True, True, True, True, True, False]
     assert not seen[[0, 1, 3, 4]].any()
-    assert touched[:n].tolist() == [2 * 8 + c for c in range(1, 7)]  # flat indices, beam order
+    # the cells whose free state now differs from ``free`` (flat indices, beam order): (2, 3) keeps
+    # cv 4 >= 3 and the hit (2, 6) gets 3, so neither becomes free
+    assert touched[:n].tolist() == [2 * 8 + 1, 2 * 8 + 4, 2 * 8 + 5]
     for _ in range(10):  # saturates at cv_max
-        himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, touched)
+        himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, free, 3, touched)
     assert cv[2, 6] == 15 and cv[2, 3] == 0
 
 

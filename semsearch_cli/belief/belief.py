@@ -165,7 +165,8 @@ class Belief:
         need = scan_cells(thetas.shape[0], float(dist.max()) if dist.size else 0.0)
         if self._touched.shape[0] < need:
             self._touched = np.empty(need, np.int64)
-        n = himm_update(self.cv, self.seen, v, u, thetas, dist, hit, sp.himm_inc, sp.himm_dec, sp.himm_max, self._touched)
+        n = himm_update(self.cv, self.seen, v, u, thetas, dist, hit, sp.himm_inc, sp.himm_dec, sp.himm_max, self.free,
+                        sp.occupied_threshold, self._touched)
         fold_free(self.free, self.seen, self.cv, sp.occupied_threshold, self._touched, n, self.dirty)
 
     def refresh_free(self, bbox: np.ndarray) -> None:

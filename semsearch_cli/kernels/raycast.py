@@ -90,7 +90,7 @@ def cast_rays(occ, v0, u0, thetas, max_cells):
 
 
 @njit(cache=True)
-def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, touched):
+def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, free, occupied, touched):
     """Histogramic in-motion mapping update (Borenstein and Koren 1991) for one scan.
 
     Cells a beam passes through before its end lose ``dec`` certainty (not below 0); the cell at
@@ -110,9 +110,13 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, touched):
         Beam angles (radians), measured ranges (cells), hit flags.
     inc, dec, cv_max : int
         HIMM increment, decrement and cap.
+    free : (H, W) bool, occupied : int
+        The free map (``seen & (cv < occupied)``, read only here; see :func:`fold_free`).
     touched : (m,) int64
-        Receives the flat index ``r * W + c`` of each touched cell (a cell may appear more than
-        once); :func:`scan_cells` gives a size that always suffices.
+        Receives the flat index ``r * W + c`` of each touched cell whose free state differs from
+        ``free`` just after the touch (a cell may appear more than once); every cell whose free
+        state differs from ``free`` after the scan is among them. :func:`scan_cells` gives a size
+        that always suffices.
 
     Returns
     -------
@@ -140,7 +144,7 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, touched):
                 x = int(cv[r, c]) - dec
                 cv[r, c] = 0 if x < 0 else x
                 seen[r, c] = True
-                if n < m:
+                if (cv[r, c] < occupied) != free[r, c] and n < m:
                     touched[n] = r * W + c
                     n += 1
             if tmr < tmc:
@@ -155,7 +159,7 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, touched):
             x = int(cv[hr, hc]) + inc
             cv[hr, hc] = cv_max if x > cv_max else x
             seen[hr, hc] = True
-            if n < m:
+            if (cv[hr, hc] < occupied) != free[hr, hc] and n < m:
                 touched[n] = hr * W + hc
                 n += 1
     return n
@@ -190,6 +194,22 @@ def fold_free(free, seen, cv, occupied, cells, n, dirty):
                 dirty[2] = c
             if c > dirty[3]:
                 dirty[3] = c
+
+
+@njit(cache=True)
+def facing_within(sx, sy, fx, fy, x, y, range2):
+    """Indices (ascending) of the signs at (sx, sy), facing along the unit vectors (fx, fy), that
+    lie within ``sqrt(range2)`` of (x, y) (all in m) and face it (the point lies on the side the
+    sign's face points to)."""
+    out = np.empty(sx.shape[0], np.int64)
+    n = 0
+    for i in range(sx.shape[0]):
+        dx = sx[i] - x
+        dy = sy[i] - y
+        if dx * dx + dy * dy <= range2 and dx * fx[i] + dy * fy[i] < 0:
+            out[n] = i
+            n += 1
+    return out[:n]
 
 
 @njit(cache=True)

@@ -7,7 +7,7 @@ import numpy as np
 from ..config import DoorCameraSpec, LaserSpec
 from ..geometry import wrap_angle
 from ..world.scenario import World
-from ..kernels.raycast import cast_rays, line_of_sight
+from ..kernels.raycast import cast_rays, facing_within, line_of_sight
 
 
 class Laser:
@@ -48,12 +48,10 @@ class DoorCamera:
 
     def read(self, x: float, y: float, heading: float, rng: np.random.Generator) -> list[tuple[int, object]]:
         """Signs read from pose (x, y, heading): list of (sign index, label as read)."""
-        dx, dy = self.sx - x, self.sy - y
-        d2 = dx * dx + dy * dy
-        near = np.nonzero((d2 <= self.spec.range**2) & (dx * self.fx + dy * self.fy < 0))[0]
+        near = facing_within(self.sx, self.sy, self.fx, self.fy, x, y, self.spec.range**2)
         if near.size == 0:
             return []
-        rel = np.abs(np.abs(wrap_angle(np.arctan2(dy[near], dx[near]) - heading)) - np.pi / 2)
+        rel = np.abs(np.abs(wrap_angle(np.arctan2(self.sy[near] - y, self.sx[near] - x) - heading)) - np.pi / 2)
         near = near[rel <= self.half]
         out = []
         v, u = self.world.frame.to_cell(x, y)
