@@ -15,7 +15,8 @@ from skimage.morphology import skeletonize
 
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
-from ..kernels.grid import GridSearch, branch_walk, local_reach, mark_visited, segment_roots, set_joins
+from ..kernels.grid import (GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, set_joins,
+                            widest_of_groups)
 from ..kernels.raycast import fold_free, himm_update, mark_viewed, scan_cells
 
 CLEARANCE_CAP_M = 1.0
@@ -229,7 +230,8 @@ class Belief:
         # clearance: write dirty+cap, compute on dirty+2cap
         w0, w1, w2, w3 = max(0, d[0] - cap), min(H, d[1] + cap + 1), max(0, d[2] - cap), min(W, d[3] + cap + 1)
         c0, c1, c2, c3 = max(0, d[0] - 2 * cap), min(H, d[1] + 2 * cap + 1), max(0, d[2] - 2 * cap), min(W, d[3] + 2 * cap + 1)
-        sub = np.pad(self.free[c0:c1, c2:c3], 1).astype(np.uint8)
+        sub = np.zeros((c1 - c0 + 2, c3 - c2 + 2), np.uint8)  # a border of walls
+        sub[1:-1, 1:-1] = self.free[c0:c1, c2:c3]
         dist = cv2.distanceTransform(sub, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
         np.minimum(dist * np.float32(res), np.float32(CLEARANCE_CAP_M), out=dist)
         self.clearance[w0:w1, w2:w3] = dist[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
@@ -380,20 +382,14 @@ class Belief:
         n, lab = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8)
         if n <= 1:
             return _empty()
-        rr, cc = np.nonzero(lab)
-        ll = lab[rr, cc]
-        clear = self.clearance[rr + r0, cc + c0]
-        order = np.lexsort((-clear, ll))  # per label, widest first
-        first = np.r_[0, np.nonzero(np.diff(ll[order]))[0] + 1]
-        pick = order[first]
-        rows, cols = rr[pick] + r0, cc[pick] + c0
+        rows, cols = widest_of_groups(lab, n, self.clearance, r0, c0)  # per group, the widest cell
         keep, theta, sr, sc = [], [], [], []
         for k in range(rows.shape[0]):
             r, c = int(rows[k]), int(cols[k])
             dr, dc, cnt = branch_walk(self.skeleton if need_branch else self.free, self.visited, r, c, BRANCH_DEPTH)
             if need_branch and cnt < MIN_BRANCH_CELLS:
                 continue
-            vr, vc = self._visited_neighbour(r, c)
+            vr, vc = nearest_visited(self.visited, r, c, 3)
             if cnt == 0:  # point away from the visited neighbour
                 dr, dc = r - vr, c - vc
             keep.append(k)
@@ -402,16 +398,6 @@ class Belief:
             sc.append(vc)
         keep = np.array(keep, np.int64)
         return Candidates(rows[keep], cols[keep], wrap_angle(np.array(theta, float)), np.array(sr, np.int64), np.array(sc, np.int64))
-
-    def _visited_neighbour(self, r, c):
-        H, W = self.visited.shape
-        for rad in (1, 2, 3):
-            rs, cs = slice(max(0, r - rad), r + rad + 1), slice(max(0, c - rad), c + rad + 1)
-            vr, vc = np.nonzero(self.visited[rs, cs])
-            if vr.size:
-                k = int(np.argmin((vr + rs.start - r) ** 2 + (vc + cs.start - c) ** 2))
-                return int(vr[k] + rs.start), int(vc[k] + cs.start)
-        return r, c
 
     # ---- distances and segments ----------------------------------------------------------
     def search(self, r: int, c: int, t_rows, t_cols, n_stop: int) -> GridSearch:

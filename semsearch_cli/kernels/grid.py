@@ -369,6 +369,49 @@ def backtrack(parent, r, c):
 
 
 @njit(cache=True)
+def widest_of_groups(lab, n, clearance, r0, c0):
+    """One cell per group of the label image ``lab`` (labels 1..n-1, 0 is background): the one
+    with the largest ``clearance[r0 + r, c0 + c]``, the first in row-major order among equals.
+    Returns (rows, cols) in the full grid's coordinates, in label order."""
+    best = np.full(n, -np.inf)
+    rows = np.zeros(n, np.int64)
+    cols = np.zeros(n, np.int64)
+    H, W = lab.shape
+    for r in range(H):
+        for c in range(W):
+            k = lab[r, c]
+            if k > 0:
+                v = clearance[r0 + r, c0 + c]
+                if v > best[k]:
+                    best[k] = v
+                    rows[k] = r0 + r
+                    cols[k] = c0 + c
+    return rows[1:], cols[1:]
+
+
+@njit(cache=True)
+def nearest_visited(visited, r, c, max_rad):
+    """The visited cell nearest to (r, c) (Euclidean, the first in row-major order among equals)
+    within the smallest square of half-side 1..``max_rad`` that holds one; (r, c) when none does."""
+    H, W = visited.shape
+    for rad in range(1, max_rad + 1):
+        best = -1
+        br = r
+        bc = c
+        for rr in range(max(0, r - rad), min(H, r + rad + 1)):
+            for cc in range(max(0, c - rad), min(W, c + rad + 1)):
+                if visited[rr, cc]:
+                    d = (rr - r) * (rr - r) + (cc - c) * (cc - c)
+                    if best < 0 or d < best:
+                        best = d
+                        br = rr
+                        bc = cc
+        if best >= 0:
+            return br, bc
+    return r, c
+
+
+@njit(cache=True)
 def branch_walk(skel, visited, r0, c0, depth):
     """Walk the skeleton out of the visited region from candidate (r0, c0).
 

@@ -222,6 +222,23 @@ class NSOS(KeepTarget):
         super().__init__(params)
         self._h_d = RollingHistogram(self.params.door_bins, True, self.params.lambda_d)
         self._h_r = RollingHistogram(self.params.robot_bins, False, self.params.lambda_r)
+        self._terms: dict = {}  # (goal, door list) -> (zeta, theta_inc, phi_p), see _segment_terms
+
+    def _segment_terms(self, door_list: dict, goal: int) -> tuple:
+        """(zeta, theta_inc, phi_p) of a segment's numbered signs. A segment's door list changes
+        only when one of its signs is read again, so the terms are kept by the list's contents
+        (the same numbers, in the same order, as computing them afresh)."""
+        items = [(lab, x, y) for lab, (_, x, y) in door_list.items() if isinstance(lab, (int, np.integer))]
+        key = (goal, tuple(items))
+        terms = self._terms.get(key)
+        if terms is None:
+            if len(self._terms) >= 1024:
+                self._terms.clear()
+            nums = np.array([i[0] for i in items], np.int64)
+            p = self.params
+            terms = self._terms[key] = (*segment_growth(nums, [i[1] for i in items], [i[2] for i in items], goal, p.w_g),
+                                        parity(nums, goal, p.w_p))
+        return terms
 
     def _decide(self, ctx, cands, keep: int | None = None):
         k = len(cands)
@@ -244,11 +261,7 @@ class NSOS(KeepTarget):
         goal = ctx.goal if isinstance(ctx.goal, (int, np.integer)) else None
         if alpha > 0 and goal is not None:
             seg, lists = b.segment_door_lists(cands.seg_rows, cands.seg_cols, p.min_reads)
-            per_seg = []  # (zeta, theta_inc, phi_p) of each segment's numbered signs
-            for lst in lists:
-                items = [(lab, x, y) for lab, (_, x, y) in lst.items() if isinstance(lab, (int, np.integer))]
-                nums = np.array([i[0] for i in items], np.int64)
-                per_seg.append((*segment_growth(nums, [i[1] for i in items], [i[2] for i in items], goal, p.w_g), parity(nums, goal, p.w_p)))
+            per_seg = [self._segment_terms(lst, goal) for lst in lists]
             for i in range(k):
                 if seg[i] < 0:
                     continue
