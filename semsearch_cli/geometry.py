@@ -8,6 +8,8 @@ Angles are radians in code and degrees in files.
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +45,13 @@ class GridFrame:
         col = (np.asarray(x, float) - self.origin_x) / self.res
         row = self.height - (np.asarray(y, float) - self.origin_y) / self.res
         return row, col
+
+    def point_to_cell(self, x: float, y: float) -> tuple[float, float, int, int]:
+        """:meth:`to_cell` and :meth:`to_index` of one point, in plain floats and ints (the same
+        arithmetic, without NumPy's per-call cost): (row, col, integer row, integer col)."""
+        col = (float(x) - self.origin_x) / self.res
+        row = self.height - (float(y) - self.origin_y) / self.res
+        return row, col, math.floor(row), math.floor(col)
 
     def to_index(self, x, y):
         """World (m) -> integer (row, col) of the containing cell."""

@@ -39,11 +39,10 @@ class DoorSensing:
     def sense(self, st: RobotState) -> tuple[bool, bool]:
         """(goal read, a sign reached min_reads)."""
         t, b, fr = self.task, st.belief, self.task.world.frame
-        v, u = fr.to_cell(st.x, st.y)
-        r, c = int(np.floor(v)), int(np.floor(u))
-        b.fold_scan(float(v), float(u), *t.laser.scan(float(v), float(u), st.heading, self.rng))
+        v, u, r, c = fr.point_to_cell(st.x, st.y)
+        b.fold_scan(v, u, *t.laser.scan(v, u, st.heading, self.rng))
         min_reads = b.spec.min_reads
-        b.views.append((float(v), float(u), st.heading))
+        b.views.append((v, u, st.heading))
         found = event = False
         for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
             st.read_signs.add(i)
@@ -54,7 +53,7 @@ class DoorSensing:
         return found, event
 
     def update(self, st: RobotState) -> None:
-        r, c = (int(v) for v in self.task.world.frame.to_index(st.x, st.y))
+        _, _, r, c = self.task.world.frame.point_to_cell(st.x, st.y)
         st.belief.visit(r, c)
         st.headings.append(st.heading)
 
