@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,7 +17,7 @@ from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import Loaded, check_folder, check_kind, expand, folder_lock, run_batch, run_rows
+from .runner import Loaded, check_folder, check_kind, expand, folder_lock, make_executor, run_batch, run_rows
 from .tasks.objects import write_log
 from .files import output_file, output_folder, temp_path
 
@@ -167,7 +168,9 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
     out_dir = Path(out) if out else Path("results") / f"{loaded[0].sc.name}-sweep-{param}"
-    with folder_lock(out_dir):
+    # one Dask cluster (or client) for every value; the process pool starts per value (a fork costs little)
+    shared = make_executor(workers, None, executor, scheduler) if executor != "processes" else nullcontext()
+    with folder_lock(out_dir), shared as runner:
         subs = [out_dir / f"{param}={v}" for v in values]
         for ld, sub in zip(loaded, subs):  # refuse foreign rows before anything runs
             check_folder(ld, sub, force)
@@ -180,7 +183,7 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
                 report_build.write_meta(sub, ld.path)
                 ld.task.write_inputs(sub)
                 runs = run_batch(ld, specs, sub, workers, progress, trace, force=force, executor=executor,
-                                 scheduler=scheduler)
+                                 scheduler=scheduler, runner=runner)
                 write_summary(runs, sub)
             frames.append(run_rows(runs).assign(value=v))
         runs = pd.concat(frames, ignore_index=True)

@@ -1,6 +1,7 @@
 """The Dask executor on a real cluster on this machine: a `dask scheduler` and two `dask worker`
 processes on 127.0.0.1. Rows match the process pool's (wall time aside), a worker killed with
-SIGKILL mid-batch loses no run and duplicates none, and a batch resumes across executors."""
+SIGKILL mid-batch loses no run and duplicates none, a batch resumes across executors, and a sweep
+starts one local cluster for all its values."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from semsearch_cli import api
 from semsearch_cli.runner import read_runs
 
 distributed = pytest.importorskip("distributed")
+cluster_module = pytest.importorskip("semsearch_cli.runner.cluster")
 
 DASK = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
 WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
@@ -100,3 +102,23 @@ def test_a_batch_resumes_across_executors(demo_dir, tmp_path):
     whole = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, out=tmp_path / "one", plots=False)
     pd.testing.assert_frame_equal(_rows(out), _rows(tmp_path / "one"))
     assert len(whole.runs) == 8
+
+
+def test_a_sweep_uses_one_cluster_for_all_its_values(demo_dir, tmp_path, monkeypatch):
+    started = []
+
+    class Counted(cluster_module.LocalCluster):
+        def __init__(self, *a, **k):
+            started.append(1)
+            super().__init__(*a, **k)
+
+    monkeypatch.setattr(cluster_module, "LocalCluster", Counted)
+    kw = dict(seeds=2, goals=[452], planners=["greedy"], workers=2)
+    res = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], out=tmp_path / "dask", executor="dask", **kw)
+    assert len(started) == 1  # not one per value
+    pool = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], out=tmp_path / "pool", **kw)
+    assert res.table["n"].tolist() == [2, 2, 2]
+    pd.testing.assert_frame_equal(res.table, pool.table)
+    for v in ("0", "0.5", "0.9"):
+        pd.testing.assert_frame_equal(_rows(tmp_path / "dask" / f"door_camera.p_misread={v}"),
+                                      _rows(tmp_path / "pool" / f"door_camera.p_misread={v}"))

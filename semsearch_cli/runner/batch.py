@@ -9,7 +9,7 @@ from typing import Callable, Sequence
 import pandas as pd
 
 from ..errors import ScenarioError
-from .executors import SerialExecutor, make_executor
+from .executors import Executor, SerialExecutor, make_executor
 from .lock import folder_lock
 from .specs import Loaded, RunSpec
 from .store import RowWriter, read_runs, run_rows
@@ -38,14 +38,16 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False) -> pd.DataFrame
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,
               progress: Callable[[dict, int, int], None] | None = None, trace: bool = False,
               start_method: str | None = None, force: bool = False, executor: str = "processes",
-              scheduler: str | None = None) -> pd.DataFrame:
+              scheduler: str | None = None, runner: Executor | None = None) -> pd.DataFrame:
     """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
     With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
     ``start_method`` is the worker processes' (see :class:`ProcessExecutor`); ``executor`` is
     ``processes`` or ``dask`` (on the scheduler at ``scheduler``, or a local cluster of
     ``workers``), see :func:`make_executor`: rows do not depend on it, and a batch started on one
-    resumes on another. ``progress(row, done, total)`` is called as each run finishes, with the
-    runs finished so far and the runs this batch has to do. The specs are streamed to the executor, never listed whole (a
+    resumes on another; ``runner``, an executor the caller made (and entered), e.g. one Dask
+    cluster for every value of a sweep, replaces both. ``progress(row, done, total)`` is called as
+    each run finishes, with the runs finished so far and the runs this batch has to do. The specs
+    are streamed to the executor, never listed whole (a
     :class:`~semsearch_cli.runner.specs.RunList` of any length costs no memory).
 
     The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's
@@ -60,10 +62,9 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
-        if total == 0 or (executor == "processes" and total == 1):
-            runner = SerialExecutor()
-        else:
-            runner = make_executor(max(1, min(workers, total)), start_method, executor, scheduler)
+        if runner is None:
+            serial = total == 0 or (executor == "processes" and total == 1)
+            runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), start_method, executor, scheduler)
         writer = RowWriter(runs_csv)
         n = 0
         try:

@@ -18,7 +18,7 @@ from typing import Iterable, Iterator
 import dask
 from distributed import Client, LocalCluster, as_completed
 
-from .executors import execute
+from .executors import Executor, execute
 from .specs import Loaded, RunSpec
 from .store import save_run_files
 
@@ -32,14 +32,25 @@ def _run_chunk(loaded: Loaded, specs: list[RunSpec], trace: bool) -> list[tuple]
     return out
 
 
-class DaskExecutor:
+class DaskExecutor(Executor):
     """Runs on the Dask scheduler at ``address`` (``tcp://HOST:PORT``), or, without one, on a
     local cluster of ``workers`` single-threaded worker processes started for the batch.
     ``chunk`` runs travel together; at most two chunks per worker thread are in flight, so the
-    list of runs is streamed, never held whole."""
+    list of runs is streamed, never held whole. Inside ``with``, one client (and local cluster)
+    serves every batch, e.g. all the values of a sweep; otherwise each batch starts its own."""
 
     def __init__(self, workers: int = 2, address: str | None = None, chunk: int = 4):
         self.workers, self.address, self.chunk = workers, address, max(1, int(chunk))
+        self._kept = None  # (client, local cluster or None) while inside ``with``
+
+    def __enter__(self):
+        self._kept = self._client()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        kept, self._kept = self._kept, None
+        if kept is not None:
+            _close(*kept)
 
     def _client(self):
         if self.address:
@@ -55,20 +66,30 @@ class DaskExecutor:
         return Client(cluster, set_as_default=False), cluster
 
     def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
-        client, cluster = self._client()
-        pending = as_completed(loop=client.loop)
+        owned = self._kept is None
+        client, cluster = self._client() if owned else self._kept
         try:
             shared = client.scatter(loaded, broadcast=True)  # once per worker, not with every run
-            specs = iter(specs)
-            ahead = 2 * max(1, sum(client.nthreads().values()))
+            try:
+                yield from self._stream(client, shared, iter(specs), out, trace)
+            finally:
+                shared.release()  # a kept cluster serves the next batch without this one's scenario
+        finally:
+            if owned:
+                _close(client, cluster)
 
-            def submit(n: int):
-                for _ in range(n):
-                    part = list(itertools.islice(specs, self.chunk))
-                    if not part:
-                        return
-                    pending.add(client.submit(_run_chunk, shared, part, trace, pure=False))
+    def _stream(self, client, shared, specs: Iterator[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+        pending = as_completed(loop=client.loop)
+        ahead = 2 * max(1, sum(client.nthreads().values()))
 
+        def submit(n: int):
+            for _ in range(n):
+                part = list(itertools.islice(specs, self.chunk))
+                if not part:
+                    return
+                pending.add(client.submit(_run_chunk, shared, part, trace, pure=False))
+
+        try:
             submit(ahead)
             for fut in pending:
                 done = fut.result()
@@ -81,7 +102,9 @@ class DaskExecutor:
         except BaseException:
             client.cancel(list(pending.futures))
             raise
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+
+
+def _close(client, cluster) -> None:
+    client.close()
+    if cluster is not None:
+        cluster.close()

@@ -43,7 +43,20 @@ def _run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list
     return rows
 
 
-class SerialExecutor:
+class Executor:
+    """What every executor gives the runner: ``rows(loaded, specs, out, trace)`` yields each run's
+    rows as it finishes. An executor is also a context manager: inside ``with`` it may keep what
+    it starts (a cluster) for several batches (a sweep's values); outside, each batch starts and
+    stops its own. Nothing to keep here."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+
+class SerialExecutor(Executor):
     """Runs in this process, in order."""
 
     def __init__(self, workers: int = 1):
@@ -68,7 +81,7 @@ def _worker_run(spec: RunSpec, out: str, trace: bool) -> list[dict]:
     return _run_and_save(_CACHE["loaded"], spec, Path(out), trace)
 
 
-class ProcessExecutor:
+class ProcessExecutor(Executor):
     """A pool of ``workers`` processes; the loaded scenario is sent to each once. ``start_method``
     (``fork``, ``spawn``, ``forkserver``; default: Python's for the platform) is how they start: a
     spawned worker unpickles the scenario in a fresh interpreter, and a planner from the user's
