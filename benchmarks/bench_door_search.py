@@ -7,9 +7,13 @@ Measures (medians of repeated runs, with ratios against baselines timed in the s
   2. whole Hotel tables with 2 workers: 4 goals x greedy and bvp x 10 seeds, and 4 goals x
      greedy and nsos at alpha 0.8, 0.9, 1.0 x 10 seeds;
   3. navigators: path lengths of the geodesic and the harmonic navigator between random pairs of
-     cells on the fully known Hotel map, and greedy runs with either navigator.
+     cells on the fully known Hotel map, and greedy runs with either navigator;
+  4. with ``--tables thesis``: every door table of the thesis on our own buildings (configs
+     normal, inverse, hotel and kth: 13 goals x greedy and nsos at alpha 0.8, 0.9, 1.0 x 10
+     seeds = 520 runs), 2 workers, rows kept in a temporary folder (``--keep DIR`` to compare them
+     with benchmarks/compare_rows.py). This part does not need ../shared.
 
-Usage: python benchmarks/bench_door_search.py [--repeat 5] [--tables bvp,nsos] [--out FILE.md]
+Usage: python benchmarks/bench_door_search.py [--repeat 5] [--tables bvp,nsos,thesis] [--keep DIR] [--out FILE.md]
 """
 
 from __future__ import annotations
@@ -53,6 +57,26 @@ def sensing_only(L: Loaded, path: np.ndarray) -> float:
     return time.perf_counter() - t0
 
 
+def thesis_tables(say, out: Path) -> None:
+    """Every door table of the thesis on our own buildings, greedy and nsos, 2 workers."""
+    repo = Path(__file__).resolve().parents[1]
+    say("## 4. every door table of the thesis (configs normal, inverse, hotel, kth; greedy and nsos x 10 seeds), 2 workers")
+    say("| config | runs | wall (s) | sum of run times (s) | km travelled |")
+    say("|---|---|---|---|---|")
+    n_all = wall_all = 0.0
+    for name in ("normal", "inverse", "hotel", "kth"):
+        t0 = time.perf_counter()
+        L = Loaded.load(repo / "configs" / f"{name}.yaml")
+        specs = expand(L, 10, planners=["greedy", "nsos"])
+        runs = run_batch(L, specs, out / name, workers=2)
+        wall = time.perf_counter() - t0
+        n_all += len(runs)
+        wall_all += wall
+        say(f"| {name} | {len(runs)} | {wall:.1f} | {runs['wall_s'].sum():.1f} | {runs['distance_m'].sum() / 1000:.1f} |")
+    say(f"| all | {n_all:.0f} | {wall_all:.1f} | | |")
+    say()
+
+
 def known_belief(L: Loaded) -> Belief:
     w = L.world
     b = Belief(w.frame, L.sc.belief, L.sc.robot.radius)
@@ -85,12 +109,10 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--pairs", type=int, default=40)
-    ap.add_argument("--tables", default="bvp,nsos", help="which whole tables to time: bvp, nsos, both or none")
+    ap.add_argument("--tables", default="bvp,nsos", help="which whole tables to time: bvp, nsos, thesis, several or none")
+    ap.add_argument("--keep", type=Path, help="folder for the thesis tables' rows (default: a temporary one)")
     ap.add_argument("--out", type=Path)
     a = ap.parse_args()
-    if not REF.is_dir():
-        print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
-        return 0
     lines = []
 
     def say(s=""):
@@ -98,6 +120,11 @@ def main() -> int:
         lines.append(s)
 
     tmp = Path(tempfile.mkdtemp(prefix="semsearch-bench-"))
+    if "thesis" in a.tables.split(","):
+        thesis_tables(say, a.keep or tmp / "thesis")
+    if not REF.is_dir():
+        print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
+        return 0
     p, _ = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5, "hotel-reference")
     L = Loaded.load(p)
     say(f"# semsearch door-search benchmark ({time.strftime('%Y-%m-%d %H:%M')}, {sys.platform}, python {sys.version.split()[0]})")
