@@ -1,9 +1,13 @@
+import os
+
 import numpy as np
+import pytest
 
 from semsearch_cli.belief import Belief
 from semsearch_cli.config import BeliefSpec
 from semsearch_cli.geometry import GridFrame
 from semsearch_cli.kernels.grid import GridSearch, dijkstra, local_reach
+from semsearch_cli.kernels.memory import lazy_zeros
 
 
 def make_belief(free):
@@ -167,3 +171,16 @@ def test_search_heap_grows_without_changing_the_result():
     far = int(np.argmax(np.where(np.isfinite(big.costs(tr, tc)), big.costs(tr, tc), -1)))
     assert big.costs(tr, tc)[far] > 50
     assert np.array_equal(np.stack(small.path(int(tr[far]), int(tc[far]))), np.stack(big.path(int(tr[far]), int(tc[far]))))
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
+def test_lazy_grids_are_zero_and_private_to_each_process():
+    a = lazy_zeros((300, 400), np.int32)
+    assert a.shape == (300, 400) and a.dtype == np.int32 and a.flags.c_contiguous and not a.any()
+    pid = os.fork()
+    if pid == 0:  # a forked worker writes into its copy
+        a[:] = 7
+        os._exit(0)
+    os.waitpid(pid, 0)
+    assert not a.any()  # the parent's grid is untouched (a shared map would show the 7s)
+    assert lazy_zeros((0, 5), bool).shape == (0, 5)

@@ -17,6 +17,7 @@ from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import (GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, set_joins,
                             widest_of_groups)
+from ..kernels.memory import lazy_zeros
 from ..kernels.raycast import fold_free, himm_update, mark_viewed, scan_cells
 
 CLEARANCE_CAP_M = 1.0
@@ -119,7 +120,7 @@ class Belief:
     Attributes
     ----------
     cv : uint8, HIMM certainty; seen : bool; free : bool (seen and below the occupied threshold);
-    visited : bool; seg_class : int16 (density class of visited cells, -1 elsewhere, Eq. 4.4);
+    visited : bool; seg_class : int16 (density class of visited cells, Eq. 4.4; 0 elsewhere);
     clearance : float32 m (to the nearest cell that is not known free, capped);
     skeleton : bool.
     """
@@ -127,24 +128,24 @@ class Belief:
     def __init__(self, frame: GridFrame, spec: BeliefSpec, robot_radius: float):
         H, W = frame.height, frame.width
         self.frame, self.spec = frame, spec
-        self.cv = np.zeros((H, W), np.uint8)
-        self.seen = np.zeros((H, W), bool)
-        self.free = np.zeros((H, W), bool)
-        self.visited = np.zeros((H, W), bool)
-        self.seg_class = np.full((H, W), -1, np.int16)
-        self.clearance = np.zeros((H, W), np.float32)
-        self.skeleton = np.zeros((H, W), bool)
-        self.passable = np.zeros((H, W), bool)
-        self.skel_band = np.zeros((H, W), bool)
-        self._search_mask = np.zeros((H, W), bool)  # skel_band, plus a search's joins while it runs
-        self.cost = np.zeros((H, W), np.float32)  # read only where passable, which refresh_derived writes with it
+        self.cv = lazy_zeros((H, W), np.uint8)
+        self.seen = lazy_zeros((H, W), bool)
+        self.free = lazy_zeros((H, W), bool)
+        self.visited = lazy_zeros((H, W), bool)
+        self.seg_class = lazy_zeros((H, W), np.int16)  # meaningful where visited
+        self.clearance = lazy_zeros((H, W), np.float32)
+        self.skeleton = lazy_zeros((H, W), bool)
+        self.passable = lazy_zeros((H, W), bool)
+        self.skel_band = lazy_zeros((H, W), bool)
+        self._search_mask = lazy_zeros((H, W), bool)  # skel_band, plus a search's joins while it runs
+        self.cost = lazy_zeros((H, W), np.float32)  # read only where passable, which refresh_derived writes with it
         self.search_state = GridSearch((H, W))
         self.version = 0  # bumped whenever passable/cost change
         self._search_key = None
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
-        self._seg_parent = np.zeros(H * W, np.int32)  # segments as a union-find forest (see kernels.grid.mark_visited)
+        self._seg_parent = lazy_zeros(H * W, np.int32)  # segments as a union-find forest (see kernels.grid.mark_visited)
         self.vbox = [H, -1, W, -1]
         self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
         self._cands = None
@@ -497,7 +498,7 @@ class Belief:
         b = self.vbox
         if b[1] >= b[0]:
             sl = (slice(b[0], b[1] + 1), slice(b[2], b[3] + 1))
-            cls = self.seg_class[sl]
+            cls = np.where(self.visited[sl], self.seg_class[sl], -1)
             sub = out[sl]
             nxt = 1
             for k in np.unique(cls[cls >= 0]):

@@ -12,6 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .memory import lazy_zeros
+
 SQRT2 = math.sqrt(2.0)
 _DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
 _DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
@@ -288,15 +290,15 @@ class GridSearch:
     """
 
     def __init__(self, shape):
-        # zeros, not filled: a value counts only where its stamp says so, and pages never written
-        # are never resident (a search touches a band, not the map); int32 cell indices (maps are
-        # at most 25 M cells)
-        self.dist = np.zeros(shape)
-        self.length_ = np.zeros(shape)
-        self.parent = np.zeros(shape, np.int32)
-        self.touched = np.zeros(shape, np.int32)
-        self.closed = np.zeros(shape, np.int32)
-        self.tmark = np.zeros(shape, np.int32)
+        # never filled: a value counts only where its stamp says so, and pages never written are
+        # never resident (a search touches a band, not the map); int32 cell indices (maps are at
+        # most 25 M cells)
+        self.dist = lazy_zeros(shape)
+        self.length_ = lazy_zeros(shape)
+        self.parent = lazy_zeros(shape, np.int32)
+        self.touched = lazy_zeros(shape, np.int32)
+        self.closed = lazy_zeros(shape, np.int32)
+        self.tmark = lazy_zeros(shape, np.int32)
         self.gen = 0
         self.source = None
         self._hk = np.empty(4096)  # the search's heap (cost, cell), grown when a search fills it
