@@ -120,3 +120,9 @@ def test_bad_yaml(tmp_path):
 def test_run_reports_bad_goal_option(demo_dir):
     res = runner.invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--goal", "12345", "--out", "/tmp/never"])
     assert res.exit_code == 2 and "--goal" in res.output
+
+
+def test_density_delta_too_fine_for_the_class_map(demo_dir, tmp_path):
+    # a delta of 0.001 m^2 would give a 20 m kernel 800,000 classes, more than the 16-bit class map holds
+    p = scenario_copy(demo_dir, tmp_path, belief={"density_delta": 0.001})
+    check_error(p, "belief.density_delta")

@@ -155,14 +155,14 @@ class Belief:
         self.examined = None  # (H, W) bool: wall faces given up on after a look from close by (lazy)
         self._view_stamp = None  # (H, W) int64: the last pose that counted for each cell
         self._n_views = 0
-        self._touched = np.empty(0, np.int64)  # cells the last scan touched (flat indices)
+        self._touched = np.empty(0, np.int64)  # cells whose free state the last scan may have changed (flat)
         self._joins = np.empty(0, np.int64)  # cells a search added to the skeleton band (flat indices)
 
     # ---- per-step updates -------------------------------------------------------------
     def fold_scan(self, v: float, u: float, thetas: np.ndarray, dist: np.ndarray, hit: np.ndarray) -> None:
         """Fold one laser scan from continuous cell position (v, u) into HIMM (``cv``, ``seen``),
-        re-derive ``free`` at the cells it touched and grow the dirty box by those that changed
-        (what :meth:`refresh_free` does over a box, at the touched cells only)."""
+        re-derive ``free`` where the scan changed it and grow the dirty box by those cells (what
+        :meth:`refresh_free` does over a box, at the few cells that can have changed)."""
         sp = self.spec
         need = scan_cells(thetas.shape[0], float(dist.max()) if dist.size else 0.0)
         if self._touched.shape[0] < need:

@@ -88,7 +88,9 @@ class DoorCameraSpec(Strict):
 class BeliefSpec(Strict):
     visited_radius: float = Field(1.2, gt=0.0, le=MAX_RADIUS, description="m, kernel of the visited region")
     density_radius: float = Field(2.4, gt=0.0, le=MAX_RADIUS, description="m, uniform kernel radius r of Eq. 4.2 (Manhattan)")
-    density_delta: float = Field(2.5, gt=0.0, le=1e4, description="m^2, delta of Eq. 4.4")
+    # at least 0.05 m^2: the densest kernel (a 20 m Manhattan radius, 800 m^2) then has 16,000
+    # classes, which the belief keeps in 16 bits
+    density_delta: float = Field(2.5, ge=0.05, le=1e4, description="m^2, delta of Eq. 4.4")
     min_reads: int = Field(3, ge=1, description="reads before a sign feeds the planner's factors")
     himm_inc: int = Field(3, ge=1, le=15)
     himm_dec: int = Field(1, ge=1, le=15)
