@@ -8,6 +8,7 @@ from semsearch_cli.config import BeliefSpec
 from semsearch_cli.geometry import GridFrame
 from semsearch_cli.kernels.grid import GridSearch, dijkstra, local_reach
 from semsearch_cli.kernels.memory import lazy_zeros
+from semsearch_cli.kernels.raycast import cast_rays
 
 
 def make_belief(free):
@@ -184,3 +185,24 @@ def test_lazy_grids_are_zero_and_private_to_each_process():
     os.waitpid(pid, 0)
     assert not a.any()  # the parent's grid is untouched (a shared map would show the 7s)
     assert lazy_zeros((0, 5), bool).shape == (0, 5)
+
+
+def test_fold_scan_with_a_full_change_buffer_matches_a_roomy_one():
+    # a scan that frees many cells at once overflows a small buffer: the belief refreshes over the
+    # scan's box instead, with the same free map and dirty box, and makes room for the next scan
+    occ = np.zeros((80, 90), bool)
+    occ[:, 85:] = True
+    occ[10, 20:60] = True
+    thetas = np.linspace(-np.pi / 2, np.pi / 2, 91)
+    dist, hit = cast_rays(occ, 40.5, 30.5, thetas, 50.0)
+    beliefs = []
+    for size in (1, 100_000):
+        b = Belief(GridFrame(0.1, 0.0, 0.0, 80, 90), BeliefSpec(), robot_radius=0.05)
+        b._touched = np.empty(size, np.int64)
+        b.fold_scan(40.5, 30.5, thetas, dist, hit)
+        beliefs.append(b)
+    small, roomy = beliefs
+    assert roomy.free.sum() > 500
+    assert np.array_equal(small.free, roomy.free) and np.array_equal(small.cv, roomy.cv)
+    assert small.dirty.tolist() == roomy.dirty.tolist()
+    assert small._touched.shape[0] > 500  # room for as many changes next time

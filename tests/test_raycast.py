@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 
-from semsearch_cli.kernels.raycast import cast_ray, cast_rays, fold_free, himm_update, line_of_sight, scan_cells
+from semsearch_cli.kernels.raycast import cast_ray, cast_rays, fold_free, himm_update, line_of_sight
 
 
 def slow_ray(occ, v0, u0, theta, max_cells, step=1e-4):
@@ -53,7 +53,7 @@ def test_himm_update_exact():
     seen = np.zeros((5, 8), bool)
     th = np.array([0.0])
     d, h = cast_rays(occ, 2.5, 1.5, th, 10.0)
-    touched = np.zeros(scan_cells(1, 10.0), np.int64)
+    touched = np.zeros(64, np.int64)
     free = np.zeros((5, 8), bool)
     free[2, 2] = True  # known free already: its state does not change
     n = himm_update(cv, seen, 2.5, 1.5, th, d, h, 3, 1, 15, free, 3, touched)

@@ -18,7 +18,7 @@ from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import (GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, set_joins,
                             widest_of_groups)
 from ..kernels.memory import lazy_zeros
-from ..kernels.raycast import fold_free, himm_update, mark_viewed, scan_cells
+from ..kernels.raycast import fold_free, himm_update, mark_viewed
 
 CLEARANCE_CAP_M = 1.0
 CONNECT_M = 1.5
@@ -155,7 +155,7 @@ class Belief:
         self.examined = None  # (H, W) bool: wall faces given up on after a look from close by (lazy)
         self._view_stamp = None  # (H, W) int64: the last pose that counted for each cell
         self._n_views = 0
-        self._touched = np.empty(0, np.int64)  # cells whose free state the last scan may have changed (flat)
+        self._touched = np.empty(1024, np.int64)  # cells whose free state the last scan may have changed (flat)
         self._joins = np.empty(0, np.int64)  # cells a search added to the skeleton band (flat indices)
 
     # ---- per-step updates -------------------------------------------------------------
@@ -164,12 +164,17 @@ class Belief:
         re-derive ``free`` where the scan changed it and grow the dirty box by those cells (what
         :meth:`refresh_free` does over a box, at the few cells that can have changed)."""
         sp = self.spec
-        need = scan_cells(thetas.shape[0], float(dist.max()) if dist.size else 0.0)
-        if self._touched.shape[0] < need:
-            self._touched = np.empty(need, np.int64)
         n = himm_update(self.cv, self.seen, v, u, thetas, dist, hit, sp.himm_inc, sp.himm_dec, sp.himm_max, self.free,
                         sp.occupied_threshold, self._touched)
-        fold_free(self.free, self.seen, self.cv, sp.occupied_threshold, self._touched, n, self.dirty)
+        if n <= self._touched.shape[0]:
+            fold_free(self.free, self.seen, self.cv, sp.occupied_threshold, self._touched, n, self.dirty)
+            return
+        # more changes than the buffer holds (the first scans, or a long-range laser in the open):
+        # refresh over the scan's whole box, which holds every cell a beam touched, and make room
+        reach = (float(dist.max()) if dist.size else 0.0) + 2.0
+        H, W = self.free.shape
+        self.refresh_free(np.array([max(0, int(v - reach)), min(H - 1, int(v + reach)), max(0, int(u - reach)), min(W - 1, int(u + reach))]))
+        self._touched = np.empty(2 * n, np.int64)
 
     def refresh_free(self, bbox: np.ndarray) -> None:
         """Re-derive ``free`` inside a scan's bounding box and grow the dirty box by the cells

@@ -115,13 +115,13 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, free, occ
     touched : (m,) int64
         Receives the flat index ``r * W + c`` of each touched cell whose free state differs from
         ``free`` just after the touch (a cell may appear more than once); every cell whose free
-        state differs from ``free`` after the scan is among them. :func:`scan_cells` gives a size
-        that always suffices.
+        state differs from ``free`` after the scan is among them.
 
     Returns
     -------
     int
-        The number of entries written to ``touched``.
+        How many such touches there were; when more than ``m``, only the first ``m`` were
+        written (the caller then refreshes ``free`` over the scan's whole box instead).
     """
     H, W = cv.shape
     n = 0
@@ -144,8 +144,9 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, free, occ
                 x = int(cv[r, c]) - dec
                 cv[r, c] = 0 if x < 0 else x
                 seen[r, c] = True
-                if (cv[r, c] < occupied) != free[r, c] and n < m:
-                    touched[n] = r * W + c
+                if (cv[r, c] < occupied) != free[r, c]:
+                    if n < m:
+                        touched[n] = r * W + c
                     n += 1
             if tmr < tmc:
                 t = tmr
@@ -159,16 +160,11 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, free, occ
             x = int(cv[hr, hc]) + inc
             cv[hr, hc] = cv_max if x > cv_max else x
             seen[hr, hc] = True
-            if (cv[hr, hc] < occupied) != free[hr, hc] and n < m:
-                touched[n] = hr * W + hc
+            if (cv[hr, hc] < occupied) != free[hr, hc]:
+                if n < m:
+                    touched[n] = hr * W + hc
                 n += 1
     return n
-
-
-def scan_cells(beams: int, max_cells: float) -> int:
-    """Entries of ``touched`` that :func:`himm_update` can fill for ``beams`` beams of at most
-    ``max_cells`` cells: a beam of length R crosses at most 2 R + 2 cells, plus its end cell."""
-    return beams * (2 * int(math.ceil(max_cells)) + 4)
 
 
 @njit(cache=True)
