@@ -306,19 +306,17 @@ class GridSearch:
 
     def run(self, passable, cost, src_r, src_c, t_rows, t_cols, n_stop=0, max_cost=np.inf) -> int:
         """Search from the source cells; returns the number of targets settled."""
-        self.gen += 1
-        self.tmark[t_rows, t_cols] = self.gen
         src_r = np.atleast_1d(np.asarray(src_r, np.int64))
         src_c = np.atleast_1d(np.asarray(src_c, np.int64))
         self.source = (tuple(src_r), tuple(src_c))
-        while True:
+        while True:  # a search that fills the heap runs again, from scratch, with a larger one
+            self.gen += 1
+            self.tmark[t_rows, t_cols] = self.gen
             settled = _dijkstra(passable, cost, src_r, src_c, self.tmark, n_stop, max_cost, self.dist, self.length_,
                                 self.parent, self.touched, self.closed, self.gen, self._hk, self._hi)
             if settled >= 0:
                 return settled
             self._hk, self._hi = np.empty(2 * self._hk.size), np.empty(2 * self._hi.size, np.int64)
-            self.gen += 1  # search again from scratch with the larger heap
-            self.tmark[t_rows, t_cols] = self.gen
 
     def settled(self, rows, cols) -> np.ndarray:
         return self.closed[rows, cols] == self.gen
