@@ -15,11 +15,14 @@ from .plots import plot_chain_stages, plot_paths_overlay, plot_scenario
 
 def chain_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Per chain x planner (the chain rows): n, success rate, mean and std of the total distance,
-    the shortest chain (the sum of the shortest legs) and the mean ratio."""
+    the shortest chain (the sum of the shortest legs) and the mean ratio, and the episode-level
+    95% intervals of the mean and the rate (:func:`.tables.intervals`)."""
     rows = runs[runs["stage"] == ""]
-    g = rows.groupby(["scenario", "goal", "planner"], sort=False)
-    return g.agg(n=("distance_m", "size"), success_rate=("success", "mean"), mean=("distance_m", "mean"),
-                 std=("distance_m", "std"), shortest_m=("shortest_m", "first"), mean_ratio=("ratio", "mean")).round(3).reset_index()
+    keys = ["scenario", "goal", "planner"]
+    g = rows.groupby(keys, sort=False)
+    out = g.agg(n=("distance_m", "size"), success_rate=("success", "mean"), mean=("distance_m", "mean"),
+                std=("distance_m", "std"), shortest_m=("shortest_m", "first"), mean_ratio=("ratio", "mean")).reset_index()
+    return out.merge(T.per_group(rows, keys, T.intervals, T.INTERVALS), on=keys, how="left").round(3)
 
 
 def stage_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -83,6 +86,8 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
              "run from scratch (same starting pose, empty map). A stage is door:N, or door:N/class@hour for an "
              "object found in the room behind door N.")
     doc.heading(3, "Whole chains: distance (m) beside the shortest chain")
+    doc.para("std: the spread of the runs; mean_lo-mean_hi (bootstrap) and success_lo-success_hi (clustered "
+             f"Wilson): {T.interval_caption(chains)}.")
     doc.table(chains.set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
     doc.heading(3, "Each stage: mean distance with the map kept / from scratch (m), and the saving")
     doc.table(wide)

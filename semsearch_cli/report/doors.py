@@ -17,11 +17,13 @@ from .tables import goal_key
 
 def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, notes: list) -> None:
     runs = pd.concat([run_rows(p.runs) for p in parts], ignore_index=True)
+    summary = T.summarise(runs)
     tabs = {
-        "summary": T.summarise(runs),
-        "five_statistics": T.five_statistics(runs),
-        "mean_std": T.mean_std(runs),
-        "percent_of_optimal": T.percent_of_optimal(runs),
+        "summary": summary,
+        "five_statistics": T.five_statistics(runs, summary),
+        "mean_std": T.mean_std(runs, summary),
+        "mean_ci": T.mean_ci(runs, summary),
+        "percent_of_optimal": T.percent_of_optimal(runs, summary),
         "success_spl": T.success_and_spl(runs),
         "significance": T.significance(runs),
     }
@@ -29,21 +31,40 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     for name, df in tabs.items():
         write_table(tdir, name, df, formats)
     if formats & {"md", "html"}:
-        for name in ("five_statistics", "mean_std", "percent_of_optimal"):
-            atomic_text(tdir / f"{name}.md", markdown_table(tabs[name], mark_rows=name != "mean_std"))
+        for name in ("five_statistics", "mean_std", "mean_ci", "percent_of_optimal"):
+            atomic_text(tdir / f"{name}.md", markdown_table(tabs[name], mark_rows=name not in ("mean_std", "mean_ci")))
+    units = T.interval_caption(summary)
     doc.heading(2, f"Door search ({len(runs)} runs)")
     doc.heading(3, "Distance travelled (m): median, mean, std, min, max (thesis Tables 4.2-4.5)")
-    doc.para("Best of each row in bold, worst in italics.")
+    doc.para(f"Over every run ({T.span(summary['n'])} runs per goal and planner), a failed run at the distance it "
+             "travelled before it ended, as the thesis. Best of each row in bold, worst in italics.")
     doc.table(tabs["five_statistics"], mark_rows=True)
     doc.heading(3, "Mean ± std beside the shortest path (Tables 4.6-4.9)")
+    doc.para("std: the spread of the runs (ddof = 1), as the thesis prints it, not the uncertainty of the mean "
+             "(next table).")
     doc.table(tabs["mean_std"])
+    doc.heading(3, "Mean with its 95% interval [low, high] (n) beside the shortest path")
+    doc.para(f"{units}; n in brackets after each interval. The interval is a BCa bootstrap (SciPy, 9999 "
+             "resamples) of the mean of the per-unit mean distances.")
+    doc.table(tabs["mean_ci"])
     doc.heading(3, "Mean as percent of the shortest path (Table 4.10)")
     doc.table(tabs["percent_of_optimal"], mark_rows=True)
     doc.heading(3, "Success rate and SPL")
-    doc.table(tabs["success_spl"].set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
-    doc.heading(3, "Is the difference significant? (Mann-Whitney U against greedy, two-sided)")
-    doc.para("effect_r: rank-biserial correlation, positive when the planner travels less than greedy.")
-    doc.table(tabs["significance"].set_index(["scenario", "goal", "planner"]).drop(columns=["baseline"]), fmt="{:.3g}")
+    doc.para(f"success_lo-success_hi: the Wilson interval at the effective sample size n / deff, deff being Kish's "
+             f"design effect of the runs clustered in units; {units}. spl: SPL (Anderson et al. 2018); soft_spl: "
+             "SoftSPL (Datta et al. 2020). The failed runs by cause: budget (ran out), stuck (no path to anywhere "
+             "new), explored (nowhere left to look), error.")
+    doc.table(tabs["success_spl"].drop(columns=["unit"]).set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
+    sig = tabs["significance"]
+    doc.heading(3, "Is the difference significant? (Wilcoxon signed-rank, paired on shared episodes; else Mann-Whitney U)")
+    doc.para("Each planner against the baseline (greedy where it ran, else the first planner). Where the two ran the "
+             "same episodes and seeds, each unit's runs share their start and random stream, so they are compared "
+             f"pair by pair, on the units above (n_pairs = {T.span(sig['n_pairs'])}): two-sided Wilcoxon signed-rank test of the "
+             "per-unit differences. Elsewhere, the two-sided Mann-Whitney U test of each side's unit means. "
+             "mean_diff: planner - baseline (m; negative: the planner travels less) with its 95% bootstrap interval "
+             "(diff_lo, diff_hi). effect_r: rank-biserial correlation (matched pairs for Wilcoxon), positive when "
+             "the planner travels more than the baseline.")
+    doc.table(sig.set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
     if formats & {"png", "html", "md"}:
         doc.heading(3, "Figures")
         _figures(doc, runs, parts, out / "figures", replay, notes)
@@ -116,8 +137,10 @@ def _replay(doc, loaded, runs, fdir, order) -> None:
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
-    cols = ["goal", "planner", "n", "success_rate", "median", "mean", "std", "min", "max", "shortest_m", "mean_ratio"]
-    return [("distance travelled (m) per goal and planner", T.summarise(run_rows(runs))[cols])]
+    cols = ["goal", "planner", "n", "episodes", "success_rate", "median", "mean", "mean_lo", "mean_hi", "std", "min", "max",
+            "shortest_m", "mean_ratio"]
+    s = T.summarise(run_rows(runs))
+    return [(f"distance travelled (m) per goal and planner; mean_lo-mean_hi: {T.interval_caption(s)}", s[cols])]
 
 
 def show(loaded, out: Path) -> None:

@@ -1,6 +1,6 @@
 """The indirect-search section of a report (Loncomilla et al. 2018, Table 3): the success rate per
-method and view scale with Wilson 95% intervals beside the paper's, the time to find and SPL, and
-success against the view scale. Tables come from runs.csv alone."""
+method and view scale with 95% intervals clustered on rooms beside the paper's, the time to find
+and SPL, and success against the view scale. Tables come from runs.csv alone."""
 
 from __future__ import annotations
 
@@ -8,9 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.stats import binomtest
 
 from ..runner import run_rows
+from . import stats as S
+from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import animate_probability, plot_rooms, plot_success_by_scale
 
@@ -41,15 +42,21 @@ def method_order(labels) -> list[str]:
 
 
 def success_table(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per scenario x method x view scale: n, found, success rate with its Wilson 95% interval,
-    mean time to find (s, over the searches that found A), mean distance, mean SPL."""
+    """Per scenario x method x view scale: n, found, success rate with its 95% interval clustered
+    on rooms (:func:`.stats.rate_ci`: Wilson at the effective sample size n / deff, Kish's design
+    effect of the searches in one room layout, which are not independent; SPEC 7), mean time to
+    find (s, over the searches that found A), mean distance, mean SPL, and the ``unit`` of the
+    interval with their number ``n_units``: ``rooms``, or for rows without a room (older folders)
+    the episodes, or the repeats of one episode (then it is the plain Wilson interval)."""
     rows = []
     for (scen, planner, scale), g in runs.groupby(["scenario", "planner", "goal"], sort=False):
         n, k = len(g), int(g["success"].sum())
-        ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+        u = S.units(g, cluster="room")
+        _, lo, hi = S.rate_ci(g["success"], u)
         found = g[g["success"] == 1]
         rows.append({"scenario": scen, "planner": planner, "view_scale": float(scale), "n": n, "found": k,
-                     "success": k / n, "ci_low": ci.low, "ci_high": ci.high,
+                     "success": k / n, "ci_low": lo, "ci_high": hi, "unit": S.unit_kind(g, cluster="room"),
+                     "n_units": int(u.nunique()),
                      "time_to_find_s": found["time_s"].astype(float).mean() if k else np.nan,
                      "distance_m": g["distance_m"].mean(), "spl": g["spl"].mean()})
     out = pd.DataFrame(rows)
@@ -70,7 +77,17 @@ def _cell(r) -> str:
     ref = ""
     if paper is not None and r.view_scale in PAPER_SCALES:
         ref = f" ({paper[PAPER_SCALES.index(r.view_scale)]})"
-    return f"{100 * r.success:.0f} [{100 * r.ci_low:.0f}-{100 * r.ci_high:.0f}]{ref}"
+    ci = "[-]" if r.ci_low != r.ci_low else f"[{100 * r.ci_low:.0f}-{100 * r.ci_high:.0f}]"
+    return f"{100 * r.success:.0f} {ci}{ref}"
+
+
+def interval_text(table: pd.DataFrame) -> str:
+    """What the intervals of :func:`success_table` are over, in words."""
+    what = {"rooms": "clustered on room layouts", "episodes": "clustered on episodes (runs without a room)",
+            "repeats": "plain Wilson, each search its own unit (runs without a room)"}
+    kinds = [what[k] for k in dict.fromkeys(table["unit"])] if len(table) else []
+    return (f"95% interval {'; '.join(kinds)}: Wilson at the effective sample size n / deff, deff being Kish's "
+            f"design effect ({T.span(table['n_units'])} units per cell)") if kinds else "95% interval"
 
 
 def time_spl(table: pd.DataFrame) -> pd.DataFrame:
@@ -97,7 +114,7 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
         atomic_text(tdir / "indirect_table3.md", markdown_table(tab3))
     doc.heading(2, f"Indirect search with secondary objects ({len(runs)} searches)")
     doc.para("Success rate (%) per method and view scale (the farthest the main object can be detected), with its "
-             "Wilson 95% interval; in brackets the paper's Table 3 (Loncomilla et al. 2018; their rooms, simulator "
+             f"{interval_text(table)}; in brackets the paper's Table 3 (Loncomilla et al. 2018; their rooms, simulator "
              "and detection table, so compare shapes, not values).")
     doc.table(tab3)
     doc.heading(3, "Time to find (s, over the searches that found it) / SPL")
@@ -105,8 +122,8 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     if formats & {"png", "html", "md"}:
         f = out / "figures" / "indirect_success.png"
         plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f)
-        doc.figure(f, "Success rate against the view scale, one line per method: ours with Wilson 95% intervals "
-                      "(left), the paper's Table 3 (right)")
+        doc.figure(f, "Success rate against the view scale, one line per method: ours with the "
+                      f"{interval_text(table)} (left), the paper's Table 3 (right)")
         if replay:
             for part in parts:
                 _replay(doc, part, run_rows(part.runs), out / "figures", notes)
@@ -144,7 +161,7 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list) ->
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
     table = success_table(run_rows(runs))
-    return [("success rate (%) [Wilson 95%] (paper's Table 3)", wide(table).reset_index())]
+    return [(f"success rate (%) [{interval_text(table)}] (paper's Table 3)", wide(table).reset_index())]
 
 
 def show(loaded, out: Path) -> None:

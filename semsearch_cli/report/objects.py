@@ -27,7 +27,8 @@ def planner_order(labels) -> list[str]:
 
 def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Per case x class x request hour x planner: n, found, success rate, mean, std (ddof 1),
-    min, max of the distance until the object was seen (or the search gave up), the shortest."""
+    min, max of the distance until the object was seen (or the search gave up), the shortest, and
+    the episode-level 95% intervals of the mean and the rate (:func:`.tables.intervals`)."""
     df = runs.copy()
     parts = [parse_label(g) for g in df["goal"]]
     df["case"] = [p[0] for p in parts]
@@ -37,6 +38,8 @@ def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     out = g.agg(n=("distance_m", "size"), found=("success", "sum"), success_rate=("success", "mean"),
                 mean=("distance_m", "mean"), std=("distance_m", "std"), min=("distance_m", "min"),
                 max=("distance_m", "max"), shortest_m=("shortest_m", "first")).reset_index()
+    keys = ["case", "class", "hour", "planner"]
+    out = out.merge(T.per_group(df, keys, T.intervals, T.INTERVALS), on=keys, how="left")
     case_order = list(dict.fromkeys(df["case"]))
     out["_c"] = out["case"].map(case_order.index)
     out["_h"] = out["hour"].map(lambda h: (h == 0, h))
@@ -68,7 +71,9 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     doc.heading(2, f"Object search over time ({len(runs)} runs)")
     doc.heading(3, "Distance until the object is seen (m): mean ± std (found / runs)")
     doc.para("A run that does not find the object counts the distance until the planner gave up "
-             "(Last Seen after its one spot, Brute Force after its whole route).")
+             "(Last Seen after its one spot, Brute Force after its whole route). std is the spread of the runs; "
+             "tables/objects.csv adds the intervals of the mean distance (mean_lo, mean_hi: bootstrap) and of the "
+             f"success rate (success_lo, success_hi: clustered Wilson), {T.interval_caption(table)}.")
     doc.table(wide)
     if formats & {"png", "html", "md"}:
         doc.heading(3, "Figures")

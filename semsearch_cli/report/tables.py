@@ -7,14 +7,53 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.stats import mannwhitneyu
 
 from ..runner import file_stem
+from . import stats as S
+
+KEYS = ["scenario", "goal", "planner"]
+
+
+def intervals(g: pd.DataFrame, value: str = "distance_m") -> dict:
+    """Episode-level statistics of one group of runs (:mod:`.stats`): the distinct ``episodes``,
+    the ``unit`` of the intervals (``episodes``, or ``repeats`` of the one episode) and their
+    number ``n_units``, the bootstrap interval of the mean of ``value`` (``mean_lo``, ``mean_hi``)
+    and the clustered Wilson interval of the success rate (``success_lo``, ``success_hi``)."""
+    u = S.units(g)
+    _, lo, hi = S.mean_ci(g[value], u)
+    _, slo, shi = S.rate_ci(g["success"], u)
+    return {"episodes": int(S.episodes(g).nunique()), "unit": S.unit_kind(g), "n_units": int(u.nunique()),
+            "mean_lo": lo, "mean_hi": hi, "success_lo": slo, "success_hi": shi}
+
+
+def per_group(runs: pd.DataFrame, keys: list, fn, columns: list) -> pd.DataFrame:
+    """One row per group of ``runs`` by ``keys`` (sorted): the keys and the dict ``fn(group)``."""
+    rows = [dict(zip(keys, k)) | fn(d) for k, d in runs.groupby(keys, sort=True)]
+    return pd.DataFrame(rows, columns=keys + columns)
+
+
+def _finite(v: pd.Series) -> pd.Series:
+    v = pd.to_numeric(v, errors="coerce")
+    return v[np.isfinite(v)]
+
+
+INTERVALS = ["episodes", "unit", "n_units", "mean_lo", "mean_hi", "success_lo", "success_hi"]
+
 
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per scenario x goal x planner variant: n, success rate, median, mean, std (ddof=1, as the
-    thesis' tables), min and max of distance_m, the shortest path and the mean ratio."""
-    g = runs.groupby(["scenario", "goal", "planner"], sort=True)
+    """Per scenario x goal x planner variant: n runs, distinct ``episodes``, success rate with its
+    interval (``success_lo``, ``success_hi``), median, mean (``mean_lo``, ``mean_hi``: its
+    interval), std (ddof=1, as the thesis' tables), min and max of distance_m, the shortest path
+    (the mean over episodes of each episode's), the mean ratio, the mean ``soft_spl`` and the mean
+    distance still to go over the failed runs (``left_m``, m; over those with a finite distance
+    left, NaN when none failed) when runs.csv has those columns, and the ``unit`` of the intervals with their number ``n_units``.
+
+    Distances are over every run, failures included at the distance they travelled (the thesis'
+    convention; see :mod:`.stats`). ``mean`` is the mean of all runs, as the thesis; the
+    interval is that of the mean of per-unit means (:func:`.stats.mean_ci`), the same number when
+    every unit has as many runs. Intervals are 95%: a bootstrap over units for the mean, the
+    clustered Wilson interval (:func:`.stats.rate_ci`) for the rate."""
+    g = runs.groupby(KEYS, sort=True)
     out = g.agg(
         n=("distance_m", "size"),
         success_rate=("success", "mean"),
@@ -23,10 +62,39 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
         std=("distance_m", "std"),
         min=("distance_m", "min"),
         max=("distance_m", "max"),
-        shortest_m=("shortest_m", "first"),
         mean_ratio=("ratio", "mean"),
     ).reset_index()
-    return out.round(3)
+    extra = {"shortest_m": lambda d: float(d.groupby(S.episodes(d))["shortest_m"].first().mean())}
+    if "soft_spl" in runs.columns:
+        extra["soft_spl"] = lambda d: float(d["soft_spl"].mean())
+    if "left_m" in runs.columns:
+        extra["left_m"] = lambda d: float(_finite(d.loc[d["success"] == 0, "left_m"]).mean())
+    more = per_group(runs, KEYS, lambda d: intervals(d) | {k: f(d) for k, f in extra.items()}, INTERVALS + list(extra))
+    out = out.merge(more, on=KEYS, how="left")
+    cols = KEYS + ["n", "episodes", "success_rate", "success_lo", "success_hi", "median", "mean", "mean_lo", "mean_hi",
+                   "std", "min", "max", "shortest_m", "mean_ratio"] + [c for c in extra if c != "shortest_m"] + ["unit", "n_units"]
+    return out[cols].round(3)
+
+
+def span(v: pd.Series) -> str:
+    """``"6"`` or ``"4-6"``: the range of the counts in ``v`` (NaN left out), for captions."""
+    v = pd.to_numeric(pd.Series(v), errors="coerce").dropna()
+    if v.empty:
+        return "0"
+    lo, hi = int(v.min()), int(v.max())
+    return f"{lo}" if lo == hi else f"{lo}-{hi}"
+
+
+def interval_caption(summary: pd.DataFrame) -> str:
+    """What the intervals of ``summary`` (:func:`summarise`) are over, and how many, in words."""
+    parts = []
+    ep, rep = summary[summary["unit"] == "episodes"], summary[summary["unit"] == "repeats"]
+    if len(ep):
+        parts.append(f"over episodes (n = {span(ep['n_units'])} per goal and planner; the repeats of an episode averaged first)")
+    if len(rep):
+        parts.append(f"over the repeats of the one episode of {'each' if not len(ep) else 'the other'} goal "
+                     f"(n = {span(rep['n_units'])}; they speak for that start only)")
+    return "95% intervals " + ", and ".join(parts) if parts else "no runs"
 
 
 def median_paths(folder: Path, med: pd.DataFrame, goal, order: list) -> dict:
@@ -72,10 +140,10 @@ def planner_order(labels) -> list[str]:
     return sorted(set(labels), key=key)
 
 
-def five_statistics(runs: pd.DataFrame) -> pd.DataFrame:
+def five_statistics(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:
     """Tables 4.2-4.5: rows (scenario, goal, statistic) for the five statistics of distance_m,
-    one column per planner variant."""
-    s = summarise(runs)
+    one column per planner variant (``summary``: :func:`summarise` of ``runs``, if at hand)."""
+    s = summarise(runs) if summary is None else summary
     long = s.melt(id_vars=["scenario", "goal", "planner"], value_vars=FIVE, var_name="statistic")
     t = long.pivot_table(index=["scenario", "goal", "statistic"], columns="planner", values="value", sort=False)
     t = t.reindex(columns=planner_order(t.columns))
@@ -83,56 +151,121 @@ def five_statistics(runs: pd.DataFrame) -> pd.DataFrame:
     return t.sort_index(level=[0, 1, 2], key=lambda idx: idx.map(order) if idx.name == "statistic" else idx)
 
 
-def mean_std(runs: pd.DataFrame) -> pd.DataFrame:
-    """Tables 4.6-4.9: ``mean +- std`` per goal and variant beside the shortest path (m)."""
-    s = summarise(runs)
-    s["cell"] = s.apply(lambda r: f"{r['mean']:.2f} ± {0.0 if pd.isna(r['std']) else r['std']:.2f}", axis=1)
+def _wide(s: pd.DataFrame, cell) -> pd.DataFrame:
+    s = s.assign(cell=s.apply(cell, axis=1))
     t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="cell", aggfunc="first")
     t = t.reindex(columns=planner_order(t.columns))
     t["shortest_m"] = s.groupby(["scenario", "goal"])["shortest_m"].first()
     return t
 
 
-def percent_of_optimal(runs: pd.DataFrame) -> pd.DataFrame:
-    """Table 4.10: mean distance as a percentage of the shortest path."""
-    s = summarise(runs)
+def mean_std(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Tables 4.6-4.9: ``mean +- std`` per goal and variant beside the shortest path (m), as the
+    thesis prints them (std over runs, ddof=1: the spread of runs, not the uncertainty of the mean;
+    see :func:`mean_ci`)."""
+    s = summarise(runs) if summary is None else summary
+    return _wide(s, lambda r: f"{r['mean']:.2f} ± {0.0 if pd.isna(r['std']) else r['std']:.2f}")
+
+
+def mean_ci(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Beside Tables 4.6-4.9: ``mean [lo, hi] (n)`` per goal and variant, the 95% interval of the
+    mean distance (m) by a bootstrap over ``n`` units (episodes, or the repeats of a goal's one
+    episode: :func:`summarise`), beside the shortest path (m)."""
+    s = summarise(runs) if summary is None else summary
+
+    def cell(r):
+        ci = "[-]" if pd.isna(r["mean_lo"]) else f"[{r['mean_lo']:.2f}, {r['mean_hi']:.2f}]"
+        return f"{r['mean']:.2f} {ci} ({r['n_units']})"
+
+    return _wide(s, cell)
+
+
+def percent_of_optimal(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Table 4.10: mean distance as a percentage of the shortest path (the mean over episodes)."""
+    s = (summarise(runs) if summary is None else summary).copy()
     s["pct"] = (100.0 * s["mean"] / s["shortest_m"]).round(2)
     t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="pct")
     return t.reindex(columns=planner_order(t.columns))
 
 
+CAUSES = ("budget", "stuck", "explored", "error")
+_CAUSE_OF_OUTCOME = {"budget": "budget", "stuck": "stuck", "not_found": "explored", "error": "error"}
+
+
+def causes(runs: pd.DataFrame) -> pd.Series:
+    """Why each run ended without finding its goal: the ``cause`` column, or where it is missing
+    or empty (older folders) the outcome (``not_found``: nowhere left to look, i.e. explored)."""
+    fallback = runs["outcome"].map(_CAUSE_OF_OUTCOME).fillna("").astype(str)
+    if "cause" not in runs.columns:
+        return fallback
+    c = runs["cause"].fillna("").astype(str)
+    return c.where(c != "", fallback)
+
+
 def success_and_spl(runs: pd.DataFrame) -> pd.DataFrame:
-    """Success rate and mean SPL (Anderson et al. 2018) per goal and variant."""
-    g = runs.groupby(["scenario", "goal", "planner"])
-    return g.agg(n=("success", "size"), success_rate=("success", "mean"), spl=("spl", "mean"),
-                 budget=("outcome", lambda o: int((o == "budget").sum())),
-                 stuck=("outcome", lambda o: int((o == "stuck").sum()))).round(3).reset_index()
+    """Per goal and variant: runs, distinct episodes, success rate with its 95% interval
+    clustered on units (:func:`.stats.rate_ci`; ``unit``, ``n_units``), mean SPL (Anderson et al.
+    2018), mean soft SPL when runs.csv has it, and the failed runs by cause (:data:`CAUSES`)."""
+    df = runs.assign(_cause=causes(runs).where(runs["success"] == 0, ""))
+
+    def row(d):
+        u = S.units(d)
+        p, lo, hi = S.rate_ci(d["success"], u)
+        out = {"n": len(d), "episodes": int(S.episodes(d).nunique()), "success_rate": p, "success_lo": lo,
+               "success_hi": hi, "spl": float(d["spl"].mean())}
+        if "soft_spl" in d.columns:
+            out["soft_spl"] = float(d["soft_spl"].mean())
+        return out | {c: int((d["_cause"] == c).sum()) for c in CAUSES} | {"unit": S.unit_kind(d), "n_units": int(u.nunique())}
+
+    cols = ["n", "episodes", "success_rate", "success_lo", "success_hi", "spl"] + (["soft_spl"] if "soft_spl" in runs.columns else [])
+    return per_group(df, KEYS, row, cols + list(CAUSES) + ["unit", "n_units"]).round(3)
 
 
 MIN_N = 5
+SIGNIFICANCE = ["scenario", "goal", "baseline", "planner", "test", "n_pairs", "n_baseline", "n", "mean_diff", "diff_lo",
+                "diff_hi", "p_value", "effect_r", "note"]
 
 
-def significance(runs: pd.DataFrame, baseline: str = "greedy") -> pd.DataFrame:
-    """Per goal, a two-sided Mann-Whitney U test (SciPy) of distance_m between ``baseline`` and
-    each other variant, with the rank-biserial effect size r = 1 - 2U / (n1 n2) (positive when
-    the variant travels less than the baseline) and a note when either sample has fewer than
-    ``MIN_N`` runs (too few for the test to mean much)."""
+def _trials(d: pd.DataFrame) -> set:
+    return set(zip(S.episodes(d), pd.to_numeric(d["seed"], errors="coerce")))
+
+
+def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "distance_m") -> pd.DataFrame:
+    """Per goal, each planner variant against a baseline on ``value`` (m).
+
+    The baseline is ``baseline`` when given and present, else greedy when present, else the first
+    planner of :func:`planner_order`. When the variant and the baseline ran the same set of
+    (episode, seed) for the goal (they share episodes and random streams), the comparison is
+    paired (:func:`.stats.paired`): per-unit differences, the Wilcoxon signed-rank test and the
+    matched-pairs rank-biserial r. Otherwise it falls back to the unpaired Mann-Whitney U test over
+    each side's unit means (:func:`.stats.unpaired`). Either way ``mean_diff`` = variant -
+    baseline with its 95% bootstrap interval (negative: the variant travels less) and ``effect_r``
+    is positive when the variant travels more. ``n_baseline`` and ``n`` count units; ``note``
+    flags fewer than ``MIN_N`` units (pairs), too few for the test to mean much."""
     rows = []
     for (scen, goal), g in runs.groupby(["scenario", "goal"]):
-        base = g[g["planner"] == baseline]["distance_m"].to_numpy()
-        for lab in planner_order(g["planner"]):
-            if lab == baseline:
+        order = planner_order(g["planner"])
+        base = baseline if baseline in order else "greedy" if "greedy" in order else order[0]
+        b = g[g["planner"] == base]
+        for lab in order:
+            if lab == base:
                 continue
-            x = g[g["planner"] == lab]["distance_m"].to_numpy()
-            row = {"scenario": scen, "goal": goal, "baseline": baseline, "planner": lab, "n_baseline": len(base), "n": len(x)}
-            if len(base) and len(x):
-                u, p = mannwhitneyu(x, base, alternative="two-sided")
-                row.update(U=float(u), p_value=float(p), effect_r=round(1.0 - 2.0 * float(u) / (len(x) * len(base)), 3))
+            x = g[g["planner"] == lab]
+            row = {"scenario": scen, "goal": goal, "baseline": base, "planner": lab}
+            if _trials(x) == _trials(b):
+                r = S.paired(x, b, value)
+                row |= {"test": f"wilcoxon signed-rank, paired on {r['unit']}", "n_pairs": r["n_pairs"],
+                        "n_baseline": r["n_pairs"], "n": r["n_pairs"]}
+                small = r["n_pairs"]
             else:
-                row.update(U=float("nan"), p_value=float("nan"), effect_r=float("nan"))
-            row["note"] = f"n < {MIN_N}: too few runs to judge" if min(len(base), len(x)) < MIN_N else ""
+                r = S.unpaired(x, b, value)
+                row |= {"test": "mann-whitney, unpaired", "n_pairs": np.nan, "n_baseline": r["n_b"], "n": r["n_a"]}
+                small = min(r["n_a"], r["n_b"])
+            row |= {k: r[k] for k in ("mean_diff", "diff_lo", "diff_hi", "p_value", "effect_r")}
+            row["note"] = f"n < {MIN_N}: too few units to judge" if small < MIN_N else ""
             rows.append(row)
-    return pd.DataFrame(rows, columns=["scenario", "goal", "baseline", "planner", "n_baseline", "n", "U", "p_value", "effect_r", "note"])
+    out = pd.DataFrame(rows, columns=SIGNIFICANCE)
+    return out.round({"mean_diff": 3, "diff_lo": 3, "diff_hi": 3, "effect_r": 3})
 
 
 def cells(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> tuple[list[str], list[list[tuple]]]:

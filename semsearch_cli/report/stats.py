@@ -1,0 +1,249 @@
+"""Statistics at the level of the episode (SPEC 9, issue 24 item 4).
+
+Runs of one episode (one start pose and goal) repeated over seeds are not independent: they share
+the start, the map and the goal, and differ only in the random stream. The unit of every interval
+and test here is therefore the *episode*, or, when a goal has a single episode (the thesis'
+configurations: one fixed start per goal), the repeat of that episode; then an interval speaks for
+that start only. Indirect search clusters on the room layout instead (SPEC 7: trials in one room
+are not independent).
+
+Failures count in the mean distance at the distance they travelled before the search ended
+(budget, stuck, explored everything, error), as in the thesis' Tables 4.2-4.10; whether a run
+failed is reported beside it by the success rate and its interval, and how far it still was from
+the goal by ``left_m``. A planner that gives up early can therefore look short on distance alone:
+read the two together.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy.stats import bootstrap, mannwhitneyu, norm, rankdata, wilcoxon
+
+NAN = float("nan")
+
+
+def episodes(df: pd.DataFrame) -> pd.Series:
+    """The ``episode`` column as int64, 0 where it is missing (folders written before episodes)."""
+    if "episode" not in df.columns:
+        return pd.Series(0, index=df.index, dtype="int64", name="episode")
+    return pd.to_numeric(df["episode"], errors="coerce").fillna(0).astype("int64")
+
+
+def _has_cluster(df: pd.DataFrame, cluster: str | None) -> bool:
+    return cluster is not None and cluster in df.columns and bool(len(df)) and \
+        not df[cluster].isna().any() and bool((df[cluster].astype(str) != "").all())
+
+
+def unit_kind(df: pd.DataFrame, cluster: str | None = None) -> str:
+    """What :func:`units` takes as the unit of ``df``: ``"rooms"`` (or the plural of any other
+    ``cluster`` column), ``"episodes"`` or ``"repeats"`` (of one episode). Words for captions."""
+    if _has_cluster(df, cluster):
+        return f"{cluster}s"
+    return "episodes" if episodes(df).nunique() > 1 else "repeats"
+
+
+def units(df: pd.DataFrame, cluster: str | None = None) -> pd.Series:
+    """The independent unit of each row, as text labels aligned with ``df.index``.
+
+    Parameters
+    ----------
+    df : DataFrame
+        Rows of one comparison (one scenario x goal x planner, or the planners being paired), with
+        ``episode`` (int; missing is read as 0) and ``seed`` (int).
+    cluster : str, optional
+        A column to cluster on instead (``"room"`` for indirect search). When the column is
+        missing or empty in any row (folders written before it), the default units are used;
+        :func:`unit_kind` says which.
+
+    Returns
+    -------
+    Series of str, named ``unit``: ``"e3"`` (the episode) when the rows span more than one episode,
+    else ``"e0/s2"`` (episode and seed: the repeats of the one episode are the units), or the
+    cluster's value.
+    """
+    if _has_cluster(df, cluster):
+        return df[cluster].astype(str).rename("unit")
+    ep = episodes(df)
+    if ep.nunique() > 1:
+        return ("e" + ep.astype(str)).rename("unit")
+    seed = pd.to_numeric(df["seed"], errors="coerce").fillna(-1).astype("int64")
+    return ("e" + ep.astype(str) + "/s" + seed.astype(str)).rename("unit")
+
+
+def _unit_means(values, unit_labels) -> pd.Series:
+    """Per-unit means of ``values`` (NaN values left out), sorted by unit."""
+    v = pd.Series(np.asarray(values, dtype=float))
+    return v.groupby(np.asarray(unit_labels), sort=True).mean().dropna()
+
+
+def _boot(samples: tuple, statistic, point: float, confidence: float, n_resamples: int, seed: int) -> tuple[float, float, float]:
+    res = bootstrap(samples, statistic, confidence_level=confidence, n_resamples=n_resamples, method="BCa",
+                    rng=np.random.default_rng(seed))
+    return point, float(res.confidence_interval.low), float(res.confidence_interval.high)
+
+
+def mean_ci(values, units, confidence: float = 0.95, n_resamples: int = 9999, seed: int = 0) -> tuple[float, float, float]:
+    """Mean over units of the per-unit means, with a bootstrap confidence interval over units.
+
+    Parameters
+    ----------
+    values : (n,) float
+        One value per run (e.g. distance_m, m); NaN values are left out.
+    units : (n,)
+        The unit of each run (:func:`units`).
+    confidence : float
+        Two-sided level of the interval.
+    n_resamples, seed : int
+        Bootstrap resamples and the seed of its ``numpy.random.Generator`` (fixed: the same rows
+        give the same interval).
+
+    Returns
+    -------
+    (mean, lo, hi) : float
+        ``mean`` is the unweighted mean of the per-unit means (the mean of all runs when every unit
+        has as many runs). The interval is ``scipy.stats.bootstrap`` (BCa) over the per-unit
+        means; ``(m, m, m)`` when all unit means are equal, ``(m, nan, nan)`` with fewer than two
+        units (``(nan, nan, nan)`` with none).
+    """
+    um = _unit_means(values, units).to_numpy()
+    if len(um) == 0:
+        return NAN, NAN, NAN
+    m = float(um.mean())
+    if len(um) < 2:
+        return m, NAN, NAN
+    if np.ptp(um) == 0:
+        return m, m, m
+    return _boot((um,), np.mean, m, confidence, n_resamples, seed)
+
+
+def wilson(p: float, n: float, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a proportion ``p`` observed over ``n`` (may be fractional) trials."""
+    z = float(norm.ppf(0.5 + confidence / 2.0))
+    d = 1.0 + z * z / n
+    centre = (p + z * z / (2.0 * n)) / d
+    half = z * np.sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / d
+    return max(0.0, float(centre - half)), min(1.0, float(centre + half))
+
+
+def rate_ci(successes, units, confidence: float = 0.95) -> tuple[float, float, float]:
+    """Success rate with a Wilson interval widened for clustered runs.
+
+    The rate is ``p = sum y / n`` over all ``n`` runs. The runs of one unit are correlated, so the
+    interval is the Wilson score interval at the effective sample size ``n_eff = n / deff``, with
+    Kish's design effect (Kish 1965, *Survey Sampling*, sec. 5.4) estimated from the data::
+
+        deff = max(1, Var_clustered / (p (1 - p) / n))
+        Var_clustered = sum_i (y_i - p m_i)^2 / n^2
+
+    for units ``i`` with ``y_i`` successes in ``m_i`` runs: the linearised variance of the ratio
+    estimator ``p``, i.e. the between-unit variance of the unit rates weighted by unit size,
+    divided by the number of units. It is taken without the small-sample factor k / (k - 1), so
+    that units of one run each give ``deff = 1`` and the plain Wilson interval exactly; with few
+    units it is slightly optimistic. ``deff`` is floored at 1 (clustering is not credited with
+    making runs *more* informative) and is 1 when ``p`` is 0 or 1 (no variance to estimate).
+
+    Parameters
+    ----------
+    successes : (n,) 0/1
+        One value per run; NaN left out.
+    units : (n,)
+        The unit of each run (:func:`units`).
+
+    Returns
+    -------
+    (rate, lo, hi) : float
+        ``(p, nan, nan)`` when the runs fall in one unit holding more than one run (no
+        between-unit variance to estimate); ``(nan, nan, nan)`` without runs.
+    """
+    y = pd.Series(np.asarray(successes, dtype=float))
+    u = pd.Series(np.asarray(units))
+    keep = y.notna().to_numpy()
+    y, u = y[keep], u[keep]
+    n = len(y)
+    if n == 0:
+        return NAN, NAN, NAN
+    p = float(y.mean())
+    per = y.groupby(u.to_numpy()).agg(["sum", "size"])
+    if len(per) < 2 and n > 1:
+        return p, NAN, NAN
+    deff = 1.0
+    if 0.0 < p < 1.0:
+        var = float(((per["sum"] - p * per["size"]) ** 2).sum()) / n**2
+        deff = max(1.0, var / (p * (1.0 - p) / n))
+    lo, hi = wilson(p, n / deff, confidence)
+    return p, lo, hi
+
+
+def _mean_diff(x, y, axis=-1):
+    return np.mean(x, axis=axis) - np.mean(y, axis=axis)
+
+
+def paired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confidence: float = 0.95) -> dict:
+    """Planners A and B on the same episodes, compared unit by unit.
+
+    Repeats are averaged per unit (:func:`units` of both tables together: the episode, or the
+    (episode, seed) when there is one episode), the two sides joined on the unit, and the
+    difference ``d = a - b`` taken per unit. Units found on one side only are dropped and counted.
+
+    Returns
+    -------
+    dict
+        ``unit`` (``"episodes"`` or ``"repeats"``), ``n_pairs``, ``unpaired``; ``mean_diff``
+        (mean of d, in the unit of ``value``) with ``diff_lo``, ``diff_hi`` from :func:`mean_ci`
+        over the pairs; ``p_value`` of the two-sided Wilcoxon signed-rank test
+        (``scipy.stats.wilcoxon``, zero differences dropped): 1.0 when every difference is zero,
+        NaN with fewer than two nonzero differences; ``effect_r``, the matched-pairs rank-biserial
+        correlation ``(R+ - R-) / (R+ + R-)`` over the ranks of the nonzero ``|d|`` (positive
+        when A has the larger ``value``, e.g. travels more; 0 when every difference is zero).
+    """
+    both = pd.concat([a, b], ignore_index=True)
+    lab = units(both).to_numpy()
+    side = np.r_[np.zeros(len(a), bool), np.ones(len(b), bool)]
+    ma = _unit_means(both[value].to_numpy()[~side], lab[~side])
+    mb = _unit_means(both[value].to_numpy()[side], lab[side])
+    common = ma.index.intersection(mb.index).sort_values()
+    d = (ma[common] - mb[common]).to_numpy()
+    out = {"unit": unit_kind(both), "n_pairs": len(d), "unpaired": len(ma) + len(mb) - 2 * len(common)}
+    out["mean_diff"], out["diff_lo"], out["diff_hi"] = mean_ci(d, np.arange(len(d)), confidence)
+    nz = d[d != 0]
+    if len(d) == 0:
+        p, r = NAN, NAN
+    elif len(nz) == 0:
+        p, r = 1.0, 0.0
+    else:
+        p = float(wilcoxon(d, alternative="two-sided").pvalue) if len(nz) >= 2 else NAN
+        ranks = rankdata(np.abs(nz))
+        r = float((ranks[nz > 0].sum() - ranks[nz < 0].sum()) / ranks.sum())
+    out["p_value"], out["effect_r"] = p, r
+    return out
+
+
+def unpaired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confidence: float = 0.95) -> dict:
+    """Planners A and B on different episodes: each side's per-unit means (:func:`units` of each
+    side alone), compared by a two-sided Mann-Whitney U test (SciPy).
+
+    Returns
+    -------
+    dict
+        ``n_a``, ``n_b`` (units); ``mean_diff`` (mean of A's unit means minus B's) with ``diff_lo``,
+        ``diff_hi`` from a two-sample BCa bootstrap (``(d, nan, nan)`` when a side has fewer than
+        two units, ``(d, d, d)`` when both sides are constant); ``U`` (A's statistic), ``p_value``
+        and ``effect_r = 2U / (n_a n_b) - 1``, the rank-biserial correlation (positive when A has
+        the larger ``value``, as :func:`paired`).
+    """
+    x = _unit_means(a[value], units(a)).to_numpy()
+    y = _unit_means(b[value], units(b)).to_numpy()
+    out = {"n_a": len(x), "n_b": len(y)}
+    if not (len(x) and len(y)):
+        return out | {"mean_diff": NAN, "diff_lo": NAN, "diff_hi": NAN, "U": NAN, "p_value": NAN, "effect_r": NAN}
+    d = float(x.mean() - y.mean())
+    if min(len(x), len(y)) < 2:
+        ci = (d, NAN, NAN)
+    elif np.ptp(x) == 0 and np.ptp(y) == 0:
+        ci = (d, d, d)
+    else:
+        ci = _boot((x, y), _mean_diff, d, confidence, 9999, 0)
+    u, p = mannwhitneyu(x, y, alternative="two-sided")
+    return out | {"mean_diff": ci[0], "diff_lo": ci[1], "diff_hi": ci[2], "U": float(u), "p_value": float(p),
+                  "effect_r": 2.0 * float(u) / (len(x) * len(y)) - 1.0}
