@@ -105,11 +105,20 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     return RunOutput(out_dir, runs, summary)
 
 
-def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", "html"), replay: bool = True) -> list[Path]:
-    """Rebuild every table and figure of one or several results folders from their runs.csv."""
+def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", "html"), replay: bool | str = True) -> list[Path]:
+    """Rebuild every table and figure of one or several results folders from their runs.csv.
+
+    ``formats``: any of md, csv, png, pdf, svg, html (figures in each image format chosen, and in
+    PNG whenever md or html is). ``replay``: False, True (the default run) or
+    ``"PLANNER,GOAL,EPISODE,SEED"``, the run to re-simulate into a GIF."""
+    formats = list(formats)
     bad = [f for f in formats if f not in report_build.ALL_FORMATS]
-    if bad:
-        raise ScenarioError("<command line>", "--format", f"unknown format(s) {bad}; valid: {', '.join(report_build.ALL_FORMATS)}")
+    if bad or not formats:
+        what = f"unknown format(s) {', '.join(map(repr, bad))}" if bad else "no format given"
+        raise ScenarioError("<command line>", "--format", f"{what}; give a comma-separated subset of "
+                            f"{', '.join(report_build.ALL_FORMATS)}")
+    if isinstance(replay, str):
+        replay = report_build.parse_replay(replay)
     for f in folders:
         if not (Path(f) / "runs.csv").is_file():
             raise ScenarioError(str(f), "", "no runs.csv here: give a folder written by `semsearch run`")

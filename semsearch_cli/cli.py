@@ -237,14 +237,22 @@ def _print_table(title: str, df) -> None:
 def report(
     folders: List[Path] = typer.Argument(..., help="Results folders (each with a runs.csv)."),
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Where to write (default: into each results folder)."),
-    fmt: str = typer.Option("md,csv,png,html", "--format", help="Comma-separated: md, csv, png, html."),
-    replay: bool = typer.Option(True, "--replay/--no-replay", help="Also re-simulate one run into an animated GIF."),
+    fmt: str = typer.Option("md,csv,png,html", "--format",
+                            help="Comma-separated, any of md, csv, png, pdf, svg, html: every figure in each image format "
+                                 "chosen (PNG also whenever md or html is: the documents embed it)."),
+    replay: Optional[str] = typer.Option(None, "--replay", metavar="PLANNER,GOAL,EPISODE,SEED",
+                                         help="The run to re-simulate into an animated GIF (default: the median run "
+                                              "of the last planner for the first goal)."),
+    no_replay: bool = typer.Option(False, "--no-replay", help="Re-simulate no run."),
 ):
     """Rebuild the thesis' tables, significance tests and figures from runs.csv alone, plus one
     self-contained report.md / report.html per results folder."""
 
     try:
-        files = api.report(folders, out_dir, [f.strip() for f in fmt.split(",") if f.strip()], replay)
+        if replay is not None and no_replay:
+            raise ScenarioError("<command line>", "--replay", "given with --no-replay; give one of them")
+        files = api.report(folders, out_dir, [f.strip() for f in fmt.split(",") if f.strip()],
+                           False if no_replay else replay if replay is not None else True)
     except ScenarioError as exc:
         _fail(exc)
     for f in files:

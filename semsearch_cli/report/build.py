@@ -19,12 +19,75 @@ import pandas as pd
 from .. import __version__
 from ..errors import ScenarioError
 from ..files import read_user_text
-from ..runner import Loaded, read_runs
+from ..runner import Loaded, read_runs, run_rows
 from . import chain, doors, indirect, objects
+from .stats import episodes
+from .tables import goal_key, planner_order
 from .document import Code, Document, atomic_text
 
-ALL_FORMATS = ("md", "csv", "png", "html")
+ALL_FORMATS = ("md", "csv", "png", "pdf", "svg", "html")  # png, pdf, svg: every figure (GIF replays stay GIF)
 SECTIONS = {"doors": doors, "objects": objects, "chain": chain, "indirect": indirect}  # kind -> its report section
+REPLAYS = ("doors", "indirect")  # the kinds whose section re-simulates a run
+
+
+@dataclass(frozen=True)
+class ReplayChoice:
+    """The run to replay (``--replay PLANNER,GOAL,EPISODE,SEED``)."""
+
+    planner: str
+    goal: str
+    episode: int
+    seed: int
+
+
+def parse_replay(text: str) -> ReplayChoice:
+    """``PLANNER,GOAL,EPISODE,SEED`` (split from the right: a planner label may hold commas)."""
+    parts = [p.strip() for p in str(text).rsplit(",", 3)]
+    if len(parts) != 4 or not all(parts) or not parts[2].isdigit() or not parts[3].lstrip("-").isdigit():
+        raise ScenarioError("<command line>", "--replay", f"expected PLANNER,GOAL,EPISODE,SEED with whole numbers for "
+                            f"the episode and the seed (e.g. greedy,76,0,3), got {text!r}")
+    return ReplayChoice(parts[0], parts[1], int(parts[2]), int(parts[3]))
+
+
+def _same_goal(a, b) -> bool:
+    """Goals as written on the command line and as read from runs.csv (1.5 and 1.50 are one view scale)."""
+    if str(a) == str(b):
+        return True
+    try:
+        return float(a) == float(b)
+    except (TypeError, ValueError):
+        return False
+
+
+def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
+    """A :class:`ScenarioError` naming ``--replay`` and listing the runs there are, unless some
+    folder of a kind with a replay holds the chosen run."""
+    rows = [run_rows(p.runs) for k in REPLAYS for p in parts_by_kind.get(k, [])]
+    rows = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["planner", "goal", "seed"])
+    ep = episodes(rows)
+    hit = (rows["planner"].astype(str) == choice.planner) & rows["goal"].map(lambda g: _same_goal(g, choice.goal)) \
+        & (ep == choice.episode) & (pd.to_numeric(rows["seed"]) == choice.seed)
+    if len(rows) and hit.any():
+        return
+    if not len(rows):
+        raise ScenarioError("<command line>", "--replay", f"these folders hold no runs of a kind with a replay "
+                            f"({', '.join(REPLAYS)}); leave --replay out")
+
+    def span(v):
+        v = sorted(set(int(x) for x in v))
+        return f"{v[0]}-{v[-1]}" if len(v) > 2 and v[-1] - v[0] == len(v) - 1 else ", ".join(map(str, v))
+
+    seen = {"planner": rows["planner"].astype(str) == choice.planner,
+            "goal": rows["goal"].map(lambda g: _same_goal(g, choice.goal)), "episode": ep == choice.episode}
+    missing = [k for k, m in seen.items() if not m.any()]
+    why = f"no such {' or '.join(missing)}" if missing else "no run has all four together"
+    goals = sorted(rows["goal"].astype(str).unique(), key=goal_key)
+    per_goal = {g: span(ep[rows["goal"].astype(str) == g]) for g in goals}
+    eps = "; ".join(f"goal {g}: {e}" for g, e in per_goal.items()) if len(goals) <= 12 else span(ep)
+    raise ScenarioError("<command line>", "--replay", f"no run {choice.planner},{choice.goal},{choice.episode},{choice.seed} "
+                        f"(PLANNER,GOAL,EPISODE,SEED) in these rows ({why}). They hold planners "
+                        f"{', '.join(planner_order(rows['planner'].astype(str)))}; goals {', '.join(goals)}; episodes "
+                        f"({eps}); seeds {span(rows['seed'])}. Give one of those, or --no-replay.")
 
 
 def write_meta(out_dir: Path, scenario: Path) -> None:
@@ -86,10 +149,15 @@ class Part:
         return self._loaded
 
 
-def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMATS, replay: bool = True) -> list[Path]:
-    """Write tables (CSV, Markdown), figures (PNG, GIF) and one report.md / report.html for the
-    rows of all ``folders`` (into ``out``; default: the folder itself when there is one, else
-    ``results/report``). Returns the report files written."""
+def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMATS, replay=True) -> list[Path]:
+    """Write tables (CSV, Markdown), figures (PNG, PDF, SVG as ``formats`` asks; PNG whenever the
+    documents are written; GIF replays) and one report.md / report.html for the rows of all
+    ``folders`` (into ``out``; default: the folder itself when there is one, else
+    ``results/report``). ``replay``: False (none), True (each section's default run) or the run to
+    replay (a :class:`ReplayChoice` or its ``PLANNER,GOAL,EPISODE,SEED`` text), checked against
+    the rows before anything is written. Returns the report files written."""
+    if isinstance(replay, str):
+        replay = parse_replay(replay)
     t0 = time.perf_counter()
     folders = [Path(f) for f in folders]
     out = Path(out) if out is not None else folders[0] if len(folders) == 1 else Path("results") / "report"
@@ -106,6 +174,8 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
             if kind not in SECTIONS:
                 raise ScenarioError(str(folder / "runs.csv"), "kind", f"unknown kind {kind!r}; known: {', '.join(SECTIONS)}")
             parts_by_kind.setdefault(kind, []).append(Part(folder, rows.reset_index(drop=True), meta))
+    if isinstance(replay, ReplayChoice):
+        check_replay(replay, parts_by_kind)
     out.mkdir(parents=True, exist_ok=True)
     (out / "tables").mkdir(exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)

@@ -10,7 +10,8 @@ import pandas as pd
 
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import plot_chain_stages, plot_paths_overlay, plot_scenario
+from .plots import image_formats, planner_colors, plot_chain_stages, plot_path_panels, plot_scenario
+from .runfiles import load_paths, median_label, safe_name, start_points
 
 
 def chain_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -93,27 +94,38 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     doc.table(wide)
     doc.heading(3, "Do later requests get cheaper? Mean saving (%) of the k-th stage over all chains")
     doc.table(pos, fmt="{:.1f}")
-    if formats & {"png", "html", "md"}:
+    img = image_formats(formats)
+    if img:
+        order = T.planner_order(runs["planner"])
         f = out / "figures" / "chain_stages.png"
-        plot_chain_stages(stages, T.planner_order(stages["planner"]), f)
-        doc.figure(f, "Each stage's mean distance with the map kept (solid) and from scratch (hatched), per planner")
-        _path_figures(doc, parts, out / "figures", notes)
+        plot_chain_stages(runs[runs["stage"] != ""], order, f, img, planner_colors(order))
+        doc.figure(f, "Each stage's mean distance with the map kept (solid) and from scratch (hatched), per planner, "
+                      "with 95% intervals (bootstrap over units)")
+        _path_figures(doc, parts, out / "figures", notes, img, planner_colors(order))
 
 
-def _path_figures(doc: Document, parts: list, fdir: Path, notes: list) -> None:
-    """Per chain, the whole path of each planner's median run (by total distance), with the stage
-    doors numbered in order."""
+def _path_figures(doc: Document, parts: list, fdir: Path, notes: list, img=("png",), colors: dict | None = None) -> None:
+    """Per chain, one panel per planner: every run's whole path faint, the median run (by total
+    distance) bold, the stage doors starred and numbered in order."""
     for part in parts:
         loaded = part.loaded(notes, "Chain path figures")
         if loaded is None:
             continue
         w, chains = loaded.world, part.runs[part.runs["stage"] == ""]
         order = T.planner_order(chains["planner"])
-        med = T.median_run(chains)
         for goal in dict.fromkeys(chains["goal"]):
-            paths = {k: (path, float(r.distance_m)) for k, (path, r) in T.median_paths(part.folder, med, goal, order).items()}
             stages = loaded.task.stages.get(str(goal), [])
-            if not paths or not stages:
+            g = chains[chains["goal"] == goal]
+            panels = {}
+            for lab in order:
+                e = g[g["planner"] == lab]
+                found = load_paths(part.folder, e)
+                if found:
+                    med = median_label(e)
+                    idx = [i for i, _ in found]
+                    panels[lab] = ([p for _, p in found], idx.index(med) if med in idx else -1,
+                                   f"median {float(e.loc[med, 'distance_m']):.0f} m, n={len(e)}")
+            if not panels or not stages:
                 continue
             at: dict = {}  # door -> the stages there ("1, 4: 7" when a chain comes back)
             for k, s in enumerate(stages, 1):
@@ -123,9 +135,10 @@ def _path_figures(doc: Document, parts: list, fdir: Path, notes: list) -> None:
                 i = w.signs.index_of(door)
                 label = ", ".join(str(k) for k, _ in ks) + ": " + " / ".join(dict.fromkeys(lab for _, lab in ks))
                 stops.append((label, float(w.signs.x[i]), float(w.signs.y[i])))
-            f = fdir / f"chain_paths_{loaded.sc.name}_{goal}.png"
-            plot_paths_overlay(w, paths, stops, f"{loaded.sc.name}: chain {goal}, median runs", f)
-            doc.figure(f, f"Chain {goal} ({loaded.sc.name}): the median run of each planner, stages numbered in order")
+            f = fdir / f"chain_paths_{loaded.sc.name}_{safe_name(goal)}.png"
+            plot_path_panels(w, panels, stops, "", f, img, colors, start_points(g, w))
+            doc.figure(f, f"Chain {goal} ({loaded.sc.name}), one panel per planner: every run faint, the median run "
+                          "(by total distance) bold; stars: the stages' doors, numbered in order")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:

@@ -8,10 +8,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..runner import file_stem, run_rows
+from ..runner import run_rows
+from . import stats as S
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import animate_run, plot_alpha_sweep, plot_boxes, plot_paths_overlay, plot_scenario
+from .plots import (animate_run, budget_curve, image_formats, nsos_alphas, plot_alpha_sweep, plot_boxes, plot_budget,
+                    plot_path_panels, plot_scenario, planner_colors)
+from .runfiles import load_paths, median_label, safe_name, start_points, stems
 from .tables import goal_key
 
 
@@ -65,57 +68,106 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
              "(diff_lo, diff_hi). effect_r: rank-biserial correlation (matched pairs for Wilcoxon), positive when "
              "the planner travels more than the baseline.")
     doc.table(sig.set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
-    if formats & {"png", "html", "md"}:
+    if image_formats(formats):
         doc.heading(3, "Figures")
-        _figures(doc, runs, parts, out / "figures", replay, notes)
+        _figures(doc, runs, parts, out / "figures", replay, notes, formats)
 
 
-def _figures(doc, runs, parts, fdir: Path, replay: bool, notes: list) -> None:
+def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)) -> None:
+    """Per scenario: distance boxes with mean CIs, success against the distance budget, the alpha
+    sweep (when nsos ran at two alphas or more); per goal the runs over the map; one replay."""
+    img = image_formats(formats)
     order = T.planner_order(runs["planner"])
+    colors = planner_colors(order)
     for scen in sorted(runs["scenario"].astype(str).unique()):
         sub = runs[runs["scenario"].astype(str) == scen]
+        unit = S.unit_kind(sub)
         f = fdir / f"boxes_{scen}.png"
-        plot_boxes(runs.assign(scenario=runs["scenario"].astype(str)), scen, order, f)
-        doc.figure(f, f"Distance per goal and planner, {scen} (box: quartiles, line: median, triangle: mean; dashed: shortest path)")
-        if sub["planner"].str.startswith("nsos").any():
+        plot_boxes(sub, scen, order, f, img, colors)
+        doc.figure(f, f"Distance travelled per goal and planner, {scen}: boxes span the quartiles (line: median; "
+                      "whiskers: 1.5 IQR; dots: outliers); diamonds: the mean with its 95% interval over "
+                      f"{unit} (bootstrap); dashed: the shortest path; n: runs per planner and goal")
+        curve = budget_curve(sub)
+        write_table(fdir.parent / "tables", f"budget_{scen}", curve, formats)
+        shortest = sub.groupby("goal")["shortest_m"].first().to_dict()
+        f = fdir / f"budget_{scen}.png"
+        plot_budget(curve, order, f, img, colors, shortest, unit)
+        doc.figure(f, f"Success against the distance budget b, {scen}: a row per goal (goals are not pooled: their "
+                      "shortest paths differ), a column per planner; the share of runs that found the goal within b "
+                      f"metres, with its 95% interval over {unit} (clustered Wilson), the other planners in grey; "
+                      "dotted: the shortest path")
+        if len(nsos_alphas(sub)) >= 2:
             f = fdir / f"alpha_{scen}.png"
-            plot_alpha_sweep(sub, f)
-            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}")
+            plot_alpha_sweep(sub, f, formats=img, colors=colors)
+            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}, with 95% intervals over {unit}; "
+                          "dashed and shaded: greedy's mean and interval")
     for part in parts:
         loaded = part.loaded(notes, "Path figures and the replay")
         if loaded is None:
             continue
         rows = run_rows(part.runs)
-        med = T.median_run(rows)
         w = loaded.world
-        for goal in sorted(med["goal"].unique(), key=goal_key):
-            paths = {k: (path, float(r.distance_m)) for k, (path, r) in T.median_paths(part.folder, med, goal, order).items()}
-            if paths:
-                f = fdir / f"paths_{loaded.sc.name}_goal{goal}.png"
-                i = w.signs.index_of(loaded.task.goal_value(goal))
-                plot_paths_overlay(w, paths, [(f"goal {goal}", float(w.signs.x[i]), float(w.signs.y[i]))],
-                                   f"{loaded.sc.name}: median runs, goal {goal}", f)
-                doc.figure(f, f"Median run of each planner for goal {goal} ({loaded.sc.name})")
+        for goal in sorted(rows["goal"].unique(), key=goal_key):
+            g = rows[rows["goal"] == goal]
+            panels = {}
+            for lab in [p for p in order if (g["planner"] == p).any()]:
+                e = g[g["planner"] == lab]
+                found = load_paths(part.folder, e)
+                if not found:
+                    continue
+                med = median_label(e)
+                idx = [i for i, _ in found]
+                panels[lab] = ([p for _, p in found], idx.index(med) if med in idx else -1,
+                               f"median {float(e.loc[med, 'distance_m']):.0f} m, n={len(e)}")
+            if not panels:
+                continue
+            value = loaded.task.goal_value(goal)
+            stops = [(f"goal {goal}", float(w.signs.x[i]), float(w.signs.y[i])) for i in w.signs.indices_of(value)]
+            f = fdir / f"paths_{loaded.sc.name}_goal{safe_name(goal)}.png"
+            plot_path_panels(w, panels, stops, "", f, img, colors, start_points(g, w))
+            doc.figure(f, f"Goal {goal} ({loaded.sc.name}), one panel per planner: every run faint, the median run "
+                          "(by distance) bold, its end dotted; the signs near the median run numbered; squares: start"
+                          f"{'s' if len(start_points(g, w)) > 1 else ''}; star: the goal")
         if replay:
-            _replay(doc, loaded, rows, fdir, T.planner_order(rows["planner"]))
+            _replay(doc, loaded, rows, fdir, T.planner_order(rows["planner"]), replay)
 
 
-def _replay(doc, loaded, runs, fdir, order) -> None:
-    """Re-simulate (runs are deterministic) the median run of the most semantic variant for the
-    first goal, recording the belief at each decision, and write it as an animated GIF."""
+def _rerun(task, variant, goal, episode: int, seed: int, recorder):
+    """Re-simulate one run (runs are deterministic): the one place the report calls ``task.run``.
+    ``episode`` is the row's index in the task's episode set; when that episode is not of ``goal``
+    (rows from before episodes read as episode 0), the goal's first episode."""
+    ep = next((e for e in getattr(task, "episodes", ()) if e.index == episode and str(e.goal) == str(goal)), None)
+    return task.run(variant, ep if ep is not None else goal, seed, recorder=recorder)
+
+
+def _replay(doc, loaded, runs, fdir, order, choice=True) -> None:
+    """Re-simulate one run, recording the belief at each decision, as an animated GIF: ``choice``
+    (planner, goal, episode, seed: the ``--replay`` value, checked against the rows before the
+    report starts), or by default the median run of the most semantic variant for the first goal."""
     w = loaded.world
-    label = order[-1]
-    goal = sorted(runs["goal"].unique(), key=goal_key)[0]
-    med = T.median_run(runs[(runs["planner"] == label) & (runs["goal"] == goal)])
-    if med.empty:
-        return
+    ep = S.episodes(runs)
+    if choice is True:
+        label = order[-1]
+        goal = sorted(runs["goal"].unique(), key=goal_key)[0]
+        sub = runs[(runs["planner"] == label) & (runs["goal"] == goal)]
+        if sub.empty:
+            return
+        row = sub.loc[median_label(sub)]
+    else:
+        m = (runs["planner"] == choice.planner) & (runs["goal"].astype(str) == str(choice.goal)) & \
+            (ep == choice.episode) & (runs["seed"].astype(int) == choice.seed)
+        if not m.any():
+            return  # the run is in another folder of this report
+        row = runs[m].iloc[0]
+    label, goal, seed, episode = str(row["planner"]), row["goal"], int(row["seed"]), int(ep[row.name])
     variant = next((v for v in loaded.task.variants() if v.label == label), None)
     if variant is None:
         return
-    seed = int(med["seed"].iloc[0])
     frames = []
-    step = max(1, int(med["decisions"].iloc[0]) // 60)
+    step = max(1, int(row["decisions"]) // 60)
     count = [0]
+    signs = w.signs
+    where = {}
 
     def rec(belief, trail, distance, cands, dec):
         count[0] += 1
@@ -123,17 +175,25 @@ def _replay(doc, loaded, runs, fdir, order) -> None:
             return
         m = np.where(belief.seen, np.where(belief.free, 2, 0), 1).astype(np.uint8)
         cx, cy = w.frame.to_world(cands.rows, cands.cols)
+        read = []
+        for lab in belief.reads.labels:
+            if lab not in where:
+                where[lab] = signs.indices_of(lab)
+            read += where[lab]
         frames.append({"map": m[::2, ::2], "path": np.asarray(trail, float), "distance": distance,
                        "cands": np.stack([cx, cy], axis=1) if len(cands) else np.zeros((0, 2)),
-                       "target": w.frame.to_world(dec.row, dec.col)})
+                       "target": w.frame.to_world(dec.row, dec.col), "read": read})
 
-    res = loaded.task.run(variant, goal, seed, recorder=rec)
+    res = _rerun(loaded.task, variant, goal, episode, seed, rec)
     if not frames:
         return
-    f = fdir / f"replay_{loaded.sc.name}_{file_stem(label, goal, seed)}.gif"
-    animate_run(w, frames, f"{label}, goal {goal}, seed {seed}", f)
-    doc.figure(f, f"Replay of {label}, goal {goal}, seed {seed} ({res.outcome}, {res.distance_m:.1f} m): "
-               "the map as built (white free, black occupied, gray unknown), candidates and the chosen one")
+    i = signs.index_of(loaded.task.goal_value(goal))
+    mark = (f"goal {goal}", float(signs.x[i]), float(signs.y[i])) if i >= 0 else None
+    f = fdir / f"replay_{loaded.sc.name}_{stems(label, goal, seed, episode)[0]}.gif"
+    animate_run(w, frames, f"{label}, goal {goal}, episode {episode}, seed {seed}", f, goal=mark)
+    doc.figure(f, f"Replay of {label}, goal {goal}, episode {episode}, seed {seed} ({res.outcome}, {res.distance_m:.1f} m): "
+               "the map as built (white free, black occupied, grey unknown), the candidates and the chosen one, the "
+               "signs read so far (numbered) and the goal (star)")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:

@@ -13,7 +13,8 @@ from ..runner import run_rows
 from . import stats as S
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import animate_probability, plot_rooms, plot_success_by_scale
+from .plots import animate_probability, image_formats, plot_rooms, plot_success_by_scale
+from .runfiles import stems
 
 # The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each
 PAPER_SCALES = (1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -119,44 +120,69 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     doc.table(tab3)
     doc.heading(3, "Time to find (s, over the searches that found it) / SPL")
     doc.table(time_spl(table))
-    if formats & {"png", "html", "md"}:
+    img = image_formats(formats)
+    if img:
         f = out / "figures" / "indirect_success.png"
-        plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f)
-        doc.figure(f, "Success rate against the view scale, one line per method: ours with the "
-                      f"{interval_text(table)} (left), the paper's Table 3 (right)")
+        plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f, img)
+        doc.figure(f, "Success rate against the view scale, one panel per method: ours with the "
+                      f"{interval_text(table)}, beside the paper's Table 3 (grey, dashed); n: searches per view scale")
         if replay:
             for part in parts:
-                _replay(doc, part, run_rows(part.runs), out / "figures", notes)
+                _replay(doc, part, run_rows(part.runs), out / "figures", notes, replay)
 
 
-def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list) -> None:
-    """Re-simulate (runs are deterministic) the first search of ISCG-PN-SM (the paper's best; else
-    the last method) at the smallest view scale, recording the probability map at every re-plan, as a GIF."""
+def _rerun(task, variant, scale: float, episode: int, seed: int, recorder):
+    """Re-simulate one search (runs are deterministic): the one place this section calls
+    ``task.run``; returns (result, the room searched). ``episode`` is the row's index in the task's
+    episode set; when that episode is not at ``scale`` (rows from before episodes, read as episode
+    0), the scale's first episode. A task without episodes searched room ``seed mod n``."""
+    eps = getattr(task, "episodes", None)
+    if eps is None:
+        return task.run(variant, scale, seed, recorder=recorder), task.grids[seed % len(task.grids)].room
+    ep = next((e for e in eps if e.index == episode and float(e.goal) == scale), None) or task.as_episode(scale)
+    return task.run(variant, ep, seed, recorder=recorder), task.grids[ep.room].room
+
+
+def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, choice=True) -> None:
+    """Re-simulate one search, recording the probability map at every re-plan, as a GIF:
+    ``choice`` (the ``--replay`` run: planner, view scale, episode, seed), or by default the first
+    search of ISCG-PN-SM (the paper's best; else the last method) at the smallest view scale."""
     loaded = part.loaded(notes, "The replay")
     if loaded is None or runs.empty:
         return
-    order = method_order(runs["planner"])
-    label = "ISCG-PN-SM" if "ISCG-PN-SM" in order else order[-1]
-    scale = float(runs["goal"].astype(float).min())
-    sub = runs[(runs["planner"] == label) & (runs["goal"].astype(float) == scale)].sort_values("seed")
+    ep = S.episodes(runs)
+    scales = runs["goal"].astype(float)
+    if choice is True:
+        order = method_order(runs["planner"])
+        label = "ISCG-PN-SM" if "ISCG-PN-SM" in order else order[-1]
+        sub = runs[(runs["planner"] == label) & (scales == scales.min())]
+    else:
+        try:
+            scale = float(choice.goal)
+        except ValueError:
+            return
+        sub = runs[(runs["planner"] == choice.planner) & (scales == scale) & (ep == choice.episode)
+                   & (runs["seed"].astype(int) == choice.seed)]
+    if sub.empty:
+        return  # the run is in another folder of this report
+    row = sub.assign(_ep=ep[sub.index]).sort_values(["_ep", "seed"]).iloc[0]
+    label, scale, seed, episode = str(row["planner"]), float(row["goal"]), int(row["seed"]), int(ep[row.name])
     variant = next((v for v in loaded.task.variants() if v.label == label), None)
-    if variant is None or sub.empty:
+    if variant is None:
         return
-    seed = int(sub["seed"].iloc[0])
     frames = []
 
     def rec(p, p0, trail, t, goal, seen):
         frames.append({"p": p.copy(), "p0": p0, "trail": trail, "t": t, "goal": (goal.x, goal.y), "seen": seen})
 
-    res = loaded.task.run(variant, scale, seed, recorder=rec)
+    res, room = _rerun(loaded.task, variant, scale, episode, seed, rec)
     if not frames:
         return
-    grid = loaded.task.grids[seed % len(loaded.task.grids)]
-    f = fdir / f"replay_{loaded.sc.name}_{label}_{scale:g}m_seed{seed}.gif"
-    animate_probability(grid.room, loaded.task.spec.target, frames, f"{label}, view scale {scale:g} m, {grid.room.name}", f)
-    doc.figure(f, f"Replay of {label} at view scale {scale:g} m, seed {seed} ({res.outcome} after {res.time_s:.0f} s): "
-               "the robot's probability map of A at each re-plan, its path, the secondary objects seen (squares), the "
-               "goal (cross); A ringed in red")
+    f = fdir / f"replay_{loaded.sc.name}_{stems(label, f'{scale:g}', seed, episode)[0]}.gif"
+    animate_probability(room, loaded.task.spec.target, frames, f"{label}, view scale {scale:g} m, {room.name}", f)
+    doc.figure(f, f"Replay of {label} at view scale {scale:g} m, episode {episode}, seed {seed} ({res.outcome} after "
+               f"{res.time_s:.0f} s): the robot's probability map of A at each re-plan, its path (cyan), the secondary "
+               "objects seen (squares), the goal (cross); A ringed in yellow")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
@@ -166,5 +192,7 @@ def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
 
 def show(loaded, out: Path) -> None:
     t = loaded.task
-    plot_rooms([g.room for g in t.grids[:20]], f"{loaded.sc.name}: {len(t.grids)} rooms (first 20); A ({t.spec.target}) "
-               f"red, secondary objects coloured, start green", out)
+    shown = min(20, len(t.grids))
+    plot_rooms([g.room for g in t.grids[:shown]], f"{loaded.sc.name}: {len(t.grids)} rooms"
+               f"{f' (the first {shown})' if shown < len(t.grids) else ''}; A ({t.spec.target}) vermillion, secondary "
+               "objects coloured (tick: facing), start square (arrow: heading)", out)

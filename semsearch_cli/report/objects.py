@@ -16,7 +16,8 @@ from ..runner import run_rows
 from ..tasks.objects import parse_label, read_log
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import plot_heat, plot_heat_steps, plot_object_bars, plot_object_paths
+from .plots import image_formats, planner_colors, plot_heat, plot_heat_steps, plot_object_bars, plot_path_panels
+from .runfiles import load_paths, median_label, start_points
 
 ORDER = {"brute_force": 0, "last_seen": 1, "lsos": 2}
 
@@ -75,14 +76,18 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
              "tables/objects.csv adds the intervals of the mean distance (mean_lo, mean_hi: bootstrap) and of the "
              f"success rate (success_lo, success_hi: clustered Wilson), {T.interval_caption(table)}.")
     doc.table(wide)
-    if formats & {"png", "html", "md"}:
+    img = image_formats(formats)
+    if img:
         doc.heading(3, "Figures")
         fdir = out / "figures"
         f = fdir / "objects_by_case.png"
-        plot_object_bars(table, planner_order(runs["planner"]), f)
-        doc.figure(f, "Distance until the object is seen per case, request hour and planner (the thesis' Figure 5.12)")
+        order = planner_order(runs["planner"])
+        plot_object_bars(table, order, f, img, planner_colors(order))
+        doc.figure(f, "Distance until the object is seen per case, request hour and planner (the thesis' Figure 5.12): "
+                      f"the mean with its 95% interval ({T.interval_caption(table)}); hatched bars: some runs did not find "
+                      "the object (the share that did above the bar)")
         for part in parts:
-            _figures(doc, run_rows(part.runs), part, fdir, notes)
+            _figures(doc, run_rows(part.runs), part, fdir, notes, img, planner_colors(order))
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
@@ -94,18 +99,18 @@ def show(loaded, out: Path) -> None:
     task, sc = loaded.task, loaded.sc
     route = task.patrol_route()
     length = float(np.hypot(*np.diff(route, axis=0).T).sum())
-    plot_object_paths(loaded.world, {}, task.places, (), f"{sc.name}: places {' '.join(task.places)}; patrol route "
-                      f"{length:.1f} m (dotted)", out, route=route)
+    plot_path_panels(loaded.world, {}, [], f"{sc.name}: places {' '.join(task.places)}; patrol route {length:.1f} m (dotted)",
+                     out, places=task.places, route=route)
 
 
-def _figures(doc, runs, part, fdir: Path, notes: list) -> None:
+def _figures(doc, runs, part, fdir: Path, notes: list, img=("png",), colors: dict | None = None) -> None:
     order = planner_order(runs["planner"])
+    colors = colors or planner_colors(order)
     folder = part.folder
     loaded = part.loaded(notes, "Heat maps and paths")
     if loaded is None:
         return
     task, world = loaded.task, loaded.world
-    med = T.median_run(runs)
     lsos = next((lab for lab in order if lab.split("[", 1)[0] == "lsos"), None)
     stepped: set[str] = set()
     for label in dict.fromkeys(runs["goal"]):
@@ -120,23 +125,32 @@ def _figures(doc, runs, part, fdir: Path, notes: list) -> None:
             heat, goals = lsos_goals(world.frame, task.known, _log(folder, loaded, req.case), req.cls, req.hour, LsosParams(**params))
             gx = [(*world.frame.to_world(r, c), phi) for r, c, phi in goals]
             f = fdir / f"heat_{stem}.png"
-            plot_heat(world, heat, task.places, req.truth, gx,
-                      f"{req.case}: {req.cls} at {req.hour:g}:00, {lsos} heat map (Eq. 5.4) and goals (Eqs. 5.5-5.6)", f)
-            doc.figure(f, f"Heat map for {label}; red rings: where the {req.cls} is")
+            plot_heat(world, heat, task.places, req.truth, gx, f"{req.case}: {req.cls} at {req.hour:g}:00", f, img)
+            doc.figure(f, f"Heat map of {lsos} for {label} (Eq. 5.4) and its goals (Eqs. 5.5-5.6), numbered in visiting "
+                          f"order; ringed: where the {req.cls} is")
             if req.case not in stepped:  # the construction, once per case (thesis Figures 5.7-5.8)
                 stepped.add(req.case)
                 f = fdir / f"heat_steps_{stem}.png"
-                _heat_steps(task, world, _log(folder, loaded, req.case), req, LsosParams(**params), f)
+                _heat_steps(task, world, _log(folder, loaded, req.case), req, LsosParams(**params), f, img)
                 doc.figure(f, f"How the heat map for {label} is built (thesis Figures 5.7-5.8)")
-        paths = {k: (path, float(r.distance_m), r.outcome) for k, (path, r) in T.median_paths(folder, med, label, order).items()}
-        if paths:
+        panels = {}
+        for lab in order:
+            e = runs[(runs["goal"] == label) & (runs["planner"] == lab)]
+            found = load_paths(folder, e)
+            if found:
+                med = e.loc[median_label(e)]
+                idx = [i for i, _ in found]
+                panels[lab] = ([p for _, p in found], idx.index(med.name) if med.name in idx else -1,
+                               f"median {float(med['distance_m']):.0f} m, {int(e['success'].sum())}/{len(e)} found")
+        if panels:
             f = fdir / f"paths_{stem}.png"
-            plot_object_paths(world, paths, task.places, req.truth,
-                              f"{req.case}: {req.cls} at {req.hour:g}:00, median run of each planner", f)
-            doc.figure(f, f"Median runs for {label}")
+            plot_path_panels(world, panels, [], "", f, img, colors, start_points(runs[runs["goal"] == label], world),
+                             places=task.places, truth=req.truth)
+            doc.figure(f, f"{req.case}: {req.cls} requested at {req.hour:g}:00, one panel per planner: every run faint, "
+                          "the median run (by distance) bold, its end dotted; ringed: the places holding the object")
 
 
-def _heat_steps(task, world, log, req, p, out: Path) -> None:
+def _heat_steps(task, world, log, req, p, out: Path, img=("png",)) -> None:
     rows = list(zip(log["class"], log["x"], log["y"], log["hour"], log["robot_x"], log["robot_y"]))
     args = (req.hour, world.frame, p.radius, task.known)
     panels = [
@@ -146,7 +160,7 @@ def _heat_steps(task, world, log, req, p, out: Path) -> None:
         ("(d) inverted kernel IK (Eq. 5.4): what LSOS uses", heat_map(rows, req.cls, *args, sector_deg=p.sector, inverted=True)),
     ]
     plot_heat_steps(world, panels, task.places, f"{req.case}: heat map for {req.cls} at {req.hour:g}:00, step by step "
-                    f"(r = {p.radius:g} m, W of Eq. 5.3)", out)
+                    f"(r = {p.radius:g} m, W of Eq. 5.3)", out, img)
 
 
 def _log(folder: Path, loaded, case: str) -> pd.DataFrame:

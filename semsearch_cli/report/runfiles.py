@@ -1,0 +1,65 @@
+"""Runs picked from rows, and their files. A run's path file, found from its row: ``paths/<stem>.npz`` beside runs.csv, with the stem of
+:func:`~semsearch_cli.runner.file_stem`. Folders written since episodes name the episode in the
+stem (``..__goal{g}__ep{e}__seed{s}``); older ones do not (and their rows have no ``episode``
+column: episode 0). The new stem is tried first, then the old one."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..runner import file_stem
+from .stats import episodes
+
+
+def stems(planner: str, goal, seed: int, episode: int = 0) -> list[str]:
+    """The stems a run's files may have, newest naming first."""
+    try:
+        new = file_stem(planner, goal, seed, episode=episode)
+    except TypeError:  # a runner from before episodes: its stems have no episode
+        new = None
+    old = file_stem(planner, goal, seed)
+    return [s for s in (new, old) if s] if new != old else [old]
+
+
+def path_file(folder: Path, planner: str, goal, seed: int, episode: int = 0) -> Path | None:
+    """The path file of one run, or None when there is none."""
+    for stem in stems(planner, goal, seed, episode):
+        f = Path(folder) / "paths" / f"{stem}.npz"
+        if f.is_file():
+            return f
+    return None
+
+
+def load_paths(folder: Path, rows: pd.DataFrame) -> list[tuple[int, np.ndarray]]:
+    """(row label in ``rows``, path (n, 2) float, m) of every row whose path file exists, in row order."""
+    ep = episodes(rows)
+    out = []
+    for i, r in rows.iterrows():
+        f = path_file(folder, str(r["planner"]), r["goal"], int(r["seed"]), int(ep[i]))
+        if f is not None:
+            out.append((i, np.load(f)["path"]))
+    return out
+
+
+def safe_name(goal) -> str:
+    """A goal as one file-name component (a KTH room's second door is ``2512/2``)."""
+    return re.sub(r"[^A-Za-z0-9._+\-]", "_", str(goal))
+
+
+def median_label(rows: pd.DataFrame):
+    """The row label of the (lower) median run by distance, ties by seed (as :func:`.tables.median_run`)."""
+    s = rows.assign(_ep=episodes(rows)).sort_values(["distance_m", "seed", "_ep"], kind="stable")
+    return s.index[(len(s) - 1) // 2]
+
+
+def start_points(rows: pd.DataFrame, world) -> list[tuple[float, float]]:
+    """The distinct starts of ``rows`` (columns start_x, start_y), else the scenario's start."""
+    if {"start_x", "start_y"} <= set(rows.columns):
+        xy = rows[["start_x", "start_y"]].apply(pd.to_numeric, errors="coerce").dropna().round(3).drop_duplicates()
+        if len(xy):
+            return [tuple(map(float, r)) for r in xy.to_numpy()]
+    return [tuple(map(float, world.start_xy))]

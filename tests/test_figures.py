@@ -1,0 +1,213 @@
+"""Figures for papers (issue 24, item 5): every image format, the success-vs-budget curve, the
+alpha figure only for two alphas or more, the replay chosen on the command line."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import norm
+from typer.testing import CliRunner
+
+from semsearch_cli.cli import app
+from semsearch_cli.metrics import COLUMNS
+from semsearch_cli.report import stats
+from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, nsos_alphas, planner_colors, thin_labels
+from semsearch_cli.report.runfiles import load_paths, median_label, stems
+
+MAGIC = {"png": b"\x89PNG", "pdf": b"%PDF", "svg": b"<?xml"}
+
+
+@pytest.fixture(scope="module")
+def demo_runs(demo_dir, tmp_path_factory):
+    """The demo, two seeds: a results folder with its paths and meta.json."""
+    out = tmp_path_factory.mktemp("figs") / "demo"
+    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "2", "--workers", "1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    return out
+
+
+def report(*args):
+    return CliRunner().invoke(app, ["report", *map(str, args)])
+
+
+def test_every_format_is_written(demo_runs, tmp_path):
+    out = tmp_path / "r"
+    res = report(demo_runs, "--out", out, "--format", "md,csv,png,pdf,svg,html", "--no-replay")
+    assert res.exit_code == 0, res.output
+    figs = out / "figures"
+    stems_ = {f.stem for f in figs.iterdir()}
+    assert stems_ == {"boxes_demo", "budget_demo", "paths_demo_goal304", "paths_demo_goal452"}  # one alpha: no alpha figure
+    for stem in stems_:
+        for fmt, magic in MAGIC.items():
+            assert (figs / f"{stem}.{fmt}").read_bytes()[:5].startswith(magic), (stem, fmt)
+    html = (out / "report.html").read_text()
+    assert html.count("data:image/png;base64,") == 4
+    md = (out / "report.md").read_text()
+    assert "](figures/budget_demo.png)" in md and ".pdf)" not in md
+    assert (out / "tables" / "budget_demo.csv").is_file()
+
+
+def test_vector_formats_alone(demo_runs, tmp_path):
+    """pdf,svg (refused before): the figures in those formats only, no documents, no PNG."""
+    out = tmp_path / "r"
+    res = report(demo_runs, "--out", out, "--format", "pdf,svg", "--no-replay")
+    assert res.exit_code == 0, res.output
+    suffixes = {f.suffix for f in (out / "figures").iterdir()}
+    assert suffixes == {".pdf", ".svg"}
+    assert not (out / "report.md").exists() and not list((out / "tables").glob("*.csv"))
+
+
+def test_image_formats():
+    assert image_formats(["md"]) == ("png",)
+    assert image_formats(["csv"]) == ()
+    assert image_formats(["svg", "html", "pdf"]) == ("png", "pdf", "svg")
+    assert image_formats(["pdf"]) == ("pdf",)
+
+
+@pytest.mark.parametrize("fmt", ["png,tiff", "jpg", ","])
+def test_an_unknown_format_is_refused(demo_runs, tmp_path, fmt):
+    res = report(demo_runs, "--out", tmp_path / "r", "--format", fmt)
+    assert res.exit_code == 2 and "--format" in res.output and "Traceback" not in res.output, res.output
+    assert "md, csv, png, pdf, svg, html" in res.output
+    assert not list((tmp_path / "r").rglob("*"))
+
+
+# ---- success against the distance budget --------------------------------------------------------
+def wilson(k, n, z=norm.ppf(0.975)):
+    p = k / n
+    c = (p + z * z / (2 * n)) / (1 + z * z / n)
+    h = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, c - h), min(1.0, c + h)
+
+
+def rows(spec):
+    """(planner, goal, seed, success, distance_m[, episode]) -> a runs table."""
+    cols = ["planner", "goal", "seed", "success", "distance_m", "episode"]
+    return pd.DataFrame([s if len(s) == 6 else (*s, 0) for s in spec], columns=cols)
+
+
+def test_budget_curve_is_exact():
+    runs = rows([("greedy", 7, 0, 1, 10.0), ("greedy", 7, 1, 1, 20.0), ("greedy", 7, 2, 0, 30.0),
+                 ("bvp", 7, 0, 1, 15.0), ("bvp", 7, 1, 1, 15.0)])
+    before = runs.copy()
+    c = budget_curve(runs)
+    pd.testing.assert_frame_equal(runs, before)  # the input is not modified
+    assert list(c.columns) == ["goal", "planner", "budget_m", "n", "successes", "rate", "lo", "hi"]
+    assert list(dict.fromkeys(c["planner"])) == ["greedy", "bvp"]
+    g = c[c["planner"] == "greedy"]
+    # budgets: 0, the distances of the runs that found the goal, the longest run (a failure)
+    assert g["budget_m"].tolist() == [0.0, 10.0, 15.0, 20.0, 30.0]
+    assert g["successes"].tolist() == [0, 1, 1, 2, 2]  # the run that failed at 30 m never counts
+    assert g["rate"].tolist() == pytest.approx([0, 1 / 3, 1 / 3, 2 / 3, 2 / 3])
+    assert (g["n"] == 3).all()
+    b = c[c["planner"] == "bvp"]
+    assert b["successes"].tolist() == [0, 0, 2, 2, 2] and b["rate"].tolist() == [0, 0, 1, 1, 1]
+    # one episode: each run is its own unit, so the band is the plain Wilson interval
+    for k, lo, hi in zip(g["successes"], g["lo"], g["hi"]):
+        assert (lo, hi) == pytest.approx(wilson(k, 3))
+    c2 = budget_curve(runs, budgets=[25.0, 12.0])
+    assert c2[c2["planner"] == "greedy"][["budget_m", "successes"]].values.tolist() == [[12.0, 1], [25.0, 2]]
+
+
+def test_budget_curve_counts_episodes_as_units():
+    """Two episodes, two repeats each: the interval is rate_ci over the episodes, per goal."""
+    runs = rows([("greedy", 7, 0, 1, 10.0, 0), ("greedy", 7, 1, 1, 12.0, 0), ("greedy", 7, 0, 1, 40.0, 1),
+                 ("greedy", 7, 1, 0, 50.0, 1), ("greedy", 9, 0, 1, 5.0, 2)])
+    c = budget_curve(runs, budgets=[20.0])
+    r = c[c["goal"] == 7].iloc[0]
+    ok = np.array([1, 1, 0, 0], float)
+    want = stats.rate_ci(ok, ["e0", "e0", "e1", "e1"])
+    assert (r["rate"], r["lo"], r["hi"]) == pytest.approx(want, nan_ok=True) and r["rate"] == 0.5
+    assert c["goal"].tolist() == [7, 9]
+
+
+def test_thin_labels_drops_overlaps_in_order():
+    x, y = np.array([0.0, 0.5, 3.0, 0.0]), np.array([0.0, 0.0, 0.0, 2.0])
+    assert thin_labels(x, y, ["12", "13", "14", "15"], char_w=0.3, height=1.0) == [0, 2, 3]
+    assert thin_labels(x, y, ["12", "13", "14", "15"], 0.3, 1.0, fixed=[(0.5, 0.0, 1.0, 1.0)]) == [2, 3]
+
+
+def test_planner_colours_are_fixed_and_colour_blind_safe():
+    order = ["greedy", "bvp", "nsos[alpha=0.8]"]
+    assert planner_colors(order) == {"greedy": PALETTE[0], "bvp": PALETTE[1], "nsos[alpha=0.8]": PALETTE[2]}
+    assert "#F0E442" not in PALETTE  # yellow marks goals only
+
+
+# ---- the alpha figure -------------------------------------------------------------------------
+def synthetic_folder(path, alphas):
+    """A results folder of greedy and nsos at ``alphas`` (rows only: no scenario, so no maps)."""
+    rng = np.random.default_rng(1)
+    out = []
+    for goal in (54, 124):
+        for label, params in [("greedy", "{}")] + [(f"nsos[alpha={a}]", json.dumps({"alpha": a})) for a in alphas]:
+            for seed in range(4):
+                d = round(float(20 * rng.uniform(1, 3)), 1)
+                out.append({"kind": "doors", "scenario": "s", "planner": label, "params": params, "goal": goal, "seed": seed,
+                            "stage": "", "map": "", "outcome": "found", "success": 1, "distance_m": d, "shortest_m": 20.0,
+                            "ratio": d / 20, "spl": 20 / d, "steps": int(d * 10), "decisions": 3, "navigator": "geodesic",
+                            "wall_s": 0.1})
+    path.mkdir()
+    pd.DataFrame(out).reindex(columns=COLUMNS).to_csv(path / "runs.csv", index=False)
+    return path
+
+
+@pytest.mark.parametrize("alphas,drawn", [((0.9,), False), ((0.8, 0.9), True)])
+def test_alpha_figure_only_for_two_alphas(tmp_path, alphas, drawn):
+    folder = synthetic_folder(tmp_path / "s", alphas)
+    assert nsos_alphas(pd.read_csv(folder / "runs.csv")) == list(alphas)
+    res = report(folder, "--format", "png,md", "--no-replay")
+    assert res.exit_code == 0, res.output
+    assert (folder / "figures" / "alpha_s.png").is_file() == drawn
+    assert ("figures/alpha_s.png" in (folder / "report.md").read_text()) == drawn
+    assert (folder / "figures" / "boxes_s.png").is_file() and (folder / "figures" / "budget_s.png").is_file()
+
+
+# ---- the replay ---------------------------------------------------------------------------------
+def test_replay_default_and_chosen(demo_runs, tmp_path):
+    runs = pd.read_csv(demo_runs / "runs.csv")
+    ep = stats.episodes(runs)
+    res = report(demo_runs, "--out", tmp_path / "d", "--format", "png")
+    assert res.exit_code == 0, res.output
+    gif = [f.name for f in (tmp_path / "d" / "figures").glob("replay_*.gif")]
+    bvp304 = runs[(runs["planner"] == "bvp") & (runs["goal"] == 304)]
+    med = bvp304.loc[median_label(bvp304)]  # default: the median run of the last planner, first goal
+    assert gif == [f"replay_demo_{stems('bvp', 304, int(med['seed']), int(ep[med.name]))[0]}.gif"]
+    e452 = int(ep[runs["goal"] == 452].iloc[0])
+    res = report(demo_runs, "--out", tmp_path / "c", "--format", "png,md", "--replay", f"greedy,452,{e452},1")
+    assert res.exit_code == 0, res.output
+    gif = [f.name for f in (tmp_path / "c" / "figures").glob("replay_*.gif")]
+    assert gif == [f"replay_demo_{stems('greedy', 452, 1, e452)[0]}.gif"]
+    assert "greedy__goal452" in gif[0] and gif[0].endswith("seed1.gif")
+    md = (tmp_path / "c" / "report.md").read_text()
+    assert f"Replay of greedy, goal 452, episode {e452}, seed 1" in md
+
+
+@pytest.mark.parametrize("value,says", [("nsos,304,0,0", "no such planner"), ("greedy,304,0,7", "seeds 0, 1"),
+                                        ("greedy,304", "PLANNER,GOAL,EPISODE,SEED"), ("greedy,304,x,0", "whole numbers")])
+def test_a_bad_replay_exits_2(demo_runs, tmp_path, value, says):
+    res = report(demo_runs, "--out", tmp_path / "r", "--replay", value)
+    assert res.exit_code == 2 and "--replay" in res.output and "Traceback" not in res.output, res.output
+    assert says in res.output
+    if "no such" in says:
+        assert "greedy, bvp" in res.output and "goals 304, 452" in res.output
+    assert not list((tmp_path / "r").rglob("*"))  # refused before anything is written
+
+
+def test_replay_and_no_replay_together_exit_2(demo_runs, tmp_path):
+    res = report(demo_runs, "--out", tmp_path / "r", "--replay", "greedy,304,0,0", "--no-replay")
+    assert res.exit_code == 2 and "--no-replay" in res.output
+
+
+# ---- path files -------------------------------------------------------------------------------
+def test_path_files_new_stem_then_old(demo_runs, tmp_path):
+    """A folder from before episodes names its path files without ``__ep``: they are still found."""
+    runs = pd.read_csv(demo_runs / "runs.csv")
+    some = runs[runs["planner"] == "greedy"]
+    assert len(load_paths(demo_runs, some)) == len(some)
+    old = tmp_path / "old"
+    (old / "paths").mkdir(parents=True)
+    r = some.iloc[0]
+    np.savez(old / "paths" / f"{stems('greedy', r['goal'], int(r['seed']))[-1]}.npz", path=np.zeros((3, 2)))
+    got = load_paths(old, some.drop(columns=["episode"], errors="ignore").iloc[:1])
+    assert len(got) == 1 and got[0][1].shape == (3, 2)
