@@ -64,7 +64,7 @@ def thesis_tables(say, out: Path) -> None:
     say("| config | runs | wall (s) | sum of run times (s) | km travelled |")
     say("|---|---|---|---|---|")
     n_all = wall_all = 0.0
-    for name in ("normal", "inverse", "hotel", "kth"):
+    for name in ("normal", "inverse", "hotel_thesis", "kth"):
         t0 = time.perf_counter()
         L = Loaded.load(repo / "configs" / f"{name}.yaml")
         specs = expand(L, 10, planners=["greedy", "nsos"])

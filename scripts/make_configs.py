@@ -34,6 +34,10 @@ LIBRARY = {
 }
 
 
+# the main job draws its starts (README: episodes); the thesis' fixed start stays in <name>_thesis.yaml
+EPISODES = {"hotel": ({"starts": 10, "seed": 0, "min_distance": 10.0}, 1)}  # name: (episodes section, repeats)
+
+
 def main() -> None:
     root = Path(__file__).resolve().parents[1]
     for name, (lay, scheme, seed, spacing, signs, goals, floor, delta, what) in LIBRARY.items():
@@ -47,6 +51,18 @@ def main() -> None:
         header = (f"# {name}: {signs} signs, goals {', '.join(map(str, goals))} (as the thesis' Table 4.1); {what}.\n"
                   f"# Our own building: semsearch generate building --layout {lay} --numbering {scheme} --seed {seed} "
                   f"--spacing {spacing} --signs {signs} (floor digit {floor}); regenerate with scripts/make_configs.py.\n")
+        if name in EPISODES:
+            thesis = {**scen, "name": f"{name}_thesis"}
+            (root / "configs" / f"{name}_thesis.yaml").write_text(
+                header + f"# The thesis' fixed start, one episode per goal, 10 seeds; configs/{name}.yaml draws its starts.\n"
+                + yaml.safe_dump(thesis, sort_keys=False))
+            print(f"configs/{name}_thesis.yaml")
+            section, repeats = EPISODES[name]
+            scen = {k: v for k, v in scen.items() if k != "experiment"}
+            scen["episodes"] = section
+            scen["experiment"] = {**thesis["experiment"], "seeds": repeats}
+            header += (f"# Episodes: {section['starts']} starts drawn per goal (at least {section['min_distance']:g} m from it), "
+                       f"{repeats} run each; the thesis' fixed start is configs/{name}_thesis.yaml.\n")
         (root / "configs" / f"{name}.yaml").write_text(header + yaml.safe_dump(scen, sort_keys=False))
         print(f"configs/{name}.yaml")
     (root / "maps" / "office").mkdir(parents=True, exist_ok=True)

@@ -12,12 +12,13 @@ import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, with_param
 from .errors import ScenarioError
-from .planners import expand_variants
+from .planners import PLANNERS, expand_variants, load_entry_points
 from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Loaded, check_folder, check_kind, expand, folder_lock, make_executor, run_batch, run_rows
+from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import output_file, output_folder, temp_path
 
@@ -96,7 +97,7 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
     out_dir = default_out(loaded, out)
     with folder_lock(out_dir):
         check_folder(loaded, out_dir, force)
-        report_build.write_meta(out_dir, loaded.path)
+        report_build.write_meta(out_dir, loaded)
         loaded.task.write_inputs(out_dir)
         runs = run_batch(loaded, specs, out_dir, workers, progress, trace, executor=executor, scheduler=scheduler)
         summary = write_summary(runs, out_dir)
@@ -189,7 +190,7 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
             if not specs:
                 raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
             with folder_lock(sub):
-                report_build.write_meta(sub, ld.path)
+                report_build.write_meta(sub, ld)
                 ld.task.write_inputs(sub)
                 runs = run_batch(ld, specs, sub, workers, progress, trace, force=force, executor=executor,
                                  scheduler=scheduler, runner=runner)
@@ -235,8 +236,13 @@ def record(scenario: str | Path, out: str | Path, cases=None) -> list[tuple[Path
 
 
 def validate(scenario: str | Path) -> dict:
-    """Every check of the loader, plus counts and each goal's shortest path (no simulation)."""
-    return Loaded.load(Path(scenario)).task.describe()
+    """Every check of the loader, plus counts, each goal's shortest path from the scenario's start
+    and the episode set (no simulation)."""
+    task = Loaded.load(Path(scenario)).task
+    eps = task.episodes
+    sp = [e.shortest_m for e in eps]
+    return {**task.describe(), "episodes": f"{len(eps)} over {len({str(e.goal) for e in eps})} goals, shortest paths "
+            f"{min(sp):.1f}-{max(sp):.1f} m, set hash {set_hash(eps)} (semsearch episodes writes them)"}
 
 
 def show(scenario: str | Path, out: str | Path) -> Path:
@@ -244,3 +250,43 @@ def show(scenario: str | Path, out: str | Path) -> Path:
     out = output_file(out, "--out", (".png", ".pdf", ".svg"))
     loaded = Loaded.load(Path(scenario))
     return report_build.show(loaded, out)
+
+
+def episodes(scenario: str | Path, out: str | Path) -> tuple[Path, list, str]:
+    """Write a scenario's episode set to the CSV ``out`` (episode, goal, start_x, start_y,
+    start_heading, room, shortest_m, hash), atomically; returns (file, episodes, set hash).
+    ``episodes: {file: that.csv}`` in a scenario runs exactly that set."""
+    loaded = Loaded.load(Path(scenario))
+    eps = loaded.task.episodes
+    rows = pd.DataFrame([e.row() for e in eps], columns=EPISODE_COLUMNS)
+    if loaded.kind == "indirect":
+        rows["room"] = [loaded.task.room_name(e) for e in eps]
+    path = output_file(out, "--out", (".csv",))
+    tmp = temp_path(path)
+    rows.to_csv(tmp, index=False)
+    os.replace(tmp, path)
+    return path, eps, set_hash(eps)
+
+
+def planners(scenario: str | Path | None = None) -> list[dict]:
+    """Every planner semsearch can run: built-in, from installed packages (entry points) and,
+    with ``scenario``, from the files it names; each with its kind of search, where it comes
+    from, its description and its parameters (name, type, default, description)."""
+    load_entry_points()
+    own = {}
+    if scenario is not None:
+        loaded = Loaded.load(Path(scenario))
+        own = {v.name: v.module for v in loaded.task.variants() if v.module}
+    out = []
+    for name, cls in sorted(PLANNERS.items(), key=lambda kv: (kv[1].task, kv[0])):
+        mod = cls.__module__
+        source = (f"file {own[name]}" if name in own else "built-in" if mod.startswith("semsearch_cli.")
+                  else f"module {mod}")
+        if mod.startswith("semsearch_user_planners.") and name not in own:
+            continue  # a file some other scenario loaded in this process
+        doc = (cls.__doc__ or "").strip().split("\n\n")[0]
+        params = [{"name": k, "type": getattr(f.annotation, "__name__", str(f.annotation)),
+                   "default": None if f.is_required() else f.default, "description": f.description or ""}
+                  for k, f in cls.Params.model_fields.items()]
+        out.append({"name": name, "kind": cls.task, "source": source, "description": " ".join(doc.split()), "params": params})
+    return out

@@ -15,7 +15,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from rich.text import Text
 
-from . import __version__, api
+from . import api
+from .provenance import version_line
 from .belief.presence import presence_scores, read_counts
 from .config.base import MAX_SEEDS
 from .config.indirect import IndirectSpec
@@ -32,8 +33,7 @@ from .world.mobilesim import import_mobilesim as imp_mobilesim
 from .world.ros_import import import_ros as imp_ros
 from .files import output_folder, temp_path
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
-                  help="Object-search planners in a fast 2D grid simulator: run scenarios over seeds, write tables and plots.")
+app = typer.Typer(add_completion=False, no_args_is_help=True)
 import_app = typer.Typer(no_args_is_help=True, help="Convert maps from other tools into scenarios.")
 app.add_typer(import_app, name="import")
 # markup off: file names, planner names and goals are printed as they are, never read as [style] tags
@@ -487,8 +487,56 @@ def import_kth(
 
 @app.command()
 def version():
-    """Print the semsearch version."""
-    out.print(__version__)
+    """Print the semsearch version, the hash of its code and the git commit it runs from."""
+    out.print(version_line())
+
+
+def _version(value: bool) -> None:
+    if value:
+        out.print(version_line())
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _main(show_version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                            help="Print the version, code hash and git commit, and exit.")):
+    """Object-search planners in a fast 2D grid simulator: run scenarios over episodes and seeds,
+    write tables and plots."""
+
+
+@app.command()
+def episodes(
+    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    out_file: str = typer.Option("episodes.csv", "--out", callback=_path, help="CSV to write."),
+):
+    """Write a scenario's episode set (each start and goal, its shortest path and a content hash)
+    to a CSV, to freeze, share or name it: `episodes: {file: episodes.csv}` in a scenario runs it."""
+
+    try:
+        path, eps, h = api.episodes(scenario, out_file)
+    except ScenarioError as exc:
+        _fail(exc)
+    goals = len({str(e.goal) for e in eps})
+    out.print(f"wrote {path}: {len(eps)} episodes over {goals} goals, set hash {h}")
+
+
+@app.command("planners")
+def planners_cmd(scenario: Optional[Path] = typer.Argument(None, help="Also list the planners this scenario's files register.")):
+    """List every planner (built-in, from installed packages, and a scenario's own files) with its
+    kind of search, where it comes from, its parameters, their defaults and descriptions."""
+
+    try:
+        found = api.planners(scenario)
+    except ScenarioError as exc:
+        _fail(exc)
+    t = Table(title="planners (parameters: name = default, description)")
+    for col in ("name", "kind", "source", "description", "parameters"):
+        t.add_column(col, overflow="fold")
+    for p in found:
+        params = "\n".join(f"{q['name']} = {q['default']!r}" + (f": {q['description']}" if q["description"] else "")
+                           for q in p["params"]) or "none"
+        t.add_row(p["name"], p["kind"], p["source"], p["description"], params)
+    out.print(t)
 
 
 def main() -> None:

@@ -3,9 +3,14 @@
 from __future__ import annotations
 
 import json
+import math
 
-COLUMNS = ["kind", "scenario", "planner", "params", "goal", "seed", "stage", "map", "outcome", "success", "distance_m",
-           "shortest_m", "ratio", "spl", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint"]
+COLUMNS = ["kind", "scenario", "planner", "params", "goal", "episode", "seed", "start_x", "start_y", "start_heading",
+           "room", "stage", "map", "outcome", "cause", "success", "distance_m", "shortest_m", "ratio", "spl", "soft_spl",
+           "left_m", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint", "code"]
+
+# the failure cause of each outcome (empty for a run that found its goal)
+CAUSES = {"found": "", "not_found": "explored", "stuck": "stuck", "budget": "budget", "error": "error"}
 
 
 def spl(success: bool, shortest: float, distance: float) -> float:
@@ -14,28 +19,53 @@ def spl(success: bool, shortest: float, distance: float) -> float:
     return shortest / max(shortest, distance) if success and shortest > 0 else 0.0
 
 
-def run_row(kind: str, scenario: str, variant, goal, seed: int, result, shortest: float, navigator: str) -> dict:
-    """One row: the run's identity (kind, scenario, planner label and parameters, goal, seed), its
-    outcome and distance beside the shortest path, SPL and counts. ``stage`` and ``map`` are
-    empty here; per-stage rows of chains fill them. ``time_s`` is the simulated time of a task
-    with a clock (indirect search), empty for the others."""
+def soft_spl(shortest: float, distance: float, left: float) -> float:
+    """SoftSPL (Datta et al. 2020) of one run: ``(1 - left / shortest) * shortest / max(shortest,
+    distance)``, the progress made towards the goal (``left``: the geodesic distance left where the
+    run ended, 0 when it succeeded) weighted by path length; the progress term is clipped at 0 (a
+    run that ends farther than it started made none). NaN when ``left`` is unknown."""
+    if not shortest > 0:
+        return 1.0 if left == 0 else 0.0
+    if not left == left:
+        return float("nan")
+    progress = max(0.0, 1.0 - (left if math.isfinite(left) else shortest) / shortest)
+    return progress * shortest / max(shortest, distance)
+
+
+def run_row(kind: str, scenario: str, variant, ep, seed: int, result, navigator: str, room: str = "") -> dict:
+    """One row: the run's identity (kind, scenario, planner label and parameters, goal, episode,
+    repeat and start), its outcome and, when it failed, why (``cause``: budget, stuck, explored
+    (nowhere left to look), error), its distance beside the episode's shortest path, SPL, SoftSPL,
+    the distance left to the goal, and counts. ``stage`` and ``map`` are empty here; per-stage rows
+    of chains fill them. ``time_s`` is the simulated time of a task with a clock (indirect
+    search), empty for the others; ``room`` the room an indirect search searched."""
     success = result.outcome == "found"
     d = result.distance_m
+    shortest = ep.shortest_m
+    left = result.left_m
     return {
         "kind": kind,
         "scenario": scenario,
         "planner": variant.label,
         "params": json.dumps(dict(variant.params), sort_keys=True),
-        "goal": goal,
+        "goal": ep.goal,
+        "episode": ep.index,
         "seed": seed,
+        "start_x": round(ep.x, 4),
+        "start_y": round(ep.y, 4),
+        "start_heading": round(math.degrees(result.start_heading), 3) if result.start_heading == result.start_heading else "",
+        "room": room,
         "stage": "",
         "map": "",
         "outcome": result.outcome,
+        "cause": CAUSES.get(result.outcome, result.outcome),
         "success": int(success),
         "distance_m": round(d, 3),
         "shortest_m": round(shortest, 3),
         "ratio": round(d / shortest, 4) if shortest > 0 else float("nan"),
         "spl": round(spl(success, shortest, d), 4),
+        "soft_spl": round(soft_spl(shortest, d, 0.0 if success else left), 4) if d == d else float("nan"),
+        "left_m": round(left, 3) if left == left else "",
         "time_s": round(result.time_s, 2) if result.time_s == result.time_s else "",
         "steps": result.steps,
         "decisions": result.decisions,

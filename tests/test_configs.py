@@ -9,7 +9,7 @@ from semsearch_cli.planners import expand_variants
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 TABLE_4_1 = {"normal": (113, [54, 55, 111, 124]), "inverse": (116, [54, 55, 111, 124]),
-             "hotel": (124, [76, 135, 148, 185]), "kth": (47, [756])}
+             "hotel_thesis": (124, [76, 135, 148, 185]), "kth": (47, [756])}
 
 
 @pytest.mark.parametrize("name", sorted(TABLE_4_1))
@@ -19,8 +19,16 @@ def test_config_matches_table_4_1(name):
     assert len(L.world.signs) == signs
     assert L.sc.goals == goals
     assert [v.label for v in expand_variants(L.sc.planners)] == ["greedy", "bvp", "nsos[alpha=0.8]", "nsos[alpha=0.9]", "nsos[alpha=1.0]"]
-    assert L.sc.experiment.seeds == 10
+    assert L.sc.experiment.seeds == 10 and L.sc.episodes is None  # the thesis' fixed start, one episode per goal
     assert all(L.world.readable_mask(i).any() for i in range(len(L.world.signs)))
+
+
+def test_the_main_job_draws_ten_starts_per_goal():
+    thesis, main = Loaded.load(CONFIGS / "hotel_thesis.yaml"), Loaded.load(CONFIGS / "hotel.yaml")
+    assert list(main.world.signs.number) == list(thesis.world.signs.number) and main.sc.goals == thesis.sc.goals
+    eps = main.task.episodes
+    assert len(eps) == 40 and all(sum(e.goal == g for e in eps) == 10 for g in main.sc.goals)
+    assert min(e.shortest_m for e in eps) >= 10.0 and main.sc.experiment.seeds == 1
 
 
 def test_numbering_follows_the_thesis_description():

@@ -217,8 +217,8 @@ def test_a_goal_with_a_slash_writes_its_path_file(tmp_path):
     L = Loaded.load(p)
     runs = run_batch(L, expand(L, 1), tmp_path / "out", 1)
     assert runs["outcome"].tolist() == ["found"]
-    assert "/" not in file_stem("greedy", "12/2", 0)
-    assert (tmp_path / "out" / "paths" / f"{file_stem('greedy', '12/2', 0)}.npz").is_file()
+    assert "/" not in file_stem("greedy", "12/2", 0, 0)
+    assert (tmp_path / "out" / "paths" / f"{file_stem('greedy', '12/2', 0, 0)}.npz").is_file()
 
 
 def test_views_needed_for_a_camera_that_misses():

@@ -83,7 +83,7 @@ def test_every_task_and_planner(kind, planner, tmp_path):
     assert set(a["kind"]) == {kind}
     assert (a["outcome"].isin(["found", "not_found", "stuck", "budget"])).all()
     assert (a["distance_m"] <= loaded.sc.experiment.max_distance + loaded.sc.robot.step).all()
-    key = ["planner", "goal", "seed", "stage", "map"]
+    key = ["planner", "goal", "episode", "seed", "stage", "map"]
     cols = [c for c in a.columns if c != "wall_s"]
     pd.testing.assert_frame_equal(a.sort_values(key)[cols].reset_index(drop=True), b.sort_values(key)[cols].reset_index(drop=True))
 

@@ -102,7 +102,7 @@ def test_trace_and_sweep_alpha(demo_dir, tmp_path):
     runs = pd.read_csv(out / "runs.csv")
     assert sorted(runs["planner"]) == ["greedy", "nsos[alpha=0.8]", "nsos[alpha=1.0]"]
     assert (out / "plots" / "alpha_sweep.png").is_file()
-    lines = (out / "traces" / "nsos_alpha0.8__goal452__seed0.jsonl").read_text().splitlines()
+    lines = (out / "traces" / "nsos_alpha0.8__goal452__ep1__seed0.jsonl").read_text().splitlines()
     assert len(lines) == runs[runs.planner == "nsos[alpha=0.8]"]["decisions"].iloc[0]
     d = json.loads(lines[-1])
     for key in ("step", "x", "y", "heading_deg", "chosen", "candidates"):

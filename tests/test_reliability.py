@@ -135,9 +135,9 @@ def test_user_text_is_not_console_markup(demo_dir, tmp_path):
 def test_the_run_list_is_computed_not_stored(demo_loaded):
     specs = expand(demo_loaded, 10**6)
     assert len(specs) == 2 * 2 * 10**6  # goals x planners x seeds, with no list behind it
-    assert specs[-1].key == (specs.variants[-1].label, str(specs.goals[-1]), 10**6 - 1)
+    assert specs[-1].key == (specs.variants[-1].label, str(specs.goals[-1]), specs.episodes[-1].index, 10**6 - 1)
     assert list(specs[:3]) == [next(iter(specs)), specs[1], specs[2]]
-    assert specs.has_key(specs[123457].key) and not specs.has_key(("greedy", "304", 10**6))
+    assert specs.has_key(specs[123457].key) and not specs.has_key(("greedy", "304", 0, 10**6))
 
 
 def test_workers_are_handed_runs_as_they_free_up(demo_loaded, tmp_path):

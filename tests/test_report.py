@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from scipy.stats import mannwhitneyu
+from scipy.stats import wilcoxon
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
@@ -41,18 +41,19 @@ def test_statistics_match_pandas():
     assert list(five.columns) == ["greedy", "bvp", "nsos[alpha=0.9]"]
 
 
-def test_significance_is_scipys_mann_whitney():
+def test_significance_is_paired_on_shared_seeds():
+    """Planners that ran the same (episode, seed) are compared pair by pair: Wilcoxon's
+    signed-rank test on the differences, their mean, and the rank-biserial effect."""
     runs = fixed_runs()
     sig = T.significance(runs).set_index(["goal", "planner"])
-    a = runs[(runs.goal == 124) & (runs.planner == "nsos[alpha=0.9]")]["distance_m"]
-    b = runs[(runs.goal == 124) & (runs.planner == "greedy")]["distance_m"]
-    u, p = mannwhitneyu(a, b, alternative="two-sided")
+    pick = lambda lab: runs[(runs.goal == 124) & (runs.planner == lab)].sort_values("seed")["distance_m"].to_numpy()  # noqa: E731
+    d = pick("nsos[alpha=0.9]") - pick("greedy")
     row = sig.loc[(124, "nsos[alpha=0.9]")]
-    assert row["U"] == u and row["p_value"] == pytest.approx(p)
-    assert row["effect_r"] == pytest.approx(1 - 2 * u / 36, abs=1e-3) and row["effect_r"] > 0.5  # nsos travels less
+    assert row["test"] == "wilcoxon signed-rank, paired on repeats" and row["n_pairs"] == 6
+    assert row["p_value"] == pytest.approx(wilcoxon(d).pvalue)
+    assert row["mean_diff"] == pytest.approx(d.mean(), abs=1e-3) and row["effect_r"] < -0.5  # nsos travels less
     assert row["note"] == ""
-    small = T.significance(fixed_runs(3))
-    assert (small["note"].str.contains("too few")).all()
+    assert T.significance(fixed_runs(3))["note"].str.contains("too few").all()
 
 
 def test_best_and_worst_are_marked():

@@ -103,8 +103,53 @@ class NavigationSpec(Strict):
     replan_every: float = Field(1.0, gt=0.0, le=MAX_COORD, description="m travelled between periodic re-plans")
 
 
+class EpisodeSpec(Strict):
+    """One start/goal problem given by hand: the goal (a door number, a request label, a chain's
+    name; for indirect search, the room's name, the view scales being the goals) and the start."""
+
+    goal: Union[int, str]
+    x: Coord
+    y: Coord
+    heading: Union[Angle, Literal["random"]] = Field("random", description="degrees, or random (drawn per repeat)")
+
+
+MAX_EPISODES = 100_000
+
+
+class EpisodesSpec(Strict):
+    """The episode set: start/goal problems, each run ``experiment.seeds`` times (the repeats).
+
+    Give one of ``starts`` (drawn), ``list`` (by hand) or ``file`` (a CSV written by ``semsearch
+    episodes``). Without an ``episodes`` section a scenario has one episode per goal, from its
+    ``start`` (the thesis' fixed starts)."""
+
+    starts: int | None = Field(None, ge=1, le=MAX_EPISODES,
+                               description="starts drawn per goal (indirect search: per room) from the reachable free space")
+    seed: int = Field(0, ge=0, le=2**31, description="the draw's seed (the same seed, the same set)")
+    where: Literal["anywhere", "corridors", "rooms"] = Field(
+        "anywhere", description="draw only in corridors (free space narrower than corridor_width) or only in rooms (the rest)")
+    corridor_width: float = Field(3.0, gt=0.0, le=MAX_RADIUS * 2, description="m, free space narrower than this is corridor")
+    min_distance: float = Field(0.0, ge=0.0, le=MAX_COORD, description="m, least geodesic distance from a start to its goal")
+    max_distance: float | None = Field(None, gt=0.0, le=MAX_COORD, description="m, greatest geodesic distance to the goal")
+    shared: bool = Field(False, description="one set of starts for every goal (each within the distances of every goal)")
+    given: list[EpisodeSpec] | None = Field(None, alias="list", description="episodes given by hand")
+    file: str | None = Field(None, description="a CSV of episodes (goal, start_x, start_y, start_heading), e.g. from semsearch episodes")
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        given = [k for k, f in (("starts", "starts"), ("list", "given"), ("file", "file")) if getattr(self, f) is not None]
+        if len(given) != 1:
+            raise ValueError("give exactly one of starts (drawn), list (by hand) or file (a CSV)"
+                             + (f"; got {' and '.join(given)}" if given else ""))
+        if self.given is not None and not self.given:
+            raise ValueError("list is empty: give at least one episode")
+        if self.max_distance is not None and self.max_distance <= self.min_distance:
+            raise ValueError(f"max_distance ({self.max_distance:g} m) must exceed min_distance ({self.min_distance:g} m)")
+        return self
+
+
 class ExperimentSpec(Strict):
-    seeds: int = Field(10, ge=1, le=MAX_SEEDS, description="runs per goal and planner variant")
+    seeds: int = Field(10, ge=1, le=MAX_SEEDS, description="repeats of each episode per planner variant (the seed column)")
     base_seed: int = Field(0, ge=0, le=2**31)
     max_distance: float = Field(2000.0, gt=0.0, le=MAX_COORD, description="m, budget per run")
     max_steps: int | None = Field(None, ge=1, le=10**9)

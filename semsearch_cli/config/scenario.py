@@ -19,7 +19,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import ScenarioError
 from ..files import read_user_text
-from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
+from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
 from .chain import ChainSpec
 from .indirect import IndirectSpec
@@ -48,6 +48,7 @@ class Scenario(Strict):
     duplicates: Literal["error", "keep-first", "any"] = Field(
         "error", description="signs sharing a number: refuse them, keep the first of each, or accept any as the goal")
     planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
+    episodes: EpisodesSpec | None = Field(None, description="start/goal problems (default: one per goal, from start)")
     experiment: ExperimentSpec = ExperimentSpec()
     robot: RobotSpec = RobotSpec()
     laser: LaserSpec = LaserSpec()

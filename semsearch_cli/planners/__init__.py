@@ -7,11 +7,11 @@ and :func:`register_planner` (door search), :class:`ObjectPlanner` and :class:`O
 search).
 """
 
-from .base import (PLANNERS, Decision, NoParams, PlanContext, Planner, Variant, expand_variants, load_entry_points,
-                   load_planner_file, register_planner)
+from .base import (PLANNERS, Decision, NoParams, PlanContext, Planner, Variant, code_of, expand_variants, load_entry_points,
+                   load_planner_file, planner_class, register_planner)
 from .doors import bvp, draft, greedy, nsos  # noqa: F401  (registration side effect)
 from .indirect import Goal, IndirectContext, IndirectPlanner
 from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 
 __all__ = ["PLANNERS", "Decision", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "PlanContext", "Planner",
-           "Variant", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "register_planner"]
+           "Variant", "code_of", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class", "register_planner"]

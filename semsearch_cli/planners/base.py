@@ -22,7 +22,7 @@ import math
 import sys
 import traceback
 from dataclasses import dataclass, field
-from importlib.metadata import entry_points
+from importlib.metadata import entry_points, packages_distributions, version
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -30,8 +30,10 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..belief import Belief, Candidates
+from .. import __version__
 from ..errors import ScenarioError
 from ..files import user_file
+from ..provenance import code_hash
 
 
 class NoParams(BaseModel):
@@ -163,11 +165,7 @@ class Variant:
         return f"{self.name}[" + ",".join(f"{k}={v}" for k, v in self.params) + "]"
 
     def build(self) -> Planner:
-        if self.module is not None:
-            load_planner_file(self.module)
-        elif self.name not in PLANNERS:
-            load_entry_points()
-        cls = PLANNERS[self.name]
+        cls = planner_class(self)
         return cls(cls.Params(**dict(self.params)))
 
 
@@ -214,4 +212,37 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
             if key not in seen:
                 seen.add(key)
                 out.append(v)
+    return out
+
+
+def planner_class(variant: Variant) -> type[Planner]:
+    """The registered class of a variant's planner (its file or entry point loaded first)."""
+    if variant.module is not None:
+        load_planner_file(variant.module)
+    elif variant.name not in PLANNERS:
+        load_entry_points()
+    return PLANNERS[variant.name]
+
+
+def code_of(variant: Variant) -> dict:
+    """What a variant's results depend on besides the scenario: semsearch's own code (version and
+    hash of its files) and the planner's: a user's file by its bytes, a planner from an installed
+    package by that distribution's name and version. ``hash`` (16 hex digits) combines them; rows
+    carry it in their ``code`` column."""
+    cls = planner_class(variant)
+    out = {"planner": variant.label, "semsearch": __version__, "semsearch_code": code_hash()}
+    mod = cls.__module__
+    if variant.module is not None:
+        out["source"] = "file"
+        out["file"] = variant.module
+        out["file_sha256"] = hashlib.sha256(Path(variant.module).read_bytes()).hexdigest()
+    elif mod == "semsearch_cli" or mod.startswith("semsearch_cli."):
+        out["source"] = "built-in"
+    else:
+        top = mod.split(".", 1)[0]
+        dists = packages_distributions().get(top, [])
+        out["source"] = "entry point"
+        out["distribution"] = ", ".join(f"{d} {version(d)}" for d in dists) or f"module {mod} (no distribution found)"
+    parts = [out["semsearch"], out["semsearch_code"], out.get("file_sha256", ""), out.get("distribution", "")]
+    out["hash"] = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     return out

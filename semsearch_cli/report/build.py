@@ -7,7 +7,9 @@ when it is gone."""
 from __future__ import annotations
 
 import datetime
+import hashlib
 import json
+import os
 import shlex
 import sys
 import time
@@ -17,9 +19,12 @@ from pathlib import Path
 import pandas as pd
 
 from .. import __version__
+from .. import provenance
 from ..errors import ScenarioError
+from ..planners import code_of
 from ..files import read_user_text
 from ..runner import Loaded, read_runs, run_rows
+from ..tasks.episodes import set_hash
 from . import chain, doors, indirect, objects
 from .stats import episodes
 from .tables import goal_key, planner_order
@@ -90,18 +95,66 @@ def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
                         f"({eps}); seeds {span(rows['seed'])}. Give one of those, or --no-replay.")
 
 
-def write_meta(out_dir: Path, scenario: Path) -> None:
-    """Record, beside runs.csv, the scenario and the command that produced (or extended) it."""
+def write_meta(out_dir: Path, loaded: Loaded) -> None:
+    """Record, beside runs.csv, what produced (or extended) it: the commands, the scenario (its
+    path relative to the folder, the hash of its bytes, its fingerprint and its episode set),
+    each planner's code (:func:`~semsearch_cli.planners.code_of`), and semsearch's version, code
+    hash, git commit and the versions of Python and the libraries (:mod:`semsearch_cli.provenance`)."""
     out_dir.mkdir(parents=True, exist_ok=True)
     f = out_dir / "meta.json"
     meta = read_meta(out_dir)
     meta.setdefault("commands", [])
-    meta["scenario"] = str(Path(scenario).resolve())
-    meta["semsearch"] = __version__
+    scenario = Path(loaded.path).resolve()
+    meta["scenario"] = os.path.relpath(scenario, out_dir.resolve())
+    meta["scenario_sha256"] = hashlib.sha256(scenario.read_bytes()).hexdigest()
+    meta["fingerprint"] = loaded.fingerprint
+    eps = loaded.task.episodes
+    meta["episodes"] = {"count": len(eps), "hash": set_hash(eps)}
+    planners = {}
+    for v in loaded.task.variants():
+        code = code_of(v)
+        if "file" in code:
+            code["file"] = os.path.relpath(code["file"], out_dir.resolve())
+        planners[v.label] = code
+    meta["planners"] = planners
+    meta["semsearch"] = provenance.describe()
     cmd = "semsearch " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if Path(sys.argv[0]).name == "semsearch" else " ".join(sys.argv)
     if cmd not in meta["commands"]:
         meta["commands"].append(cmd)
     atomic_text(f, json.dumps(meta, indent=2))
+
+
+def scenario_of(folder: Path, meta: dict) -> Path | None:
+    """The scenario file meta.json names (relative to the folder, or absolute as earlier
+    versions wrote it); None when it names none or the file is gone."""
+    if not meta.get("scenario"):
+        return None
+    p = Path(meta["scenario"])
+    p = p if p.is_absolute() else Path(folder) / p
+    return p if p.is_file() else None
+
+
+def provenance_table(meta: dict) -> pd.DataFrame:
+    """What meta.json says made the rows, one line per fact (for the end of report.md)."""
+    sem = meta.get("semsearch")
+    rows = []
+    if isinstance(sem, dict):
+        rows += [("semsearch", f"{sem.get('version')} (code {sem.get('code')})"), ("git commit", sem.get("commit") or "not from a checkout")]
+        rows += [(k, v) for k, v in sem.items() if k not in ("version", "code", "commit")]
+    elif sem:
+        rows.append(("semsearch", str(sem)))
+    for key in ("scenario", "scenario_sha256", "fingerprint"):
+        if meta.get(key):
+            rows.append((key, meta[key]))
+    if isinstance(meta.get("episodes"), dict):
+        rows.append(("episodes", f"{meta['episodes'].get('count')} (set hash {meta['episodes'].get('hash')})"))
+    for label, code in (meta.get("planners") or {}).items():
+        if isinstance(code, dict):
+            what = code.get("source", "")
+            what += f" {code['file']}" if code.get("file") else ""
+            what += f" {code['distribution']}" if code.get("distribution") else ""
+            rows.append((f"planner {label}", f"code {code.get('hash')} ({what.strip()})"))
+    return pd.DataFrame(rows, columns=["what", "value"]).set_index("what")
 
 
 def read_meta(folder: Path) -> dict:
@@ -135,8 +188,8 @@ class Part:
         """The scenario named in meta.json, loaded (once), or None with a note saying that
         ``what`` were skipped and why."""
         if self._loaded is None:
-            path = Path(self.meta.get("scenario", ""))
-            if not self.meta.get("scenario") or not path.is_file():
+            path = scenario_of(self.folder, self.meta)
+            if path is None:
                 self._loaded = f"the scenario file named in {self.folder / 'meta.json'} is not available"
             else:
                 try:
@@ -196,9 +249,14 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
         if meta.get("commands"):
             doc.code("\n".join(meta["commands"]))
         doc.para("Rebuild this report: ", Code("semsearch report " + " ".join(shlex.quote(str(f)) for f in folders)))
-        if meta.get("scenario") and Path(meta["scenario"]).is_file():
+        scenario = scenario_of(Path(folder), meta)
+        if scenario is not None:
             doc.para("Scenario ", Code(meta["scenario"]), ":")
-            doc.code(Path(meta["scenario"]).read_text(errors="replace").strip(), "yaml")
+            doc.code(scenario.read_text(errors="replace").strip(), "yaml")
+        prov = provenance_table(meta)
+        if len(prov):
+            doc.para("Provenance (meta.json): the code, the versions and the inputs these rows were made with.")
+            doc.table(prov)
     for n in notes:
         doc.note(n)
     files = []

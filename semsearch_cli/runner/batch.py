@@ -3,21 +3,30 @@ finishes, so an interrupted batch keeps every finished run and resumes where it 
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 from typing import Callable, Sequence
 
 import pandas as pd
 
 from ..errors import ScenarioError
+from ..files import temp_path
+from ..planners import code_of
 from .executors import Executor, SerialExecutor, make_executor
 from .lock import folder_lock
 from .specs import Loaded, RunSpec
 from .store import RowWriter, read_runs, run_rows
 
 
-def check_folder(loaded: Loaded, out: Path, force: bool = False) -> pd.DataFrame:
+def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | None = None) -> pd.DataFrame:
     """The rows of ``out/runs.csv`` that a batch of ``loaded`` may resume (see :func:`run_batch`);
-    a :class:`ScenarioError` when they were made with another scenario, unless ``force``."""
+    a :class:`ScenarioError` when they were made with another scenario, unless ``force``.
+
+    ``codes`` (planner label -> code hash, :func:`~semsearch_cli.planners.code_of`): rows of
+    those planners made by other code (an edited planner file, another semsearch) are never
+    reused: they are moved to ``runs.superseded.csv`` (appended, so nothing is lost), said so on
+    standard error, and their runs run again."""
     runs_csv = out / "runs.csv"
     done = run_rows(read_runs(runs_csv))
     fp = loaded.fingerprint
@@ -32,7 +41,29 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False) -> pd.DataFrame
             n += 1
         runs_csv.rename(out / f"runs.{n}.csv.bak")
         done = run_rows(read_runs(runs_csv))
+    if codes and len(done):
+        stale = done["planner"].isin(list(codes)) & (done["code"].astype(str) != done["planner"].map(codes))
+        if stale.any():
+            _supersede(out, {str(p) for p in done.loc[stale, "planner"]})
+            done = run_rows(read_runs(runs_csv))
     return done
+
+
+def _supersede(out: Path, planners: set) -> None:
+    """Move every row (stage rows too) of ``planners`` from runs.csv to the end of
+    runs.superseded.csv; runs.csv is replaced atomically, after the side file is on disk."""
+    runs_csv, side = out / "runs.csv", out / "runs.superseded.csv"
+    rows = read_runs(runs_csv)
+    moved = rows["planner"].astype(str).isin(planners)
+    with open(side, "a", encoding="utf-8", newline="") as fh:
+        rows[moved].to_csv(fh, index=False, header=fh.tell() == 0)
+        fh.flush()
+        os.fsync(fh.fileno())
+    tmp = temp_path(runs_csv)
+    rows[~moved].to_csv(tmp, index=False)
+    os.replace(tmp, runs_csv)
+    print(f"{int(moved.sum())} row(s) of {', '.join(sorted(planners))} in {runs_csv} were made by other code (the "
+          f"planner's file or semsearch changed since): moved to {side.name}; their runs run again", file=sys.stderr)
 
 
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,
@@ -56,9 +87,12 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
     ``runs.<n>.csv.bak``) and starts afresh."""
     runs_csv = out / "runs.csv"
     fp = loaded.fingerprint
+    variants = specs.variants if hasattr(specs, "variants") else list({s.variant for s in specs})
+    codes = {v.label: code_of(v)["hash"] for v in variants}
     with folder_lock(out):
-        done = check_folder(loaded, out, force)
-        have = {(str(p), str(g), int(s)) for p, g, s in zip(done["planner"], done["goal"], done["seed"])} if len(done) else set()
+        done = check_folder(loaded, out, force, codes)
+        have = {(str(p), str(g), int(e), int(s)) for p, g, e, s in zip(done["planner"], done["goal"], done["episode"], done["seed"])} \
+            if len(done) else set()
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
@@ -71,6 +105,7 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
             for rows in runner.rows(loaded, todo, out, trace):
                 for r in rows:
                     r["fingerprint"] = fp
+                    r["code"] = codes.get(r["planner"], "")
                 writer.write(rows)
                 n += 1
                 if progress:
@@ -78,3 +113,4 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
         finally:
             writer.close()
         return read_runs(runs_csv)
+

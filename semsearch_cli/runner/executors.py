@@ -28,12 +28,12 @@ def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[di
     ``error`` and the message, so the rest of the batch goes on."""
     task = loaded.task
     try:
-        res = task.run(spec.variant, spec.goal, spec.seed, trace)
+        res = task.run(spec.variant, spec.episode, spec.seed, trace)
     except Exception as exc:  # a user's planner (or a bug): recorded, not fatal to the batch
         where = traceback.extract_tb(exc.__traceback__)[-1]
         msg = f"{type(exc).__name__}: {exc} ({Path(where.filename).name}:{where.lineno})"
         res = RunResult("error", math.nan, 0, 0, 0.0, np.zeros((0, 2), np.float32), message=msg)
-    return task.rows(spec.variant, spec.goal, spec.seed, res), res
+    return task.rows(spec.variant, spec.episode, spec.seed, res), res
 
 
 def _run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list[dict]:

@@ -1,6 +1,6 @@
 """A loaded scenario and its runs: goals x planner variants x seeds (SPEC 9).
 
-A run's randomness comes only from its own seed (:func:`semsearch_cli.tasks.run_seed`), so rows
+A run's randomness comes only from its episode and repeat (:func:`semsearch_cli.tasks.episode_seed`), so rows
 do not depend on the number of workers or the executor.
 """
 
@@ -16,29 +16,36 @@ from pathlib import Path
 from ..config import Scenario, load_scenario, parse_scenario
 from ..planners import Variant
 from ..tasks import Task, build_task
+from ..tasks.episodes import Episode
 from ..world.scenario import World, build_world
 
 
 @dataclass(frozen=True)
 class RunSpec:
-    goal: object
+    """One run: repeat ``seed`` of episode ``episode`` by planner variant ``variant``."""
+
+    episode: Episode
     variant: Variant
     seed: int
 
     @property
+    def goal(self):
+        return self.episode.goal
+
+    @property
     def key(self) -> tuple:
-        return (self.variant.label, str(self.goal), int(self.seed))
+        return (self.variant.label, str(self.goal), int(self.episode.index), int(self.seed))
 
     @property
     def stem(self) -> str:
-        return file_stem(self.variant.label, self.goal, self.seed)
+        return file_stem(self.variant.label, self.goal, self.seed, self.episode.index)
 
 
-def file_stem(label: str, goal, seed=None) -> str:
+def file_stem(label: str, goal, seed=None, episode=None) -> str:
     """File-name stem of a run (or, without seed, of a goal x variant): one path component
     whatever the planner label or goal holds (a KTH room's second door is the goal ``2512/2``)."""
     safe = label.replace("[", "_").replace("]", "").replace("=", "").replace(",", "_")
-    stem = f"{safe}__goal{goal}" + (f"__seed{seed}" if seed is not None else "")
+    stem = f"{safe}__goal{goal}" + (f"__ep{episode}" if episode is not None else "") + (f"__seed{seed}" if seed is not None else "")
     return _UNSAFE.sub("_", stem)
 
 
@@ -87,7 +94,7 @@ class Loaded:
         its fingerprint). Rows carry it, and a batch resumes only rows that match."""
         if self._fingerprint is None:
             d = self.sc.model_dump(mode="json")
-            for key in ("planners", "goals"):
+            for key in ("planners", "goals", "name"):  # the name decides nothing (seeds do not hash it)
                 d.pop(key, None)
             for key in ("seeds", "out"):
                 d["experiment"].pop(key, None)
@@ -122,17 +129,21 @@ def _files_by_content(d, base: Path):
 
 
 class RunList(Sequence):
-    """goals x planner variants x seeds, in that nesting order, as a sequence computed on demand:
-    its length and any item come from arithmetic, so a list of a billion runs costs no memory
-    (a batch streams it to the workers)."""
+    """episodes x planner variants x repeats, in that nesting order, as a sequence computed on
+    demand: its length and any item come from arithmetic, so a list of a billion runs costs no
+    memory (a batch streams it to the workers)."""
 
-    def __init__(self, goals: list, variants: list[Variant], seeds: int):
-        self.goals, self.variants, self.seeds = list(goals), list(variants), int(seeds)
+    def __init__(self, episodes: list[Episode], variants: list[Variant], seeds: int):
+        self.episodes, self.variants, self.seeds = list(episodes), list(variants), int(seeds)
         self._labels = {v.label for v in self.variants}
-        self._goal_keys = {str(g) for g in self.goals}
+        self._episode_keys = {(str(e.goal), e.index) for e in self.episodes}
+
+    @property
+    def goals(self) -> list:
+        return list(dict.fromkeys(e.goal for e in self.episodes))
 
     def __len__(self) -> int:
-        return len(self.goals) * len(self.variants) * self.seeds
+        return len(self.episodes) * len(self.variants) * self.seeds
 
     def __getitem__(self, i):
         if isinstance(i, slice):
@@ -141,25 +152,27 @@ class RunList(Sequence):
         if not -n <= i < n:
             raise IndexError(i)
         i %= n
-        per_goal = len(self.variants) * self.seeds
-        return RunSpec(self.goals[i // per_goal], self.variants[(i // self.seeds) % len(self.variants)], i % self.seeds)
+        per_episode = len(self.variants) * self.seeds
+        return RunSpec(self.episodes[i // per_episode], self.variants[(i // self.seeds) % len(self.variants)], i % self.seeds)
 
     def __iter__(self):
-        for g in self.goals:
+        for e in self.episodes:
             for v in self.variants:
                 for s in range(self.seeds):
-                    yield RunSpec(g, v, s)
+                    yield RunSpec(e, v, s)
 
     def has_key(self, key: tuple) -> bool:
-        """Whether the run ``(label, goal, seed)`` (:attr:`RunSpec.key`) is in the list."""
-        label, goal, seed = key
-        return label in self._labels and str(goal) in self._goal_keys and 0 <= int(seed) < self.seeds
+        """Whether the run ``(label, goal, episode, seed)`` (:attr:`RunSpec.key`) is in the list."""
+        label, goal, episode, seed = key
+        return label in self._labels and (str(goal), int(episode)) in self._episode_keys and 0 <= int(seed) < self.seeds
 
 
 def expand(loaded: Loaded, seeds: int | None = None, goals=None, planners=None) -> RunList:
-    """goals x planner variants x seeds, in that nesting order (a :class:`RunList`)."""
+    """episodes x planner variants x repeats, in that nesting order (a :class:`RunList`);
+    ``goals`` keeps the episodes of those goals, ``planners`` the variants of those names."""
     variants = loaded.task.variants()
     if planners:
         variants = [v for v in variants if v.name in planners or v.label in planners]
-    gl = [g for g in loaded.goals if goals is None or str(g) in {str(x) for x in goals}]
-    return RunList(gl, variants, seeds or loaded.sc.experiment.seeds)
+    keep = None if goals is None else {str(x) for x in goals}
+    eps = [e for e in loaded.task.episodes if keep is None or str(e.goal) in keep]
+    return RunList(eps, variants, seeds or loaded.sc.experiment.seeds)

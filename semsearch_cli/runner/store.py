@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError
-from ..metrics import COLUMNS
+from ..metrics import CAUSES, COLUMNS
 from ..files import temp_path
 
 
@@ -29,17 +29,27 @@ def read_runs(path: Path) -> pd.DataFrame:
     bad = "not a runs.csv written by semsearch; move it away or write into another folder with --out"
     try:
         df = pd.read_csv(io.BytesIO(data), dtype={"stage": str, "map": str, "message": str, "kind": str, "scenario": str,
-                                                  "fingerprint": str}, encoding="utf-8")  # a scenario may be named 50045233
+                                                  "fingerprint": str, "code": str, "room": str, "cause": str},
+                         encoding="utf-8")  # a scenario may be named 50045233
     except (ValueError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
         raise ScenarioError(str(path), "", f"{bad} ({type(exc).__name__})") from None
     if "kind" not in df.columns and "wall_s" in df.columns:
         raise ScenarioError(str(path), "kind", "this runs.csv was written by an older semsearch (no kind column); "
                             "write new runs into another folder with --out")
-    missing = [c for c in COLUMNS if c not in df.columns and c != "fingerprint"]
+    missing = [c for c in COLUMNS if c not in df.columns and c not in LATER]
     if missing:
         raise ScenarioError(str(path), "", f"{bad} (no column {', '.join(missing[:3])})")
-    df[["stage", "map", "message"]] = df[["stage", "map", "message"]].fillna("")
+    for c, default in LATER.items():  # rows of an earlier semsearch: one episode, no cause, no code
+        if c not in df.columns:
+            df[c] = df["outcome"].map(CAUSES) if c == "cause" else default
+    df[TEXT] = df[TEXT].fillna("")
     return df.dropna(subset=["wall_s"])
+
+
+# columns added after the first release, with what rows written before them stand for
+LATER = {"episode": 0, "start_x": float("nan"), "start_y": float("nan"), "start_heading": float("nan"), "room": "",
+         "cause": None, "soft_spl": float("nan"), "left_m": float("nan"), "fingerprint": "", "code": ""}
+TEXT = ["stage", "map", "message", "room", "cause", "code"]
 
 
 def _whole_lines(fh) -> int:

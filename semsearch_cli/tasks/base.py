@@ -11,8 +11,8 @@ scenario is.
 
 from __future__ import annotations
 
+import math
 import time
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -20,16 +20,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..config import Scenario
+from ..kernels.grid import dijkstra
 from ..errors import ScenarioError
 from ..metrics import run_row
 from ..planners import Variant, expand_variants
 from ..world.scenario import World
-
-
-def run_seed(scenario: str, goal, seed: int, base_seed: int) -> np.random.SeedSequence:
-    """The seed of one run, derived from (scenario, goal, seed) only: every planner variant sees
-    the same start heading and sensor draws for seed k, whatever the worker count."""
-    return np.random.SeedSequence([base_seed, seed, zlib.crc32(scenario.encode()), zlib.crc32(str(goal).encode())])
+from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words, region_mask
 
 
 @dataclass
@@ -80,6 +76,8 @@ class RunResult:
     stages: list = field(default_factory=list)  # extra rows of a run (chains: one per stage and mode)
     message: str = ""
     time_s: float = float("nan")  # simulated seconds, for tasks with a clock
+    left_m: float = float("nan")  # geodesic distance left to the goal where the run ended (0 when found)
+    start_heading: float = float("nan")  # rad, the heading the run started with
 
 
 TASKS: dict[str, type["Task"]] = {}
@@ -127,38 +125,152 @@ class Task:
                 return g
         return label
 
-    # ---- running ----------------------------------------------------------------------
-    def start_state(self, rng: np.random.Generator) -> RobotState:
-        """The robot at the scenario's start (a random heading draws from ``rng``)."""
+    # ---- episodes ---------------------------------------------------------------------
+    @property
+    def episodes(self) -> list[Episode]:
+        """The scenario's episode set (see :mod:`.episodes`), built on first use."""
+        if getattr(self, "_episodes", None) is None:
+            self._episodes = self.build_episodes()
+        return self._episodes
+
+    def goal_field(self, goal) -> np.ndarray:
+        """(H, W) float, m: the ground-truth geodesic distance from every cell to ``goal`` (to the
+        nearest pose that achieves it), inf where unreachable; kept while the episodes are built
+        (one map-sized array per goal), then dropped."""
+        cache = self.__dict__.setdefault("_fields", {})
+        key = str(goal)
+        if key not in cache:
+            w = self.world
+            rr, cc = np.nonzero(self.goal_cells(goal))
+            if not len(rr):
+                cache[key] = np.full(w.reach.shape, np.inf)
+            else:
+                _, length, _ = dijkstra(w.reach, np.ones((1, 1), np.float32), rr, cc, np.zeros_like(w.reach), 0, np.inf)
+                cache[key] = length * w.frame.res
+        return cache[key]
+
+    def goal_cells(self, goal) -> np.ndarray:  # pragma: no cover
+        """(H, W) bool: the reachable poses that achieve ``goal`` (a kind defines it)."""
+        raise NotImplementedError
+
+    def distance_left(self, goal, x: float, y: float) -> float:
+        """Geodesic distance (m) from (x, y) to ``goal``; inf when unreachable."""
         w = self.world
-        heading = w.start_heading if w.start_heading is not None else float(rng.uniform(-np.pi, np.pi))
-        x, y = w.start_xy
-        return RobotState(x, y, heading, trail=[(x, y)])
+        r, c = w.frame.to_index(x, y)
+        if "_fields" in self.__dict__ and str(goal) in self._fields:
+            f = self._fields[str(goal)]
+            return float(f[r, c]) if 0 <= r < f.shape[0] and 0 <= c < f.shape[1] else math.inf
+        if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
+            return math.inf
+        return w.geodesic((int(r), int(c)), self.goal_cells(goal))[0]
+
+    def shortest_from(self, goal, x: float, y: float) -> float:
+        """The shortest path (m) of ``goal`` from a start at (x, y)."""
+        return self.distance_left(goal, x, y)
+
+    def build_episodes(self) -> list[Episode]:
+        """The episodes of the scenario's ``episodes`` section, or one per goal from its start."""
+        try:
+            return self._build_episodes()
+        finally:
+            self.__dict__.pop("_fields", None)
+
+    def _build_episodes(self) -> list[Episode]:
+        spec, w = self.sc.episodes, self.world
+        if spec is None:
+            h = None if w.start_heading is None else float(np.degrees(w.start_heading))
+            eps = [dict(goal=g, x=w.start_xy[0], y=w.start_xy[1], heading=h, file=self.file, field="start") for g in self.goals]
+        else:
+            eps = given_episodes(spec, self.path.parent, self.file)
+            if eps is None:
+                eps = self.draw_episodes(spec)
+        out = []
+        for k, e in enumerate(eps):
+            goal = self.check_episode_goal(e)
+            r, c = w.frame.to_index(e["x"], e["y"])
+            if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
+                raise ScenarioError(e["file"], e["field"], f"the start ({e['x']:g}, {e['y']:g}) m is not free space "
+                                    "reachable from the scenario's start (or lies closer than the robot radius to a wall)")
+            d = self.shortest_from(goal, e["x"], e["y"])  # inf only for a goal nothing achieves (an object absent at its hour)
+            out.append(Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None, d))
+        return out
+
+    def check_episode_goal(self, e: dict):
+        """The goal an episode names, as the scenario writes it; a :class:`ScenarioError` when it
+        is not one of the scenario's goals."""
+        for g in self.goals:
+            if str(g) == str(e["goal"]):
+                return g
+        raise ScenarioError(e["file"], e["field"], f"goal {e['goal']} is not one of the scenario's goals "
+                            f"({', '.join(map(str, self.goals))})")
+
+    def draw_episodes(self, spec) -> list[dict]:
+        """``spec.starts`` drawn starts per goal (or shared by every goal), as in :mod:`.episodes`."""
+        w = self.world
+        stand = w.reach & region_mask(w.free, w.frame.res, spec.where, spec.corridor_width)
+        where = "" if spec.where == "anywhere" else f" in {spec.where}"
+        band = f"between {spec.min_distance:g} and {spec.max_distance:g} m" if spec.max_distance else f"at least {spec.min_distance:g} m"
+        out = []
+        groups = [(list(self.goals), [spec.seed])] if spec.shared else [([g], [spec.seed, *label_words(g)]) for g in self.goals]
+        for goals, seed in groups:
+            fields = [f for f in (self.goal_field(g) for g in goals) if np.isfinite(f).any()]
+            starts = draw_starts(stand, fields, w.frame.to_world, spec.starts,
+                                 np.random.default_rng(seed), spec.min_distance, spec.max_distance)
+            if not starts:
+                raise ScenarioError(self.file, "episodes", f"no reachable free cell{where} lies {band} from goal"
+                                    f"{'s' if len(goals) > 1 else ''} {', '.join(map(str, goals))}; widen the distances "
+                                    "or the region")
+            out += [dict(goal=g, x=x, y=y, heading=h, file=self.file, field="episodes") for g in goals for x, y, h in starts]
+        if spec.shared:  # goal by goal, as when drawn per goal
+            out.sort(key=lambda e: [str(g) for g in self.goals].index(str(e["goal"])))
+        return out
+
+    def as_episode(self, ep) -> Episode:
+        """``ep`` itself when it is an :class:`Episode`, else a goal's first episode, or one from
+        the scenario's start for a goal the set lacks (a convenience for scripts and tests:
+        ``task.run(variant, 148, 0)``)."""
+        if isinstance(ep, Episode):
+            return ep
+        for e in self.episodes:
+            if str(e.goal) == str(ep) or (isinstance(ep, float) and str(e.goal) == f"{ep:g}"):
+                return e
+        w = self.world  # a goal without episodes: from the scenario's start
+        h = None if w.start_heading is None else float(np.degrees(w.start_heading))
+        return Episode(-1, ep, w.start_xy[0], w.start_xy[1], h, None, self.shortest_from(ep, *w.start_xy))
+
+    # ---- running ----------------------------------------------------------------------
+    def start_state(self, ep: Episode, rng: np.random.Generator) -> RobotState:
+        """The robot at the episode's start (a heading left to each repeat draws from ``rng``)."""
+        heading = math.radians(ep.heading) if ep.heading is not None else float(rng.uniform(-np.pi, np.pi))
+        return RobotState(ep.x, ep.y, heading, trail=[(ep.x, ep.y)])
 
     def episode(self, state: RobotState, planner, goal, rng: np.random.Generator, trace: bool = False,
                 recorder=None) -> tuple[Outcome, RobotState]:  # pragma: no cover
         raise NotImplementedError
 
-    def run(self, variant: Variant, goal, seed: int, trace: bool = False, recorder=None) -> RunResult:
-        """One run from the start: the start state, then one episode."""
+    def run(self, variant: Variant, ep: Episode, seed: int, trace: bool = False, recorder=None) -> RunResult:
+        """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode): the start state, then
+        one search."""
         t0 = time.perf_counter()
-        goal = self.goal_value(goal)
-        rng = np.random.default_rng(run_seed(self.sc.name, goal, seed, self.sc.experiment.base_seed))
-        st = self.start_state(rng)
-        out, st = self.episode(st, variant.build(), goal, rng, trace, recorder)
+        ep = self.as_episode(ep)
+        rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
+        st = self.start_state(ep, rng)
+        heading = st.heading
+        out, st = self.episode(st, variant.build(), ep.goal, rng, trace, recorder)
+        left = 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), sorted(st.read_signs), out.trace)
+                         np.asarray(st.trail, np.float32), sorted(st.read_signs), out.trace, left_m=left,
+                         start_heading=heading)
 
-    def shortest_for(self, goal, seed: int) -> float:
-        """The shortest path (m) of run ``seed`` for ``goal`` (the same for every seed unless a
-        task varies its world by seed)."""
-        return self.shortest.get(self.goal_value(goal), float("nan"))
-
-    def rows(self, variant: Variant, goal, seed: int, res: RunResult) -> list[dict]:
+    def rows(self, variant: Variant, ep: Episode, seed: int, res: RunResult) -> list[dict]:
         """The rows of one finished run: its own, then any per-stage rows."""
-        row = run_row(self.kind, self.sc.name, variant, goal, seed, res, self.shortest_for(goal, seed),
-                      self.sc.navigation.navigator)
+        row = run_row(self.kind, self.sc.name, variant, ep, seed, res, self.sc.navigation.navigator,
+                      self.room_name(ep))
         return [row] + [{**row, **s} for s in res.stages]
+
+    def room_name(self, ep: Episode) -> str:
+        """The room an episode searches (indirect search), else empty."""
+        return ""
 
     def max_steps(self) -> int:
         e = self.sc.experiment
@@ -180,4 +292,6 @@ def build_task(sc: Scenario, world: World, path: Path) -> Task:
     kind = sc.search_kind
     if kind not in TASKS:
         raise ScenarioError(str(path), "kind", f"no task of kind {kind!r}; known: {', '.join(sorted(TASKS))}")
-    return TASKS[kind].build(sc, world, path)
+    task = TASKS[kind].build(sc, world, path)
+    task.episodes  # built and checked now: a bad episode is an error of the scenario's
+    return task

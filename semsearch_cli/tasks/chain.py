@@ -24,6 +24,7 @@ leg from there to the nearest pose that sees an instance of the class in its roo
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -33,7 +34,8 @@ import pandas as pd
 from ..errors import ScenarioError
 from ..metrics import spl
 from ..planners import Variant
-from .base import RobotState, RunResult, Task, register_task, run_seed
+from .base import RobotState, RunResult, Task, register_task
+from .episodes import Episode, episode_seed
 from .doors import DoorTask
 from .objects import Case, ObjectTask
 
@@ -77,7 +79,7 @@ class ChainTask(Task):
             if any(s.cls is not None for s in stages):
                 task._check_object_stages(ch, stages, field)
             task.stages[ch.name] = stages
-            task.legs[ch.name] = task._shortest_legs(ch, stages, field)
+            task.legs[ch.name] = task._shortest_legs(ch, stages, field, world.start_cell)
             task.shortest[ch.name] = float(sum(task.legs[ch.name]))
         task.variants()
         return task
@@ -106,9 +108,10 @@ class ChainTask(Task):
     def _instances(self, ch, s: Stage) -> list[tuple[str, str]]:
         return self.objects.instances(ch.truth, s.hour)
 
-    def _shortest_legs(self, ch, stages, field) -> list[float]:
+    def _shortest_legs(self, ch, stages, field, cell) -> list[float]:
+        """The shortest legs of chain ``ch`` from ``cell``: to each door's nearest reading pose
+        and, for an object stage, on from there to the nearest pose that sees the object."""
         w = self.world
-        cell = w.start_cell
         legs = []
         for j, s in enumerate(stages):
             d, end = w.geodesic(cell, w.reading_cells(s.door))
@@ -137,6 +140,21 @@ class ChainTask(Task):
     def goals(self) -> list:
         return list(self.chains)
 
+    def goal_cells(self, goal) -> np.ndarray:
+        """The poses that read the chain's first door (drawn starts keep their distance to it)."""
+        return self.world.reading_cells(self.stages[str(goal)][0].door)
+
+    def shortest_from(self, goal, x: float, y: float) -> float:
+        ch = self.chains[str(goal)]
+        if (x, y) == tuple(self.world.start_xy):
+            return self.shortest[ch.name]
+        k = self.sc.chains.index(ch)
+        return float(sum(self._legs_from(ch, x, y, f"chains[{k}]")))
+
+    def _legs_from(self, ch, x: float, y: float, field: str = "episodes") -> list[float]:
+        r, c = self.world.frame.to_index(x, y)
+        return self._shortest_legs(ch, self.stages[ch.name], field, (int(r), int(c)))
+
     # ---- running ----------------------------------------------------------------------
     def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, trace: bool):
         """One stage from ``st``: (outcome, decisions, trace)."""
@@ -152,21 +170,28 @@ class ChainTask(Task):
                                               room, None, rng, trace)
         return out.outcome, decisions + out.decisions, tr + out.trace
 
-    def run(self, variant: Variant, goal, seed: int, trace: bool = False, recorder=None) -> RunResult:
+    def run(self, variant: Variant, ep: Episode, seed: int, trace: bool = False, recorder=None) -> RunResult:
         t0 = time.perf_counter()
-        ch = self.chains[str(goal)]
+        ep = self.as_episode(ep)
+        ch = self.chains[str(ep.goal)]
         base = self.sc.experiment.base_seed
-        st = self.start_state(np.random.default_rng(run_seed(self.sc.name, ch.name, seed, base)))
+        st = self.start_state(ep, np.random.default_rng(episode_seed(ep, seed, base)))
+        heading = st.heading
         st.belief = self.doors.new_belief()
         stages, decisions, trace_all = [], 0, []
         outcome = "found"
-        leg = iter(self.legs[ch.name])
+        legs = self.legs[ch.name] if (ep.x, ep.y) == tuple(self.world.start_xy) else self._legs_from(ch, ep.x, ep.y)
+        leg = iter(legs)
+        used = 0
+        left = 0.0
         for k, s in enumerate(self.stages[ch.name], 1):
             pose = (st.x, st.y, st.heading)
             d0, s0, t_stage = st.distance, st.steps, time.perf_counter()
-            stage_seed = run_seed(self.sc.name, f"{ch.name}#{k}", seed, base)  # the same draws kept and from scratch
+            stage_seed = episode_seed(ep, seed, base, k)  # the same draws kept and from scratch
             outcome, dec, tr = self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True, trace)
-            shortest = next(leg) + (next(leg) if s.cls is not None else 0.0)
+            n_legs = 2 if s.cls is not None else 1
+            shortest = sum(next(leg) for _ in range(n_legs))
+            used += n_legs
             decisions += dec
             trace_all += [{**d, "stage": k} for d in tr]
             stages.append(_stage_row(k, s, "kept", outcome, st.distance - d0, st.steps - s0, shortest, dec, time.perf_counter() - t_stage))
@@ -176,13 +201,20 @@ class ChainTask(Task):
             o2, d2, _ = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, False)
             stages.append(_stage_row(k, s, "scratch", o2, fresh.distance, fresh.steps, shortest, d2, time.perf_counter() - t_s))
             if outcome != "found":
+                # left: to this stage's door (when its door was not read) and the legs after it;
+                # unknown once the door was read and the object search in the room failed
+                rest = float(sum(legs[used:]))
+                unread = st.read_signs.isdisjoint(self.world.signs.indices_of(s.door))
+                to_door = self.doors.distance_left(s.door, st.x, st.y) if unread else math.nan
+                left = to_door + (legs[used - 1] if s.cls is not None else 0.0) + rest
                 break
         res = RunResult(outcome, st.distance, st.steps, decisions, time.perf_counter() - t0,
-                        np.asarray(st.trail, np.float32), sorted(st.read_signs), trace_all, stages)
+                        np.asarray(st.trail, np.float32), sorted(st.read_signs), trace_all, stages, left_m=left,
+                        start_heading=heading)
         return res
 
-    def rows(self, variant, goal, seed, res):
-        rows = super().rows(variant, goal, seed, res)
+    def rows(self, variant, ep, seed, res):
+        rows = super().rows(variant, ep, seed, res)
         rows[0]["map"] = "kept"
         return rows
 

@@ -263,6 +263,10 @@ class DoorTask(Task):
             if self.world.signs.index_of(g) < 0:
                 raise ScenarioError(self.file, f"{field}[{k}]", f"no door sign carries the number {g}")
 
+    def goal_cells(self, goal) -> np.ndarray:
+        """The poses that read sign ``goal`` (see :meth:`World.reading_cells`)."""
+        return self.world.reading_cells(goal)
+
     def new_belief(self) -> Belief:
         return Belief(self.world.frame, self.sc.belief, self.sc.robot.radius)
 

@@ -34,7 +34,8 @@ from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.semantic import SemanticCamera
 from ..world.rooms import Room, generate_rooms, read_rooms
-from .base import Outcome, RobotState, RunResult, Task, register_task, run_seed
+from .base import Outcome, RobotState, RunResult, Task, register_task
+from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
 from .loop import run_loop
 
 
@@ -322,8 +323,10 @@ class IndirectTask(Task):
             self._cones[scale] = self.camera.templates(scale, self.spec.resolution)
         return self._cones[scale]
 
-    def shortest_of(self, k: int, scale: float) -> float:
-        """Shortest path (m) of room ``k`` at ``scale``: to the nearest standing cell that sees A."""
+    def field(self, k: int, scale: float) -> np.ndarray:
+        """(H, W) path length (m) over room ``k``'s standing cells to the nearest cell from which
+        A is in view at ``scale`` for some heading and the detection table gives a chance of
+        detecting it (A is not seen from every side); inf where no such cell is reachable."""
         key = (k, scale)
         if key not in self._shortest:
             g = self.grids[k]
@@ -348,9 +351,23 @@ class IndirectTask(Task):
                 for a, b in zip(rr, cc):
                     if not line_of_sight(occ, float(v0), float(u0), a + 0.5, b + 0.5, 0.0):
                         ok[a, b] = False
-            lengths = g.lengths_from(*g.room.start[:2])
-            self._shortest[key] = float(lengths[ok].min()) if ok.any() else float("inf")
+            rr, cc = np.nonzero(ok)
+            if not len(rr):
+                self._shortest[key] = np.full(g.stand.shape, np.inf)
+            else:
+                g.search.run(g.stand, g.cost, rr, cc, np.zeros(0, np.int64), np.zeros(0, np.int64), 0)
+                done = g.search.closed == g.search.gen
+                self._shortest[key] = np.where(done, g.search.length_ * fr.res, np.inf)
         return self._shortest[key]
+
+    def shortest_of(self, k: int, scale: float, x: float | None = None, y: float | None = None) -> float:
+        """Shortest path (m) in room ``k`` at ``scale`` from (x, y) (default: the room's start)."""
+        g = self.grids[k]
+        if x is None:
+            x, y = g.room.start[:2]
+        r, c = g.frame.to_index(x, y)
+        f = self.field(k, scale)
+        return float(f[r, c]) if 0 <= r < f.shape[0] and 0 <= c < f.shape[1] else math.inf
 
     @property
     def goals(self) -> list:
@@ -362,22 +379,73 @@ class IndirectTask(Task):
                 return g
         return label
 
+    # ---- episodes ---------------------------------------------------------------------------
+    def room_name(self, ep: Episode) -> str:
+        return self.grids[ep.room].room.name
+
+    def build_episodes(self) -> list[Episode]:
+        """Per view scale, the rooms' episodes: each room from its own start (no ``episodes``
+        section); ``starts`` drawn per room, the same for every scale, uniformly over the cells the
+        robot can stand on from which A can be detected (within the distances given); or given by
+        hand (``goal``: the room's name, searched at every scale) or in a file (``goal``: the
+        scale, ``room``: the room's name)."""
+        spec = self.sc.episodes
+        names = {g.room.name: k for k, g in enumerate(self.grids)}
+        per_room: list[tuple[int, float, float, float | None, str, str]] = []  # room, x, y, heading, file, field
+        scaled: list[tuple[float, int, float, float, float | None, str, str]] = []  # given with a scale
+        if spec is None:
+            per_room = [(k, *g.room.start, self.file, f"indirect.rooms ({g.room.name})") for k, g in enumerate(self.grids)]
+        elif spec.starts is not None:
+            if spec.where != "anywhere":
+                raise ScenarioError(self.file, "episodes.where", "indirect search draws its starts inside its rooms; "
+                                    "remove where")
+            for k, g in enumerate(self.grids):
+                fields = [f for f in (self.field(k, s) for s in self.goals) if np.isfinite(f).any()]
+                starts = draw_starts(g.stand, fields, g.frame.to_world, spec.starts,
+                                     np.random.default_rng([spec.seed, *label_words(g.room.name)]),
+                                     spec.min_distance, spec.max_distance)
+                if not starts:
+                    raise ScenarioError(self.file, "episodes", f"no cell of room {g.room.name} lies within the distances "
+                                        "given from a pose that detects A; widen them")
+                per_room += [(k, x, y, h, self.file, "episodes") for x, y, h in starts]
+        else:
+            for e in given_episodes(spec, self.path.parent, self.file):
+                room = e["room"] if e["room"] is not None else str(e["goal"])
+                if room not in names:
+                    raise ScenarioError(e["file"], e["field"], f"no room named {room!r} (rooms: {', '.join(list(names)[:5])}, ...)")
+                if e["room"] is None:
+                    per_room.append((names[room], e["x"], e["y"], e["heading"], e["file"], e["field"]))
+                else:
+                    scale = self.goal_value(e["goal"])
+                    if scale not in self.goals:
+                        raise ScenarioError(e["file"], e["field"], f"goal {e['goal']} is not one of the view scales {self.goals}")
+                    scaled.append((scale, names[room], e["x"], e["y"], e["heading"], e["file"], e["field"]))
+        items = [(s, *p) for s in self.goals for p in per_room] + scaled
+        out = []
+        for scale, k, x, y, h, file, field in items:
+            g = self.grids[k]
+            r, c = g.frame.to_index(x, y)
+            if not (0 <= r < g.stand.shape[0] and 0 <= c < g.stand.shape[1] and g.stand[r, c]):
+                raise ScenarioError(file, field, f"the start ({x:g}, {y:g}) m is not a cell of room {g.room.name} "
+                                    "the robot can stand on")
+            out.append(Episode(len(out), scale, float(x), float(y), None if h is None else float(h), k,
+                               self.shortest_of(k, scale, x, y)))
+        return out
+
     # ---- running ----------------------------------------------------------------------------
-    def run(self, variant: Variant, goal, seed: int, trace: bool = False, recorder=None) -> RunResult:
+    def run(self, variant: Variant, ep: Episode, seed: int, trace: bool = False, recorder=None) -> RunResult:
         t0 = time.perf_counter()
-        scale = float(self.goal_value(goal))
-        k = seed % len(self.grids)
-        rng = np.random.default_rng(run_seed(self.sc.name, scale, seed, self.sc.experiment.base_seed))
-        out, st = self.episode(self.start_state_of(k), variant.build(), scale, rng, trace, recorder, room=k)
+        ep = self.as_episode(ep)
+        scale = float(ep.goal)
+        rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
+        st = self.start_state(ep, rng)
+        heading = st.heading
+        out, st = self.episode(st, variant.build(), scale, rng, trace, recorder, room=ep.room)
+        left = 0.0 if out.outcome == "found" else self.shortest_of(ep.room, scale, st.x, st.y)
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
                          np.asarray(st.trail, np.float32), [], out.trace,
                          message="the robot could not move" if out.outcome == "stuck" else "",
-                         time_s=out.steps / self.spec.camera.fps)
-
-    def start_state_of(self, room: int) -> RobotState:
-        """The robot at room ``room``'s start, with no belief yet."""
-        x, y, h = self.grids[room].room.start
-        return RobotState(x, y, math.radians(h), trail=[(x, y)])
+                         time_s=out.steps / self.spec.camera.fps, left_m=left, start_heading=heading)
 
     def episode(self, state, planner, goal, rng, trace=False, recorder=None, room: int = 0):
         """Search room ``room`` for A at view scale ``goal`` from ``state`` (a new map of A when it
@@ -390,10 +458,6 @@ class IndirectTask(Task):
         max_steps = s0 + int(round(spec.time_limit * spec.camera.fps))
         outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move)
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
-
-    def shortest_for(self, goal, seed: int) -> float:
-        """Run ``seed`` searches room ``seed mod n``: its own shortest path."""
-        return self.shortest_of(seed % len(self.grids), float(self.goal_value(goal)))
 
     def describe(self):
         spec = self.spec

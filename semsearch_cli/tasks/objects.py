@@ -376,6 +376,15 @@ class ObjectTask(Task):
                                 np.zeros_like(self.world.reach), 0, np.inf)
         return length * self.world.frame.res
 
+    def goal_cells(self, goal) -> np.ndarray:
+        """The reachable poses that see an instance of the request's target (heading free)."""
+        req = self.request(goal)
+        rng = self.spec.camera.for_class(req.cls)[1]
+        out = np.zeros(self.world.reach.shape, bool)
+        for p in req.truth:
+            out |= self.view_mask(*self.places[p], rng)
+        return out
+
     def shortest_to(self, req: Request) -> float:
         """Geodesic from the start to the nearest pose that sees an instance of the target
         (heading free); inf when the request's ground truth holds none."""

@@ -1,0 +1,71 @@
+"""What made a result: semsearch's version and the hash of its code, the git commit it was
+installed from (when it runs from a checkout), and the versions of what it runs on.
+
+``code_hash()`` hashes every ``.py`` file of the package (its path and bytes), so two installs of
+the same code agree and any edit, committed or not, changes it; rows carry it through each
+planner's code hash (see :func:`semsearch_cli.planners.code_of`)."""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import platform
+import subprocess
+import sys
+from importlib import metadata
+from pathlib import Path
+
+from . import __version__
+
+PACKAGE = Path(__file__).resolve().parent
+DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "scikit-image", "opencv-python-headless", "matplotlib", "pydantic")
+
+
+@functools.cache
+def code_hash() -> str:
+    """sha256 (16 hex digits) of the package's Python files, paths and bytes, in path order."""
+    h = hashlib.sha256()
+    for f in sorted(PACKAGE.rglob("*.py")):
+        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0")
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+@functools.cache
+def git_commit() -> str | None:
+    """The commit of the checkout the package runs from (``+dirty`` when its files differ from
+    it), or None when it was installed from elsewhere (a wheel, an sdist)."""
+    root = PACKAGE.parent
+    if not (root / ".git").exists():
+        return None
+    try:
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--", PACKAGE.name],
+                               capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if head.returncode != 0:
+        return None
+    return head.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+
+
+def version_line() -> str:
+    """``semsearch 0.1.0 (code 1a2b..., commit abc...)``: what ``semsearch --version`` prints."""
+    commit = git_commit()
+    return f"semsearch {__version__} (code {code_hash()}" + (f", commit {commit}" if commit else "") + ")"
+
+
+def environment() -> dict:
+    """Python, the platform and the versions of the libraries the numbers depend on."""
+    deps = {}
+    for d in DEPENDENCIES:
+        try:
+            deps[d] = metadata.version(d)
+        except metadata.PackageNotFoundError:
+            deps[d] = None
+    return {"python": sys.version.split()[0], "platform": platform.platform(), "machine": platform.machine(), **deps}
+
+
+def describe() -> dict:
+    """semsearch's version, code hash, commit and environment, for meta.json."""
+    return {"version": __version__, "code": code_hash(), "commit": git_commit(), **environment()}

@@ -1,0 +1,163 @@
+"""Episodes: the start/goal problems a scenario's runs are made of.
+
+An episode is a goal (a door number, an object request, a chain, an indirect view scale in one
+room) and a start pose (x, y in m, heading in degrees, or no heading: drawn at each repeat). A
+scenario's runs are episodes x planner variants x repeats (the ``seed`` column); every planner
+variant meets the same episodes and, at repeat k, the same random stream, so planners can be
+compared episode by episode.
+
+A run's random stream (:func:`episode_seed`) derives from the base seed, the episode's content
+(goal, start, room) and the repeat, never from the scenario's name, its path or the episode's
+position in the set: a renamed copy of a scenario gives the same rows.
+
+The set comes from the scenario's ``episodes`` section (:class:`~semsearch_cli.config.base.EpisodesSpec`):
+drawn (``starts`` per goal, from the reachable free space, seeded), given by hand (``list``), or
+read from a CSV (``file``, as written by ``semsearch episodes``). Without the section there is one
+episode per goal, from the scenario's ``start`` (the thesis' fixed starts).
+
+Drawing. The candidate cells are those the robot can stand on and reach from the scenario's
+start, optionally only corridors or only rooms: a cell is in a room when a disk of diameter
+``corridor_width`` fits in the free space around it (a morphological opening of the free map),
+in a corridor otherwise. Of those, a cell qualifies when its geodesic distance to the goal (to the
+nearest pose that achieves it, as the shortest path column measures it) lies in
+[``min_distance``, ``max_distance``]; with ``shared`` it must do so for every goal. The starts
+are drawn uniformly among qualifying cells (cell centres, without replacement while there are
+enough), each with a heading uniform in [-180, 180) degrees, by a generator seeded by
+``episodes.seed`` and the goal's label (or by the seed alone when shared), so adding a goal does
+not move the other goals' starts.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..config.base import EpisodesSpec
+from ..errors import ScenarioError
+from ..files import read_user_text
+
+EPISODE_COLUMNS = ["episode", "goal", "start_x", "start_y", "start_heading", "room", "shortest_m", "hash"]
+
+
+@dataclass(frozen=True)
+class Episode:
+    """One start/goal problem.
+
+    index : int, its position in the scenario's set (the ``episode`` column); goal : the goal as
+    the scenario writes it; x, y : float, m; heading : float, degrees, or None (drawn at each
+    repeat); room : int or None, the room searched (indirect search); shortest_m : float, the
+    ground-truth shortest path from the start to the goal (m).
+    """
+
+    index: int
+    goal: object
+    x: float
+    y: float
+    heading: float | None = None
+    room: int | None = None
+    shortest_m: float = math.nan
+
+    @property
+    def content(self) -> str:
+        """What the episode is, as text: goal, start and room (not its index, not its path length)."""
+        h = None if self.heading is None else round(float(self.heading), 3)
+        return json.dumps([str(self.goal), round(float(self.x), 4), round(float(self.y), 4), h, self.room])
+
+    @property
+    def hash(self) -> str:
+        return hashlib.sha256(self.content.encode()).hexdigest()[:16]
+
+    def row(self) -> dict:
+        """The episode as a row of ``episodes.csv``."""
+        return {"episode": self.index, "goal": self.goal, "start_x": round(self.x, 4), "start_y": round(self.y, 4),
+                "start_heading": "" if self.heading is None else round(self.heading, 3),
+                "room": "" if self.room is None else self.room, "shortest_m": round(self.shortest_m, 3), "hash": self.hash}
+
+
+def episode_seed(ep: Episode, repeat: int, base_seed: int, *salt: int) -> np.random.SeedSequence:
+    """The seed of repeat ``repeat`` of episode ``ep``: base seed, episode content, repeat (and a
+    ``salt`` for a sub-stream, e.g. a chain's stage). Independent of names, paths and order."""
+    words = np.frombuffer(hashlib.sha256(ep.content.encode()).digest()[:16], np.uint32)
+    return np.random.SeedSequence([int(base_seed), int(repeat), *(int(w) for w in words), *(int(s) for s in salt)])
+
+
+def set_hash(episodes: list[Episode]) -> str:
+    """One hash for a whole set (its episodes' contents, in order)."""
+    return hashlib.sha256("\n".join(e.content for e in episodes).encode()).hexdigest()[:16]
+
+
+def label_words(label) -> list[int]:
+    """A goal label as integers for seeding (its text's hash)."""
+    return [int(w) for w in np.frombuffer(hashlib.sha256(str(label).encode()).digest()[:8], np.uint32)]
+
+
+def region_mask(free: np.ndarray, res: float, where: str, corridor_width: float) -> np.ndarray:
+    """(H, W) bool: the cells of ``where`` ("anywhere", "rooms": a disk of diameter
+    ``corridor_width`` fits in the free space around the cell, "corridors": the other free cells)."""
+    if where == "anywhere":
+        return np.ones(free.shape, bool)
+    k = 2 * int(round(corridor_width / res / 2)) + 1  # odd: a centred disk (an even one shifts the opening)
+    disk = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    wide = cv2.morphologyEx(free.astype(np.uint8), cv2.MORPH_OPEN, disk).astype(bool) & free
+    return wide if where == "rooms" else free & ~wide
+
+
+def draw_starts(stand: np.ndarray, fields: list[np.ndarray], to_world, n: int, rng: np.random.Generator,
+                lo: float, hi: float | None) -> list[tuple[float, float, float]]:
+    """``n`` starts (x, y m, heading deg) among the cells of ``stand`` whose distance in every
+    field (m) lies in [lo, hi]; empty when no cell qualifies."""
+    ok = stand.copy()
+    for f in fields:
+        ok &= np.isfinite(f) & (f >= lo) & (f <= (np.inf if hi is None else hi))
+    rr, cc = np.nonzero(ok)
+    if not len(rr):
+        return []
+    pick = rng.choice(len(rr), size=n, replace=len(rr) < n)
+    heading = rng.uniform(-180.0, 180.0, n)
+    xs, ys = to_world(rr[pick], cc[pick])
+    return [(round(float(x), 4), round(float(y), 4), round(float(h), 2)) for x, y, h in zip(xs, ys, heading)]
+
+
+def read_episodes_csv(path: Path, owner: str) -> list[dict]:
+    """The rows of an episodes CSV (goal, start_x, start_y, start_heading[, room]) as dicts; a
+    :class:`ScenarioError` naming the file and the line for anything else."""
+    text = read_user_text(path, "episodes file", owner, "episodes.file")
+    rows = list(csv.DictReader(io.StringIO(text)))
+    need = {"goal", "start_x", "start_y"}
+    if not rows or not need <= set(rows[0]):
+        raise ScenarioError(str(path), "", "expected a CSV with columns goal, start_x, start_y[, start_heading] "
+                            "(as semsearch episodes writes), with at least one row")
+    out = []
+    for k, r in enumerate(rows, 2):
+        try:
+            x, y = float(r["start_x"]), float(r["start_y"])
+            h = (r.get("start_heading") or "").strip()
+            heading = None if h in ("", "random") else float(h)
+            room = (r.get("room") or "").strip()
+        except (TypeError, ValueError):
+            raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be numbers "
+                                "(start_heading may be empty: drawn at each repeat)") from None
+        if not all(math.isfinite(v) for v in (x, y) + (() if heading is None else (heading,))):
+            raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be finite")
+        out.append({"goal": r["goal"], "x": x, "y": y, "heading": heading, "room": room or None,
+                    "file": str(path), "field": f"line {k}"})
+    return out
+
+
+def given_episodes(spec: EpisodesSpec, base: Path, file: str) -> list[dict] | None:
+    """The episodes a scenario gives by hand or in a file, as dicts (goal, x, y, heading, room,
+    file, field: where each came from, for errors); None when they are to be drawn."""
+    if spec.given is not None:
+        return [{"goal": e.goal, "x": e.x, "y": e.y, "heading": None if e.heading == "random" else float(e.heading),
+                 "room": None, "file": file, "field": f"episodes.list[{k}]"} for k, e in enumerate(spec.given)]
+    if spec.file is not None:
+        return read_episodes_csv(base / spec.file, file)
+    return None
