@@ -2,6 +2,8 @@
 that made them, and what meta.json records."""
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -197,10 +199,12 @@ def test_meta_json_records_the_provenance(tmp_path):
 def test_version_and_the_planner_list():
     res = CliRunner().invoke(app, ["--version"])
     assert res.exit_code == 0 and res.output.startswith("semsearch 0.1.0 (code ")
-    res = CliRunner().invoke(app, ["planners", str(ROOT / "examples" / "custom_planner" / "scenario.yaml")])
-    assert res.exit_code == 0, res.output
+    # a process of its own, as a user runs it (a process registers a planner name from one file only)
+    res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "planners",
+                          str(ROOT / "examples" / "custom_planner" / "scenario.yaml")], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
     for words in ("nsos", "alpha = 0.9", "straight_on", "my_planner.py", "turn_weight", "ISCG-PN-SM", "lsos"):
-        assert words in res.output, words
+        assert words in res.stdout, words
 
 
 # ---- indirect search ------------------------------------------------------------------------
@@ -218,3 +222,36 @@ def test_indirect_search_draws_a_start_per_trial_inside_its_room(tmp_path):
         r, c = g.frame.to_index(e.x, e.y)
         assert g.stand[r, c] and np.isfinite(e.shortest_m)
     assert len({(e.x, e.y) for e in eps}) == 6
+
+
+def test_object_search_and_chains_draw_starts_too(tmp_path):
+    d = yaml.safe_load((CONFIGS / "office.yaml").read_text())
+    d["map"]["image"] = str(ROOT / "maps" / "office" / "map.png")
+    d["objects"]["cases"] = [c for c in d["objects"]["cases"] if c["name"] == "Moved-mug"]
+    d["planners"] = [{"name": "lsos"}]
+    d["episodes"] = {"starts": 3, "where": "rooms", "corridor_width": 2.0}
+    d["experiment"] = {"seeds": 1, "max_distance": 300}
+    p = tmp_path / "office.yaml"
+    p.write_text(yaml.safe_dump(d))
+    L = Loaded.load(p)
+    t, w = L.task, L.world
+    rooms = region_mask(w.free, w.frame.res, "rooms", 2.0)
+    assert len(t.episodes) == 3 * len(t.goals)
+    for e in t.episodes:
+        r, c = w.frame.to_index(e.x, e.y)
+        assert rooms[r, c] and w.reach[r, c]
+        assert e.shortest_m == pytest.approx(w.geodesic((int(r), int(c)), t.goal_cells(e.goal))[0], abs=1e-6)
+    rows = run_batch(L, expand(L, goals=[t.goals[0]]), tmp_path / "out", 1)
+    assert len(rows) == 3 and (rows["start_x"].tolist() == [e.x for e in t.episodes[:3]])
+    h = yaml.safe_load((CONFIGS / "hospital.yaml").read_text())
+    h["map"]["image"] = str(ROOT / "maps" / "hospital" / "map.png")
+    h["doors"] = str(ROOT / "maps" / "hospital" / "doors.csv")
+    h["episodes"] = {"starts": 2}
+    q = tmp_path / "hospital.yaml"
+    q.write_text(yaml.safe_dump(h))
+    c = Loaded.load(q).task
+    first = c.episodes[0]
+    ch = c.chains[str(first.goal)]
+    r, cc = c.world.frame.to_index(first.x, first.y)
+    legs = c._shortest_legs(ch, c.stages[ch.name], "x", (int(r), int(cc)))
+    assert first.shortest_m == pytest.approx(sum(legs)) and first.shortest_m > legs[0]  # every leg, not the first alone

@@ -129,6 +129,8 @@ class EpisodesSpec(Strict):
     where: Literal["anywhere", "corridors", "rooms"] = Field(
         "anywhere", description="draw only in corridors (free space narrower than corridor_width) or only in rooms (the rest)")
     corridor_width: float = Field(3.0, gt=0.0, le=MAX_RADIUS * 2, description="m, free space narrower than this is corridor")
+    clearance: float = Field(0.5, ge=0.0, le=MAX_RADIUS, description="m, least distance from a drawn start to a wall "
+                             "(a start hugging a wall can leave the robot unable to plan; door and object maps)")
     min_distance: float = Field(0.0, ge=0.0, le=MAX_COORD, description="m, least geodesic distance from a start to its goal")
     max_distance: float | None = Field(None, gt=0.0, le=MAX_COORD, description="m, greatest geodesic distance to the goal")
     shared: bool = Field(False, description="one set of starts for every goal (each within the distances of every goal)")

@@ -12,7 +12,7 @@ from ..runner import run_rows
 from . import stats as S
 from . import tables as T
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import (animate_run, budget_curve, image_formats, nsos_alphas, plot_alpha_sweep, plot_boxes, plot_budget,
+from .plots import (animate_run, budget_curve, episode_mean, image_formats, nsos_alphas, plot_alpha_sweep, plot_boxes, plot_budget,
                     plot_path_panels, plot_scenario, planner_colors)
 from .runfiles import load_paths, median_label, safe_name, start_points, stems
 from .tables import goal_key
@@ -86,16 +86,16 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
         plot_boxes(sub, scen, order, f, img, colors)
         doc.figure(f, f"Distance travelled per goal and planner, {scen}: boxes span the quartiles (line: median; "
                       "whiskers: 1.5 IQR; dots: outliers); diamonds: the mean with its 95% interval over "
-                      f"{unit} (bootstrap); dashed: the shortest path; n: runs per planner and goal")
+                      f"{unit} (bootstrap); dashed: the shortest path (mean over the episodes); n: runs per planner and goal")
         curve = budget_curve(sub)
         write_table(fdir.parent / "tables", f"budget_{scen}", curve, formats)
-        shortest = sub.groupby("goal")["shortest_m"].first().to_dict()
+        shortest = {g: episode_mean(d, "shortest_m") for g, d in sub.groupby("goal")}
         f = fdir / f"budget_{scen}.png"
         plot_budget(curve, order, f, img, colors, shortest, unit)
         doc.figure(f, f"Success against the distance budget b, {scen}: a row per goal (goals are not pooled: their "
                       "shortest paths differ), a column per planner; the share of runs that found the goal within b "
                       f"metres, with its 95% interval over {unit} (clustered Wilson), the other planners in grey; "
-                      "dotted: the shortest path")
+                      "dotted: the shortest path (mean over the episodes)")
         if len(nsos_alphas(sub)) >= 2:
             f = fdir / f"alpha_{scen}.png"
             plot_alpha_sweep(sub, f, formats=img, colors=colors)

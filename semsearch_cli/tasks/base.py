@@ -184,16 +184,20 @@ class Task:
             eps = given_episodes(spec, self.path.parent, self.file)
             if eps is None:
                 eps = self.draw_episodes(spec)
-        out = []
-        for k, e in enumerate(eps):
-            goal = self.check_episode_goal(e)
+        goals = [self.check_episode_goal(e) for e in eps]
+        for e in eps:
             r, c = w.frame.to_index(e["x"], e["y"])
             if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
                 raise ScenarioError(e["file"], e["field"], f"the start ({e['x']:g}, {e['y']:g}) m is not free space "
                                     "reachable from the scenario's start (or lies closer than the robot radius to a wall)")
-            d = self.shortest_from(goal, e["x"], e["y"])  # inf only for a goal nothing achieves (an object absent at its hour)
-            out.append(Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None, d))
-        return out
+        shortest = {}
+        for g in dict.fromkeys(map(str, goals)):  # goal by goal: one map-sized field alive at a time
+            for k, (goal, e) in enumerate(zip(goals, eps)):
+                if str(goal) == g:  # inf only for a goal nothing achieves (an object absent at its hour)
+                    shortest[k] = e["shortest"] if "shortest" in e else self.shortest_from(goal, e["x"], e["y"])
+            self.__dict__.get("_fields", {}).pop(g, None)
+        return [Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None, shortest[k])
+                for k, (goal, e) in enumerate(zip(goals, eps))]
 
     def check_episode_goal(self, e: dict):
         """The goal an episode names, as the scenario writes it; a :class:`ScenarioError` when it
@@ -207,7 +211,7 @@ class Task:
     def draw_episodes(self, spec) -> list[dict]:
         """``spec.starts`` drawn starts per goal (or shared by every goal), as in :mod:`.episodes`."""
         w = self.world
-        stand = w.reach & region_mask(w.free, w.frame.res, spec.where, spec.corridor_width)
+        stand = w.reach & (w.clearance >= spec.clearance) & region_mask(w.free, w.frame.res, spec.where, spec.corridor_width)
         where = "" if spec.where == "anywhere" else f" in {spec.where}"
         band = f"between {spec.min_distance:g} and {spec.max_distance:g} m" if spec.max_distance else f"at least {spec.min_distance:g} m"
         out = []
@@ -217,10 +221,15 @@ class Task:
             starts = draw_starts(stand, fields, w.frame.to_world, spec.starts,
                                  np.random.default_rng(seed), spec.min_distance, spec.max_distance)
             if not starts:
-                raise ScenarioError(self.file, "episodes", f"no reachable free cell{where} lies {band} from goal"
+                raise ScenarioError(self.file, "episodes", f"no reachable free cell{where}, {spec.clearance:g} m or more from "
+                                    f"walls, lies {band} from goal"
                                     f"{'s' if len(goals) > 1 else ''} {', '.join(map(str, goals))}; widen the distances "
                                     "or the region")
-            out += [dict(goal=g, x=x, y=y, heading=h, file=self.file, field="episodes") for g in goals for x, y, h in starts]
+            for g in goals:
+                out += [dict(goal=g, x=x, y=y, heading=h, file=self.file, field="episodes", shortest=self.shortest_from(g, x, y))
+                        for x, y, h in starts]
+                if not spec.shared:
+                    self._fields.pop(str(g), None)
         if spec.shared:  # goal by goal, as when drawn per goal
             out.sort(key=lambda e: [str(g) for g in self.goals].index(str(e["goal"])))
         return out

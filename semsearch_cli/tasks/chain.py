@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError
-from ..metrics import spl
+from ..metrics import CAUSES, spl
 from ..planners import Variant
 from .base import RobotState, RunResult, Task, register_task
 from .episodes import Episode, episode_seed
@@ -229,9 +229,11 @@ class ChainTask(Task):
 
 def _stage_row(k: int, s: Stage, mode: str, outcome: str, distance: float, steps: int, shortest: float, decisions: int,
                wall: float) -> dict:
-    """The columns of a stage row that differ from its chain's row."""
+    """The columns of a stage row that differ from its chain's row (SoftSPL and the distance left
+    are the chain's alone: empty here)."""
     success = outcome == "found"
-    return {"stage": f"{k}:{s.label}", "map": mode, "outcome": outcome, "success": int(success),
+    return {"stage": f"{k}:{s.label}", "map": mode, "outcome": outcome, "cause": CAUSES.get(outcome, outcome),
+            "success": int(success), "soft_spl": "", "left_m": "",
             "distance_m": round(distance, 3), "shortest_m": round(shortest, 3),
             "ratio": round(distance / shortest, 4) if shortest > 0 else float("nan"),
             "spl": round(spl(success, shortest, distance), 4), "steps": steps, "decisions": decisions, "wall_s": round(wall, 3)}

@@ -16,7 +16,9 @@ read from a CSV (``file``, as written by ``semsearch episodes``). Without the se
 episode per goal, from the scenario's ``start`` (the thesis' fixed starts).
 
 Drawing. The candidate cells are those the robot can stand on and reach from the scenario's
-start, optionally only corridors or only rooms: a cell is in a room when a disk of diameter
+start, at least ``clearance`` from walls (0.5 m by default: a robot started within a few
+centimetres of its radius from a wall, facing it, sees too little to plan and can end stuck at its
+start; one such start in 40 on the hotel did), optionally only corridors or only rooms: a cell is in a room when a disk of diameter
 ``corridor_width`` fits in the free space around it (a morphological opening of the free map),
 in a corridor otherwise. Of those, a cell qualifies when its geodesic distance to the goal (to the
 nearest pose that achieves it, as the shortest path column measures it) lies in
