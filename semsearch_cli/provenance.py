@@ -1,9 +1,10 @@
 """What made a result: semsearch's version and the hash of its code, the git commit it was
 installed from (when it runs from a checkout), and the versions of what it runs on.
 
-``code_hash()`` hashes every ``.py`` file of the package (its path and bytes), so two installs of
-the same code agree and any edit, committed or not, changes it; rows carry it through each
-planner's code hash (see :func:`semsearch_cli.planners.code_of`)."""
+``code_hash()`` hashes the ``.py`` files of the package that a run executes (paths and bytes; not
+the report or the command line), so two installs of the same code agree and any edit of the
+simulator or a planner, committed or not, changes it; rows carry it through each planner's code
+hash (see :func:`semsearch_cli.planners.code_of`)."""
 
 from __future__ import annotations
 
@@ -21,14 +22,30 @@ PACKAGE = Path(__file__).resolve().parent
 DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "scikit-image", "opencv-python-headless", "matplotlib", "pydantic")
 
 
-@functools.cache
-def code_hash() -> str:
-    """sha256 (16 hex digits) of the package's Python files, paths and bytes, in path order."""
+# what a run does not execute: the report, the command line and its API (a typo fixed in a plot
+# must not throw every row away)
+NOT_RUN = ("report/", "cli.py", "api.py")
+
+
+def files_hash(root: Path, skip: tuple = (), recursive: bool = True) -> str:
+    """sha256 (16 hex digits) of the Python files under ``root`` (in its subfolders too when
+    ``recursive``; paths relative to it and bytes, in path order), leaving out those whose
+    relative path starts with one of ``skip``."""
     h = hashlib.sha256()
-    for f in sorted(PACKAGE.rglob("*.py")):
-        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0")
+    for f in sorted(root.rglob("*.py") if recursive else root.glob("*.py")):
+        rel = f.relative_to(root).as_posix()
+        if rel.startswith(skip) or "/." in "/" + rel:
+            continue
+        h.update(rel.encode() + b"\0")
         h.update(f.read_bytes())
     return h.hexdigest()[:16]
+
+
+@functools.cache
+def code_hash() -> str:
+    """The hash of the code a run executes: every Python file of the package but the report and
+    the command line (:data:`NOT_RUN`)."""
+    return files_hash(PACKAGE, NOT_RUN)
 
 
 @functools.cache

@@ -139,7 +139,7 @@ def test_a_renamed_copy_gives_identical_rows(tmp_path):
     a, b = demo(tmp_path, "demo"), demo(tmp_path / "elsewhere", "another-name")
     ra = run_batch(Loaded.load(a), expand(Loaded.load(a)), tmp_path / "a", 1)
     rb = run_batch(Loaded.load(b), expand(Loaded.load(b)), tmp_path / "b", 1)
-    cols = [c for c in ra.columns if c not in ("scenario", "wall_s")]
+    cols = [c for c in ra.columns if c not in ("scenario", "wall_s", "fingerprint")]  # the name is part of the fingerprint
     key = ["goal", "episode", "seed"]
     pd.testing.assert_frame_equal(ra.sort_values(key)[cols].reset_index(drop=True), rb.sort_values(key)[cols].reset_index(drop=True))
     assert set(ra["scenario"]) == {"demo"} and set(rb["scenario"]) == {"another-name"}
@@ -255,3 +255,34 @@ def test_object_search_and_chains_draw_starts_too(tmp_path):
     r, cc = c.world.frame.to_index(first.x, first.y)
     legs = c._shortest_legs(ch, c.stages[ch.name], "x", (int(r), int(cc)))
     assert first.shortest_m == pytest.approx(sum(legs)) and first.shortest_m > legs[0]  # every leg, not the first alone
+
+
+@pytest.mark.parametrize("text,where", [
+    ("", "expected a CSV"),
+    ("goal,start_x\n304,1\n", "expected a CSV"),
+    ("goal,start_x,start_y\n304,15,10\n\n304,abc,10\n", "line 4"),
+    ("goal,start_x,start_y\n304,15,nan\n", "finite"),
+    ('goal,start_x,start_y\n304,15,"' + "x" * 200_000 + '"\n', "not a CSV"),
+])
+def test_a_bad_episodes_file_is_refused_naming_it_and_the_line(tmp_path, text, where):
+    (tmp_path / "eps.csv").write_text(text)
+    res = CliRunner().invoke(app, ["validate", str(demo(tmp_path, episodes={"file": "eps.csv"}))])
+    assert res.exit_code == 2 and "eps.csv" in res.output and where in res.output and "Traceback" not in res.output
+
+
+def test_a_changed_episode_set_never_passes_off_another_starts_rows(tmp_path):
+    """Rows are resumed by (goal, episode index): when the set changes under an index (here a
+    goal added to shared starts), the rows of the old start are moved aside and re-run."""
+    p = demo(tmp_path, goals=[304], episodes={"starts": 2, "shared": True, "min_distance": 5.0})
+    L = Loaded.load(p)
+    out = tmp_path / "out"
+    first = run_batch(L, expand(L, seeds=1), out, 1)
+    p2 = demo(tmp_path, goals=[304, 452], episodes={"starts": 2, "shared": True, "min_distance": 5.0})
+    L2 = Loaded.load(p2)
+    starts = {(str(e.goal), e.index): (e.x, e.y) for e in L2.task.episodes}
+    again = run_batch(L2, expand(L2, seeds=1), out, 1)
+    assert len(again) == 4 and all(starts[(str(g), e)] == (x, y) for g, e, x, y in
+                                   zip(again["goal"], again["episode"], again["start_x"], again["start_y"]))
+    side = pd.read_csv(out / "runs.superseded.csv")
+    moved = [(x, y) for x, y in zip(first["start_x"], first["start_y"]) if (x, y) not in set(zip(again["start_x"], again["start_y"]))]
+    assert len(side) == len(moved) > 0

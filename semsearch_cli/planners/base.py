@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import inspect
 import itertools
 import math
 import sys
@@ -33,7 +34,7 @@ from ..belief import Belief, Candidates
 from .. import __version__
 from ..errors import ScenarioError
 from ..files import user_file
-from ..provenance import code_hash
+from ..provenance import code_hash, files_hash
 
 
 class NoParams(BaseModel):
@@ -226,16 +227,21 @@ def planner_class(variant: Variant) -> type[Planner]:
 
 def code_of(variant: Variant) -> dict:
     """What a variant's results depend on besides the scenario: semsearch's own code (version and
-    hash of its files) and the planner's: a user's file by its bytes, a planner from an installed
-    package by that distribution's name and version. ``hash`` (16 hex digits) combines them; rows
-    carry it in their ``code`` column."""
+    :func:`~semsearch_cli.provenance.code_hash`) and the planner's: a user's file by its bytes and
+    those of the other Python files beside it (modules it may import); a planner from an
+    installed package by that distribution's name and version and the hash of its package's
+    Python files (an editable install changes with its files). ``hash`` (16 hex digits) combines
+    them; rows carry it in their ``code`` column."""
     cls = planner_class(variant)
     out = {"planner": variant.label, "semsearch": __version__, "semsearch_code": code_hash()}
     mod = cls.__module__
+    own = ""
     if variant.module is not None:
+        path = Path(variant.module)
         out["source"] = "file"
         out["file"] = variant.module
-        out["file_sha256"] = hashlib.sha256(Path(variant.module).read_bytes()).hexdigest()
+        out["file_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        own = out["file_sha256"] + files_hash(path.parent, recursive=False)
     elif mod == "semsearch_cli" or mod.startswith("semsearch_cli."):
         out["source"] = "built-in"
     else:
@@ -243,6 +249,11 @@ def code_of(variant: Variant) -> dict:
         dists = packages_distributions().get(top, [])
         out["source"] = "entry point"
         out["distribution"] = ", ".join(f"{d} {version(d)}" for d in dists) or f"module {mod} (no distribution found)"
-    parts = [out["semsearch"], out["semsearch_code"], out.get("file_sha256", ""), out.get("distribution", "")]
+        src = inspect.getsourcefile(sys.modules[top]) if top in sys.modules else None
+        if src:
+            root = Path(src).parent if Path(src).name == "__init__.py" else None
+            out["package_code"] = files_hash(root) if root else hashlib.sha256(Path(src).read_bytes()).hexdigest()[:16]
+        own = out["distribution"] + out.get("package_code", "")
+    parts = [out["semsearch"], out["semsearch_code"], own]
     out["hash"] = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     return out

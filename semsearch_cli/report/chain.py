@@ -22,7 +22,7 @@ def chain_table(runs: pd.DataFrame) -> pd.DataFrame:
     keys = ["scenario", "goal", "planner"]
     g = rows.groupby(keys, sort=False)
     out = g.agg(n=("distance_m", "size"), success_rate=("success", "mean"), mean=("distance_m", "mean"),
-                std=("distance_m", "std"), shortest_m=("shortest_m", "first"), mean_ratio=("ratio", "mean")).reset_index()
+                std=("distance_m", "std"), shortest_m=("shortest_m", "mean"), mean_ratio=("ratio", "mean")).reset_index()
     return out.merge(T.per_group(rows, keys, T.intervals, T.INTERVALS), on=keys, how="left").round(3)
 
 
@@ -32,7 +32,7 @@ def stage_table(runs: pd.DataFrame) -> pd.DataFrame:
     st = runs[runs["stage"] != ""]
     g = st.groupby(["scenario", "goal", "stage", "planner", "map"], sort=False)
     return g.agg(n=("distance_m", "size"), success_rate=("success", "mean"), mean=("distance_m", "mean"),
-                 shortest_m=("shortest_m", "first")).round(3).reset_index()
+                 shortest_m=("shortest_m", "mean")).round(3).reset_index()
 
 
 def saving_table(stages: pd.DataFrame) -> pd.DataFrame:

@@ -136,7 +136,7 @@ def _rerun(task, variant, goal, episode: int, seed: int, recorder):
     """Re-simulate one run (runs are deterministic): the one place the report calls ``task.run``.
     ``episode`` is the row's index in the task's episode set; when that episode is not of ``goal``
     (rows from before episodes read as episode 0), the goal's first episode."""
-    ep = next((e for e in getattr(task, "episodes", ()) if e.index == episode and str(e.goal) == str(goal)), None)
+    ep = next((e for e in task.episodes if e.index == episode and str(e.goal) == str(goal)), None)
     return task.run(variant, ep if ep is not None else goal, seed, recorder=recorder)
 
 

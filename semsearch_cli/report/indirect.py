@@ -135,11 +135,8 @@ def _rerun(task, variant, scale: float, episode: int, seed: int, recorder):
     """Re-simulate one search (runs are deterministic): the one place this section calls
     ``task.run``; returns (result, the room searched). ``episode`` is the row's index in the task's
     episode set; when that episode is not at ``scale`` (rows from before episodes, read as episode
-    0), the scale's first episode. A task without episodes searched room ``seed mod n``."""
-    eps = getattr(task, "episodes", None)
-    if eps is None:
-        return task.run(variant, scale, seed, recorder=recorder), task.grids[seed % len(task.grids)].room
-    ep = next((e for e in eps if e.index == episode and float(e.goal) == scale), None) or task.as_episode(scale)
+    0), the scale's first episode."""
+    ep = next((e for e in task.episodes if e.index == episode and float(e.goal) == scale), None) or task.as_episode(scale)
     return task.run(variant, ep, seed, recorder=recorder), task.grids[ep.room].room
 
 

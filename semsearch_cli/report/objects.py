@@ -38,7 +38,7 @@ def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     g = df.groupby(["case", "class", "hour", "planner"], sort=False)
     out = g.agg(n=("distance_m", "size"), found=("success", "sum"), success_rate=("success", "mean"),
                 mean=("distance_m", "mean"), std=("distance_m", "std"), min=("distance_m", "min"),
-                max=("distance_m", "max"), shortest_m=("shortest_m", "first")).reset_index()
+                max=("distance_m", "max"), shortest_m=("shortest_m", "mean")).reset_index()
     keys = ["case", "class", "hour", "planner"]
     out = out.merge(T.per_group(df, keys, T.intervals, T.INTERVALS), on=keys, how="left")
     case_order = list(dict.fromkeys(df["case"]))

@@ -388,7 +388,7 @@ def budget_curve(runs: pd.DataFrame, budgets=None, confidence: float = 0.95) -> 
         unit = stats.units(g)
         found = g["success"].astype(float).to_numpy() == 1
         dist = g["distance_m"].astype(float).to_numpy()
-        grid = np.unique(np.r_[0.0, dist[found], dist.max()]) if budgets is None else np.sort(np.asarray(budgets, float))
+        grid = np.unique(np.r_[0.0, dist[found], np.nanmax(dist, initial=0.0)]) if budgets is None else np.sort(np.asarray(budgets, float))
         for lab in planner_order(g["planner"]):
             m = (g["planner"] == lab).to_numpy()
             u = unit.to_numpy()[m]

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..runner import file_stem
+from ..metrics import CAUSES as OUTCOME_CAUSES
 from . import stats as S
 
 KEYS = ["scenario", "goal", "planner"]
@@ -97,27 +96,6 @@ def interval_caption(summary: pd.DataFrame) -> str:
     return "95% intervals " + ", and ".join(parts) if parts else "no runs"
 
 
-def median_paths(folder: Path, med: pd.DataFrame, goal, order: list) -> dict:
-    """Planner label -> (path (n, 2) m, its row) of the median run of each planner for ``goal``
-    (``med`` from :func:`median_run`), in ``order``, for the runs whose path file is in
-    ``folder/paths``."""
-    out = {}
-    for r in med[med["goal"].astype(str) == str(goal)].itertuples(index=False):
-        p = folder / "paths" / f"{file_stem(r.planner, goal, int(r.seed))}.npz"
-        if p.is_file():
-            out[r.planner] = (np.load(p)["path"], r)
-    return {k: out[k] for k in order if k in out}
-
-
-def median_run(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per scenario x goal x planner: the row of the run whose distance is the (lower) median."""
-    def pick(df):
-        df = df.sort_values(["distance_m", "seed"])
-        return df.iloc[(len(df) - 1) // 2]
-
-    return runs.groupby(["scenario", "goal", "planner"], sort=True)[runs.columns.tolist()].apply(pick).reset_index(drop=True)
-
-
 # ---- the thesis' tables and what it lacked (issue: reports) -------------------------------------
 FIVE = ["median", "mean", "std", "min", "max"]
 
@@ -189,13 +167,12 @@ def percent_of_optimal(runs: pd.DataFrame, summary: pd.DataFrame | None = None) 
 
 
 CAUSES = ("budget", "stuck", "explored", "error")
-_CAUSE_OF_OUTCOME = {"budget": "budget", "stuck": "stuck", "not_found": "explored", "error": "error"}
 
 
 def causes(runs: pd.DataFrame) -> pd.Series:
     """Why each run ended without finding its goal: the ``cause`` column, or where it is missing
     or empty (older folders) the outcome (``not_found``: nowhere left to look, i.e. explored)."""
-    fallback = runs["outcome"].map(_CAUSE_OF_OUTCOME).fillna("").astype(str)
+    fallback = runs["outcome"].map(OUTCOME_CAUSES).fillna("").astype(str)
     if "cause" not in runs.columns:
         return fallback
     c = runs["cause"].fillna("").astype(str)

@@ -44,26 +44,51 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
     if codes and len(done):
         stale = done["planner"].isin(list(codes)) & (done["code"].astype(str) != done["planner"].map(codes))
         if stale.any():
-            _supersede(out, {str(p) for p in done.loc[stale, "planner"]})
+            names = ", ".join(sorted({str(p) for p in done.loc[stale, "planner"]}))
+            _supersede(out, lambda rows: rows["planner"].astype(str).isin(done.loc[stale, "planner"].astype(str)),
+                       f"were made by other code ({names}: the planner's file or semsearch changed since)")
+            done = run_rows(read_runs(runs_csv))
+    if len(done):
+        moved = _moved_episodes(loaded, done)
+        if moved.any():
+            keys = set(zip(done.loc[moved, "goal"].astype(str), done.loc[moved, "episode"].astype(int)))
+            _supersede(out, lambda rows: pd.Series([k in keys for k in zip(rows["goal"].astype(str), rows["episode"].astype(int))],
+                                                   index=rows.index),
+                       "belong to episodes whose start is no longer the one at their index (the goals or the "
+                       "episode set changed)")
             done = run_rows(read_runs(runs_csv))
     return done
 
 
-def _supersede(out: Path, planners: set) -> None:
-    """Move every row (stage rows too) of ``planners`` from runs.csv to the end of
-    runs.superseded.csv; runs.csv is replaced atomically, after the side file is on disk."""
+def _moved_episodes(loaded: Loaded, done: pd.DataFrame) -> pd.Series:
+    """Rows whose (goal, episode index) no longer names the start they ran from: a row is
+    resumed by that index, so a changed episode set must not pass another start's rows off as
+    its own."""
+    where = {(str(e.goal), e.index): (round(e.x, 4), round(e.y, 4)) for e in loaded.task.episodes}
+    got = zip(done["goal"].astype(str), done["episode"].astype(int), done["start_x"].astype(float).round(4),
+              done["start_y"].astype(float).round(4))
+    return pd.Series([(g, e) in where and where[(g, e)] != (x, y) for g, e, x, y in got], index=done.index)
+
+
+def _supersede(out: Path, which, why: str) -> None:
+    """Move the rows ``which(rows)`` selects (a run's stage rows with it) from runs.csv to the end
+    of runs.superseded.csv (nothing is lost), then replace runs.csv atomically; say so on stderr."""
     runs_csv, side = out / "runs.csv", out / "runs.superseded.csv"
     rows = read_runs(runs_csv)
-    moved = rows["planner"].astype(str).isin(planners)
+    moved = which(rows)
+    old = rows[moved]
+    header = pd.read_csv(side, nrows=0).columns.tolist() if side.is_file() and side.stat().st_size else None
     with open(side, "a", encoding="utf-8", newline="") as fh:
-        rows[moved].to_csv(fh, index=False, header=fh.tell() == 0)
+        (old if header is None else old.reindex(columns=header)).to_csv(fh, index=False, header=header is None)
         fh.flush()
         os.fsync(fh.fileno())
     tmp = temp_path(runs_csv)
-    rows[~moved].to_csv(tmp, index=False)
+    with open(tmp, "w", encoding="utf-8", newline="") as fh:
+        rows[~moved].to_csv(fh, index=False)
+        fh.flush()
+        os.fsync(fh.fileno())
     os.replace(tmp, runs_csv)
-    print(f"{int(moved.sum())} row(s) of {', '.join(sorted(planners))} in {runs_csv} were made by other code (the "
-          f"planner's file or semsearch changed since): moved to {side.name}; their runs run again", file=sys.stderr)
+    print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}; their runs run again", file=sys.stderr)
 
 
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,

@@ -94,7 +94,7 @@ class Loaded:
         its fingerprint). Rows carry it, and a batch resumes only rows that match."""
         if self._fingerprint is None:
             d = self.sc.model_dump(mode="json")
-            for key in ("planners", "goals", "name"):  # the name decides nothing (seeds do not hash it)
+            for key in ("planners", "goals"):  # the name stays: rows of a renamed copy are not resumed under the old name
                 d.pop(key, None)
             for key in ("seeds", "out"):
                 d["experiment"].pop(key, None)

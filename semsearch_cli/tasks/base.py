@@ -178,8 +178,7 @@ class Task:
     def _build_episodes(self) -> list[Episode]:
         spec, w = self.sc.episodes, self.world
         if spec is None:
-            h = None if w.start_heading is None else float(np.degrees(w.start_heading))
-            eps = [dict(goal=g, x=w.start_xy[0], y=w.start_xy[1], heading=h, file=self.file, field="start") for g in self.goals]
+            eps = [self.start_episode(g) for g in self.goals]
         else:
             eps = given_episodes(spec, self.path.parent, self.file)
             if eps is None:
@@ -198,6 +197,12 @@ class Task:
             self.__dict__.get("_fields", {}).pop(g, None)
         return [Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None, shortest[k])
                 for k, (goal, e) in enumerate(zip(goals, eps))]
+
+    def start_episode(self, goal) -> dict:
+        """The episode of ``goal`` from the scenario's start (its heading, or None: per repeat)."""
+        w = self.world
+        h = None if w.start_heading is None else float(np.degrees(w.start_heading))
+        return dict(goal=goal, x=w.start_xy[0], y=w.start_xy[1], heading=h, file=self.file, field="start")
 
     def check_episode_goal(self, e: dict):
         """The goal an episode names, as the scenario writes it; a :class:`ScenarioError` when it
@@ -243,9 +248,8 @@ class Task:
         for e in self.episodes:
             if str(e.goal) == str(ep) or (isinstance(ep, float) and str(e.goal) == f"{ep:g}"):
                 return e
-        w = self.world  # a goal without episodes: from the scenario's start
-        h = None if w.start_heading is None else float(np.degrees(w.start_heading))
-        return Episode(-1, ep, w.start_xy[0], w.start_xy[1], h, None, self.shortest_from(ep, *w.start_xy))
+        e = self.start_episode(ep)  # a goal without episodes: from the scenario's start
+        return Episode(-1, ep, e["x"], e["y"], e["heading"], None, self.shortest_from(ep, e["x"], e["y"]))
 
     # ---- running ----------------------------------------------------------------------
     def start_state(self, ep: Episode, rng: np.random.Generator) -> RobotState:

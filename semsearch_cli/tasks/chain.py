@@ -24,7 +24,6 @@ leg from there to the nearest pose that sees an instance of the class in its roo
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 
@@ -121,20 +120,25 @@ class ChainTask(Task):
             legs.append(d)
             cell = end
             if s.cls is not None:
-                ot = self.objects
-                rng = ot.spec.camera.for_class(s.cls)[1]
-                target = np.zeros_like(w.reach)
-                room = set(self.room_places(s.door))
-                for cl, p in self._instances(ch, s):
-                    if cl == s.cls and p in room:
-                        target |= ot.view_mask(*ot.places[p], rng)
-                d, end = w.geodesic(cell, target)
+                d, end = w.geodesic(cell, self._object_target(ch, s))
                 if end is None:
                     raise ScenarioError(self.file, f"{field}.stages[{j}]", f"at {s.hour:g}:00 no {s.cls} stands in the room "
                                         f"behind door {s.door} (timeline {ch.truth}) where the camera could see it")
                 legs.append(d)
                 cell = end
         return legs
+
+    def _object_target(self, ch, s: Stage) -> np.ndarray:
+        """(H, W) bool: the reachable poses that see an instance of stage ``s``'s class in the room
+        behind its door, at its hour."""
+        ot = self.objects
+        rng = ot.spec.camera.for_class(s.cls)[1]
+        target = np.zeros_like(self.world.reach)
+        room = set(self.room_places(s.door))
+        for cl, p in self._instances(ch, s):
+            if cl == s.cls and p in room:
+                target |= ot.view_mask(*ot.places[p], rng)
+        return target
 
     @property
     def goals(self) -> list:
@@ -201,12 +205,15 @@ class ChainTask(Task):
             o2, d2, _ = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, False)
             stages.append(_stage_row(k, s, "scratch", o2, fresh.distance, fresh.steps, shortest, d2, time.perf_counter() - t_s))
             if outcome != "found":
-                # left: to this stage's door (when its door was not read) and the legs after it;
-                # unknown once the door was read and the object search in the room failed
+                # left: to this stage's door and on to its object (when its door was not read), or
+                # to its object (the door read, the search in the room failed); then the legs after it
                 rest = float(sum(legs[used:]))
-                unread = st.read_signs.isdisjoint(self.world.signs.indices_of(s.door))
-                to_door = self.doors.distance_left(s.door, st.x, st.y) if unread else math.nan
-                left = to_door + (legs[used - 1] if s.cls is not None else 0.0) + rest
+                if st.read_signs.isdisjoint(self.world.signs.indices_of(s.door)):
+                    left = self.doors.distance_left(s.door, st.x, st.y) + (legs[used - 1] if s.cls is not None else 0.0)
+                else:
+                    r, c = self.world.frame.to_index(st.x, st.y)
+                    left = self.world.geodesic((int(r), int(c)), self._object_target(ch, s))[0]
+                left += rest
                 break
         res = RunResult(outcome, st.distance, st.steps, decisions, time.perf_counter() - t0,
                         np.asarray(st.trail, np.float32), sorted(st.read_signs), trace_all, stages, left_m=left,

@@ -132,13 +132,19 @@ def read_episodes_csv(path: Path, owner: str) -> list[dict]:
     """The rows of an episodes CSV (goal, start_x, start_y, start_heading[, room]) as dicts; a
     :class:`ScenarioError` naming the file and the line for anything else."""
     text = read_user_text(path, "episodes file", owner, "episodes.file")
-    rows = list(csv.DictReader(io.StringIO(text)))
+    reader = csv.DictReader(io.StringIO(text))
+    rows = []
+    try:
+        for r in reader:
+            rows.append((reader.line_num, r))
+    except csv.Error as exc:
+        raise ScenarioError(str(path), f"line {reader.line_num}", f"not a CSV file semsearch can read ({exc})") from None
     need = {"goal", "start_x", "start_y"}
-    if not rows or not need <= set(rows[0]):
+    if not rows or not need <= set(reader.fieldnames or ()):
         raise ScenarioError(str(path), "", "expected a CSV with columns goal, start_x, start_y[, start_heading] "
                             "(as semsearch episodes writes), with at least one row")
     out = []
-    for k, r in enumerate(rows, 2):
+    for k, r in rows:
         try:
             x, y = float(r["start_x"]), float(r["start_y"])
             h = (r.get("start_heading") or "").strip()
@@ -149,7 +155,7 @@ def read_episodes_csv(path: Path, owner: str) -> list[dict]:
                                 "(start_heading may be empty: drawn at each repeat)") from None
         if not all(math.isfinite(v) for v in (x, y) + (() if heading is None else (heading,))):
             raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be finite")
-        out.append({"goal": r["goal"], "x": x, "y": y, "heading": heading, "room": room or None,
+        out.append({"goal": (r["goal"] or "").strip(), "x": x, "y": y, "heading": heading, "room": room or None,
                     "file": str(path), "field": f"line {k}"})
     return out
 

@@ -2,8 +2,9 @@
 in a room, helped by the secondary objects the semantic camera sees.
 
 Goals are view scales (m): how far A can be detected (the secondary objects always at
-``camera.secondary_range``). Run k of a goal searches room ``k mod n`` from the room's start, so
-the rooms are used equally often, as in the paper. One step of the loop is one camera frame
+``camera.secondary_range``). An episode is one room at one scale, from a start in that room (the
+room's own start, or starts drawn per room: :meth:`IndirectTask.build_episodes`), so the rooms are
+used equally often, as in the paper. One step of the loop is one camera frame
 (``camera.fps``): (1) the camera detects (Section 4.2-4.3), (2) the map of A takes the frame in
 (Section 3.1: A not seen; each secondary object seen or, for PN planners, not seen; a planner
 without masks folds in A's non-detections only), (3) A detected ends the search, (4) the planner
@@ -253,7 +254,7 @@ class IndirectSearch:
 
 @register_task
 class IndirectTask(Task):
-    """Indirect search: goals are view scales; seed k searches room k mod n."""
+    """Indirect search: goals are view scales; each episode searches one room from one start."""
 
     kind = "indirect"
     planner_kind = "indirect"
