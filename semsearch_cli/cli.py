@@ -75,7 +75,7 @@ def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
 @app.command()
 def run(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Runs per goal and planner variant (default: the scenario's experiment.seeds)."),
+    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Repeats of each episode per planner variant (default: the scenario's experiment.seeds)."),
     workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
     goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate)."),
     planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
@@ -86,7 +86,7 @@ def run(
     executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
 ):
-    """Run a scenario's experiment: goals x planner variants x seeds; rows are appended to
+    """Run a scenario's experiment: episodes x planner variants x repeats; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
     _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir, progress=tick, trace=trace,
