@@ -66,6 +66,9 @@ class SemanticCameraSpec(Strict):
     pitch: float = Field(30.0, ge=0.0, lt=90.0, description="degrees down (ours: the paper gives none; at 0 nothing "
                          "nearer than 1.2 m is in the vertical field, so view scale 1.0 could never see A)")
     fps: float = Field(3.0, gt=0.0, le=30.0)
+    occlusion: Literal["diameter", "radius"] = Field(
+        "diameter", description="Algorithm 4 as printed: spheres overlap when their centres are nearer than the sum of "
+        "atan2(rho, x) with rho the diameter; radius: the sum of angular radii atan2(rho / 2, x) (our earlier reading)")
     diameters: dict[str, Annotated[float, Field(gt=0.0, le=10.0)]] = Field(
         default_factory=lambda: {"monitor": 0.5, "keyboard": 0.45, "system_unit": 0.45, "router": 0.25},
         description="m, each class's sphere for occlusion (Algorithm 4; ours: the paper gives no sizes)")

@@ -14,11 +14,14 @@ eleven methods, each registered under the paper's name, so rows read ``UIS``, ``
 - ``AOSEOOR`` (Elfring et al., Algorithm 3, Eq. 36): no probability map. Among the secondary
   objects seen and not yet visited, the one with the highest EU = p(o | A) + w / atan(dist) is the
   target when its EU reaches ``threshold``; the robot goes to a pose ``approach`` m from it, facing
-  it, and marks it visited on arrival. Otherwise it searches at random (a random reachable pose).
+  it, and marks it visited on arrival. Otherwise it searches at random: by default it goes to a
+  random reachable free pose of the room (``random_search: waypoint``); ``walk``, our earlier
+  reading, makes a short random move within one re-plan's horizon.
   p(o | A) is the share of Table 2 in which o is seen with A at all, 1 - C^VF.
 
 Local search: ``n_poses`` random sequences of a rotation, a translation and a rotation that the
-robot can finish before the next re-plan (SPEC: N is not in the paper; ours: 50), collision-free;
+robot can finish before the next re-plan (N = 3, as the paper prints under Eq. 34; 50 was our
+earlier choice), collision-free;
 the one whose final view cone holds the most probability of A (Eq. 33; V of Eq. 34 is the camera's
 cone at the view scale, on the grid, ignoring obstacles). Global search: regions of
 ``region`` x ``region`` cells; P_reg the sum of the map in a region; its centroid moved to the
@@ -118,7 +121,7 @@ class IndirectPlanner(Planner):
 
 class LocalParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
-    n_poses: int = Field(50, ge=1, le=5000, description="N of Eq. 33 (ours: the paper gives none)")
+    n_poses: int = Field(3, ge=1, le=5000, description="N of Eq. 34: candidate poses per re-plan (the paper prints N = 3)")
 
 
 class GlobalParams(BaseModel):
@@ -167,6 +170,22 @@ def best_view(ctx: IndirectContext, p: np.ndarray, n: int) -> tuple[Goal, float]
         h = ctx.heading + ctx.rng.uniform(-1.0, 1.0) * min(math.pi, ctx.turn_rate * ctx.horizon)
         return Goal(ctx.x, ctx.y, float(h), {"mode": "turn"}), 0.0
     return Goal(float(xs[k]), float(ys[k]), float(hs[k]), {"mode": "local", "mass": round(float(score[k]), 5)}), float(score[k])
+
+
+WAYPOINT_TRIES = 20
+
+
+def random_waypoint(ctx: IndirectContext) -> Goal:
+    """A pose drawn uniformly over the room's free cells the robot can stand on and reach, with a
+    uniform heading (a turn on the spot when none of ``WAYPOINT_TRIES`` draws is reachable)."""
+    rr, cc = np.nonzero(ctx.stand)
+    if len(rr):
+        for _ in range(WAYPOINT_TRIES):
+            k = int(ctx.rng.integers(len(rr)))
+            x, y = ctx.frame.to_world(rr[k], cc[k])
+            if np.isfinite(ctx.path_length(np.array([x]), np.array([y]))[0]):
+                return Goal(float(x), float(y), float(ctx.rng.uniform(-math.pi, math.pi)), {"mode": "random"})
+    return Goal(ctx.x, ctx.y, float(ctx.heading + math.pi / 2), {"mode": "turn"})
 
 
 class LocalSearch(IndirectPlanner):
@@ -248,7 +267,7 @@ for _search, _base in (("ISC", LocalSearch), ("ISCG", GlobalSearch)):
 
 class IsupParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
-    n_poses: int = Field(50, ge=1, le=5000)
+    n_poses: int = Field(3, ge=1, le=5000, description="N of Eq. 34 when it searches locally (the paper prints N = 3)")
     particles: int = Field(500, ge=1, le=100000)
     keep: float = Field(0.5, gt=0.0, le=1.0, description="keep particles at or above this share of the best weight")
 
@@ -287,7 +306,10 @@ class AoseoorParams(BaseModel):
     w: float = Field(0.1, ge=0.0, description="weight of distance in Eq. 36")
     threshold: float = Field(0.5, ge=0.0, description="EU needed to go to an object (ours: the paper gives none)")
     approach: float = Field(0.8, gt=0.0, description="m from the object to look at it from (ours)")
-    n_poses: int = Field(50, ge=1, le=5000)
+    random_search: Literal["waypoint", "walk"] = Field(
+        "waypoint", description="waypoint: go to a random reachable free pose of the room (Elfring et al.'s random "
+        "search); walk: a short random move within one re-plan's horizon (our earlier reading)")
+    n_poses: int = Field(50, ge=1, le=5000, description="random moves tried per re-plan (random_search: walk)")
 
 
 @register_planner("AOSEOOR")
@@ -326,7 +348,9 @@ class Aoseoor(IndirectPlanner):
                     self.target = cands[j]
                     return Goal(float(gx), float(gy), float(a + math.pi), {"mode": "object", "object": cands[j],
                                                                            "eu": round(float(eu[j]), 4)})
-        # random search: a random reachable pose
+        if self.params.random_search == "waypoint":
+            return random_waypoint(ctx)
+        # random walk: a short random move that the robot can finish before the next re-plan
         xs, ys, hs, ok = local_poses(ctx, self.params.n_poses)
         k = int(np.flatnonzero(ok)[0]) if ok.any() else None
         if k is None:

@@ -5,10 +5,11 @@ Eq. 37 (robot yaw, then the camera's pitch; ours: ``pitch`` degrees down, since 
 none), and is in view when its distance r_d (Eq. 38) lies in [min_depth, range], its horizontal
 angle theta_d (Eq. 39) within hfov / 2 and its vertical angle phi_d (Eq. 40) within vfov / 2, and
 no obstacle box stands on the line from the robot to it. Objects in view occlude each other as
-spheres (Algorithm 4): when the angular distance of two centres is at most the sum of their
-angular radii ``atan2(rho / 2, x_cam)``, the farther one is not detected. (Algorithm 4 prints
-``atan2(rho, x)`` with rho the diameter, which is the angular diameter; two projected discs meet
-when the centres are nearer than the sum of the radii, so we halve it.) Each object left is then
+spheres (Algorithm 4): when the angular distance of two centres is at most the sum of
+``atan2(rho, x_cam)`` over the two, rho the object's diameter, as the paper prints it (by default,
+``occlusion: diameter``), the farther one is not detected. ``occlusion: radius`` halves rho (the
+sum of angular radii: where two projected discs actually meet; our earlier reading, kept as an
+option: the printed test hides more objects). Each object left is then
 detected with the probability of the look-up table (Table 1's axes; ours unless the scenario gives
 its own): the yaw bin is the direction from the object to the camera relative to the object's
 yaw, the nearest of the eight; the distance is interpolated linearly between the table's columns
@@ -131,12 +132,13 @@ class SemanticCamera:
 
     def occlude(self, seen: list[Seen]) -> list[Seen]:
         """Algorithm 4: of two objects whose projected spheres overlap, the farther is hidden."""
+        scale = 1.0 if self.spec.occlusion == "diameter" else 0.5
         hidden = set()
         for i in range(len(seen)):
             for j in range(i + 1, len(seen)):
                 a, b = seen[i], seen[j]
-                ang_a = math.atan2(self.spec.diameters.get(a.cls, 0.3) / 2, a.x_cam)
-                ang_b = math.atan2(self.spec.diameters.get(b.cls, 0.3) / 2, b.x_cam)
+                ang_a = math.atan2(self.spec.diameters.get(a.cls, 0.3) * scale, a.x_cam)
+                ang_b = math.atan2(self.spec.diameters.get(b.cls, 0.3) * scale, b.x_cam)
                 if math.hypot(b.theta - a.theta, a.phi - b.phi) <= ang_a + ang_b:
                     hidden.add(j if b.r > a.r else i)
         return [s for k, s in enumerate(seen) if k not in hidden]
