@@ -6,8 +6,9 @@ cost of one camera frame (wall time / frames, medians over its searches) as a ra
 the same run, the baseline: UIS updates the map with A's non-detections only, so the ratio is what
 each method's secondary objects and planning add.
 
-Usage: python benchmarks/bench_indirect.py [--seeds 200] [--workers 2] [--out results/indirect]
-       (--seeds 20 is a tenth of the experiment, a couple of minutes); then
+Usage: python benchmarks/bench_indirect.py [--starts 10] [--workers 2] [--out results/indirect]
+       (trials per method and scale: --starts drawn in each of the 20 rooms, one run each;
+       --starts 1 is a tenth of the experiment, a couple of minutes); then
        semsearch report results/indirect  for the tables, figures and the replay
 """
 
@@ -18,6 +19,7 @@ import time
 from pathlib import Path
 
 from semsearch_cli.report.build import write_meta
+from semsearch_cli.config import read_yaml
 from semsearch_cli.runner import Loaded, expand, run_batch
 
 SCENARIO = Path(__file__).resolve().parents[1] / "configs" / "indirect.yaml"
@@ -25,21 +27,25 @@ SCENARIO = Path(__file__).resolve().parents[1] / "configs" / "indirect.yaml"
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=200)
+    ap.add_argument("--starts", type=int, default=None, help="starts drawn per room (default: the scenario's)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("results/indirect"))
     ap.add_argument("--scenario", type=Path, default=SCENARIO)
     args = ap.parse_args()
-    loaded = Loaded.load(args.scenario)
-    specs = expand(loaded, seeds=args.seeds)
+    data = read_yaml(args.scenario)
+    if args.starts is not None:
+        data["episodes"] = {**(data.get("episodes") or {}), "starts": args.starts}
+    loaded = Loaded.load(args.scenario, data)
+    specs = expand(loaded)
+    trials = len(specs) // max(1, len(loaded.task.variants()) * len(loaded.goals))
     runs_csv = args.out / "runs.csv"
     if runs_csv.is_file():
         raise SystemExit(f"{runs_csv} exists: the benchmark times a fresh run; give another --out")
-    write_meta(args.out, args.scenario)  # so that `semsearch report OUT` can replay a search
+    write_meta(args.out, loaded)  # so that `semsearch report OUT` can replay a search
     t0 = time.perf_counter()
     rows = run_batch(loaded, specs, args.out, workers=args.workers)
     wall = time.perf_counter() - t0
-    print(f"{len(rows)} searches ({len(loaded.task.variants())} methods x {len(loaded.goals)} view scales x {args.seeds} "
+    print(f"{len(rows)} searches ({len(loaded.task.variants())} methods x {len(loaded.goals)} view scales x {trials} "
           f"trials), {args.workers} workers: {wall:.1f} s = {wall / 60:.1f} min (target for 15,400: 30 min); "
           f"{rows['steps'].sum() / 1e6:.2f} M frames, {rows['time_s'].astype(float).sum() / 3600:.0f} h simulated")
     rows = rows.assign(ms_per_frame=1000 * rows["wall_s"] / rows["steps"].clip(lower=1))

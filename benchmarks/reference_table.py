@@ -66,7 +66,7 @@ def main() -> int:
         L.world = build_world(L.sc, p.parent, str(p))
         todo = expand(L, a.seeds)
         t0 = time.perf_counter()
-        write_meta(a.out / name.lower(), p)
+        write_meta(a.out / name.lower(), L)
         runs = run_batch(L, todo, a.out / name.lower(), a.workers)
         print(f"{name}: {len(todo)} runs in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
         s = summarise(runs).set_index(["goal", "planner"])
