@@ -5,6 +5,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -324,3 +325,28 @@ def test_a_bad_indirect_section_names_the_field(tmp_path):
     p = scenario(tmp_path, rooms="missing.yaml")
     res = CliRunner().invoke(app, ["validate", str(p)])
     assert res.exit_code == 2 and "missing.yaml" in res.output and "rooms file not found" in res.output, res.output
+
+
+def test_the_papers_claims_are_judged_paired_and_clustered_on_rooms():
+    """ISCG-PN-SM finds A in every search, ISC-PN-SM in the rooms 5-9 only: +50 points, an interval
+    over rooms clear of 0 on the paper's side (reproduced); AOSEOOR and UIS alike: inside the noise."""
+    from semsearch_cli.report.indirect import PAPER_TABLE3, claims_table, difference_table, success_table
+
+    rows = []
+    for method in ("ISCG-PN-SM", "ISC-PN-SM", "AOSEOOR", "UIS"):
+        for room in range(10):
+            for start in range(2):
+                ok = method in ("ISCG-PN-SM", "AOSEOOR", "UIS") or room >= 5
+                rows.append({"scenario": "s", "planner": method, "goal": 1.0, "room": f"r{room}", "start_x": float(start),
+                             "start_y": 0.0, "seed": 0, "success": int(ok), "time_s": 10.0, "distance_m": 1.0, "spl": 0.5,
+                             "episode": room * 2 + start})
+    runs = pd.DataFrame(rows)
+    c = claims_table(runs).set_index(["better", "worse"])
+    iscg = c.loc[("ISCG-PN-SM", "ISC-PN-SM")]
+    assert iscg["pairs"] == 20 and iscg["ours"] == 50.0 and iscg["lo"] > 0 and iscg["verdict"] == "reproduced"
+    assert iscg["paper"] == PAPER_TABLE3["ISCG-PN-SM"][0] - PAPER_TABLE3["ISC-PN-SM"][0]
+    assert c.loc[("AOSEOOR", "UIS")]["verdict"] == "inside the noise"
+    diff, mad = difference_table(success_table(runs))
+    assert diff.loc["UIS", "1 m"] == f"{100 - PAPER_TABLE3['UIS'][0]:+.0f}"
+    assert mad == pytest.approx(np.mean([abs(100 - PAPER_TABLE3[m][0]) for m in ("ISCG-PN-SM", "AOSEOOR", "UIS")]
+                                        + [abs(50 - PAPER_TABLE3["ISC-PN-SM"][0])]))

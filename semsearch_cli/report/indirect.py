@@ -105,6 +105,98 @@ def _pivot(t: pd.DataFrame) -> pd.DataFrame:
     return w
 
 
+def difference_table(table: pd.DataFrame) -> tuple[pd.DataFrame, float]:
+    """Rows method, columns view scale: ours minus the paper's Table 3 (percentage points), where
+    the paper has the cell; and the mean absolute difference over those cells (nan without any)."""
+    t = table[table["view_scale"].isin(PAPER_SCALES)].copy()
+    paper = [PAPER_TABLE3.get(p.split("[", 1)[0]) for p in t["planner"]]
+    t["diff"] = [100 * r - (ref[PAPER_SCALES.index(v)] if ref else np.nan)
+                 for r, v, ref in zip(t["success"], t["view_scale"], paper)]
+    t = t.dropna(subset=["diff"])
+    if t.empty:
+        return pd.DataFrame(), float("nan")
+    w = _pivot(t.assign(cell=[f"{d:+.0f}" for d in t["diff"]]))
+    return w, float(t["diff"].abs().mean())
+
+
+def _claims() -> list[tuple[str, str, str]]:
+    """The paper's claims as (claim, better, worse) pairs of methods: the global search over the
+    local one, positive and negative information over positive only, soft masks over hard ones
+    (the paper's Table 3 has each of them in most cells), and AOSEOOR over UIS."""
+    out = []
+    for info in ("PN", "OP"):
+        for m in ("HM", "SM"):
+            out.append(("ISCG over ISC", f"ISCG-{info}-{m}", f"ISC-{info}-{m}"))
+    for search in ("ISC", "ISCG"):
+        for m in ("HM", "SM"):
+            out.append(("PN over OP", f"{search}-PN-{m}", f"{search}-OP-{m}"))
+    for search in ("ISC", "ISCG"):
+        for info in ("PN", "OP"):
+            out.append(("SM over HM", f"{search}-{info}-SM", f"{search}-{info}-HM"))
+    out.append(("AOSEOOR over UIS", "AOSEOOR", "UIS"))
+    return out
+
+
+PAIR_KEYS = ["room", "start_x", "start_y", "seed"]  # what two searches share when they are paired
+
+
+def _paired_success(a: pd.DataFrame, b: pd.DataFrame, keys: list[str]) -> tuple[float, float, float, int]:
+    """Mean paired difference of success (a - b, over the searches both ran from the same start,
+    room and repeat, and ``keys``) with its 95% bootstrap interval over rooms; (nan, ...) when
+    nothing pairs."""
+    j = a[keys + ["success"]].merge(b[keys + ["success"]], on=keys, suffixes=("_a", "_b"))
+    if j.empty:
+        return np.nan, np.nan, np.nan, 0
+    d = j["success_a"].astype(float) - j["success_b"].astype(float)
+    room = j["room"].astype(str) if (j["room"].astype(str) != "").all() else pd.Series(range(len(j)), index=j.index)
+    m, lo, hi = S.mean_ci(d, room)
+    return m, lo, hi, len(j)
+
+
+def _verdict(paper: float, lo: float, hi: float) -> str:
+    if not (lo == lo and hi == hi):
+        return "too few to judge"
+    if lo > 0 or hi < 0:
+        return "reproduced" if (lo > 0) == (paper > 0) and paper != 0 else "contradicted"
+    return "inside the noise"
+
+
+def claims_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Each of the paper's claims (:func:`_claims`, and for every method that success grows from
+    the smallest view scale to the largest) as a paired difference of success rate (points, ours:
+    over the searches both sides ran from the same start; the interval a bootstrap over rooms)
+    beside the paper's difference (the mean over the view scales both ran), marked reproduced
+    (our interval excludes 0 on the paper's side), contradicted (it excludes 0 on the other side)
+    or inside the noise."""
+    runs = runs.assign(method=runs["planner"].astype(str).str.split("[").str[0], scale=runs["goal"].astype(float))
+    for k in PAIR_KEYS:
+        if k not in runs.columns:
+            runs[k] = 0 if k != "room" else ""
+    rows = []
+    scales = sorted(runs["scale"].unique())
+    for claim, better, worse in _claims():
+        a, b = runs[runs["method"] == better], runs[runs["method"] == worse]
+        if a.empty or b.empty:
+            continue
+        m, lo, hi, n = _paired_success(a, b, PAIR_KEYS + ["scale"])
+        both = [s for s in scales if s in PAPER_SCALES]
+        paper = np.mean([PAPER_TABLE3[better][PAPER_SCALES.index(s)] - PAPER_TABLE3[worse][PAPER_SCALES.index(s)]
+                         for s in both]) if both else np.nan
+        rows.append({"claim": claim, "better": better, "worse": worse, "pairs": n, "ours": 100 * m, "lo": 100 * lo,
+                     "hi": 100 * hi, "paper": paper, "verdict": _verdict(paper, lo, hi)})
+    if len(scales) >= 2:
+        s0, s1 = scales[0], scales[-1]
+        for method in method_order(runs["method"]):
+            g = runs[runs["method"] == method]
+            m, lo, hi, n = _paired_success(g[g["scale"] == s1], g[g["scale"] == s0], PAIR_KEYS)
+            ref = PAPER_TABLE3.get(method)
+            paper = (ref[PAPER_SCALES.index(s1)] - ref[PAPER_SCALES.index(s0)]) if ref and {s0, s1} <= set(PAPER_SCALES) else np.nan
+            rows.append({"claim": f"success grows from {s0:g} m to {s1:g} m", "better": f"{method} at {s1:g} m",
+                         "worse": f"{method} at {s0:g} m", "pairs": n, "ours": 100 * m, "lo": 100 * lo, "hi": 100 * hi,
+                         "paper": paper, "verdict": _verdict(paper, lo, hi)})
+    return pd.DataFrame(rows, columns=["claim", "better", "worse", "pairs", "ours", "lo", "hi", "paper", "verdict"]).round(1)
+
+
 def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, notes: list) -> None:
     runs = pd.concat([run_rows(p.runs) for p in parts], ignore_index=True)
     table = success_table(runs)
@@ -118,6 +210,20 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
              f"{interval_text(table)}; in brackets the paper's Table 3 (Loncomilla et al. 2018; their rooms, simulator "
              "and detection table, so compare shapes, not values).")
     doc.table(tab3)
+    diff, mad = difference_table(table)
+    claims = claims_table(runs)
+    write_table(tdir, "indirect_claims", claims, formats)
+    if len(diff):
+        doc.heading(3, "Ours minus the paper's Table 3 (percentage points)")
+        doc.para(f"Mean absolute difference over the {diff.notna().sum().sum()} cells the paper has: {mad:.1f} points.")
+        doc.table(diff)
+    if len(claims):
+        doc.heading(3, "The paper's claims, paired")
+        doc.para("Each claim as a difference of success rate (points; ours: the mean over the searches both sides ran "
+                 "from the same start, room and repeat, with its 95% bootstrap interval over rooms; the paper's: the "
+                 "mean of its Table 3 differences over the same view scales). Reproduced: our interval excludes 0 on "
+                 "the paper's side; contradicted: on the other side; inside the noise: it holds 0.")
+        doc.table(claims.set_index(["claim", "better", "worse"]), fmt="{:.1f}")
     doc.heading(3, "Time to find (s, over the searches that found it) / SPL")
     doc.table(time_spl(table))
     img = image_formats(formats)
