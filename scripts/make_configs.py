@@ -34,7 +34,7 @@ LIBRARY = {
 }
 
 
-# the main job draws its starts (README: episodes); the thesis' fixed start stays in <name>_thesis.yaml
+# the main job draws its starts (docs/episodes.md); the thesis' fixed start stays in <name>_thesis.yaml
 EPISODES = {"hotel": ({"starts": 10, "seed": 0, "min_distance": 10.0}, 1)}  # name: (episodes section, repeats)
 
 

@@ -4,7 +4,7 @@ sections, broken files). Whatever the input, `semsearch validate` accepts it (ex
 refuses it (exit 2 with one paragraph); it never raises.
 
 CI runs a fixed, bounded set of examples (profile ``ci``); a longer random search runs with
-``SEMSEARCH_FUZZ=nightly python -m pytest tests/test_fuzz.py`` (README, "Bad input").
+``SEMSEARCH_FUZZ=nightly python -m pytest tests/test_fuzz.py`` (docs/usage.md, "Bad input").
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The sections every scenario shares: map, start, door signs, planners, robot, sensors, belief,
 navigation, experiment (SPEC 1). Lengths are metres, angles degrees; every model forbids unknown
 keys, so a misspelt key is an error naming the field, and refuses NaN and infinity, so a number
-is always a number. Sizes have upper bounds (``LIMITS`` in the README) so that no value makes an
+is always a number. Sizes have upper bounds (the Limits table in docs/usage.md) so that no value makes an
 array too big for memory or a loop that never ends."""
 
 from __future__ import annotations

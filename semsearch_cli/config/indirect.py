@@ -114,7 +114,7 @@ class IndirectRobotSpec(Strict):
     """Ours: the paper gives no speeds. We chose a slow robot, so that five minutes do not cover a
     6 m x 6 m room (an earlier measurement, with N = 50 and fixed starts, had UIS find the monitor
     in 80-90% of the searches at 0.3 m/s and 60 degrees/s); ``benchmarks/indirect_calibration.py``
-    measures what each value does (README, indirect search)."""
+    measures what each value does (docs/indirect-search.md)."""
 
     speed: float = Field(0.15, gt=0.0, le=2.0, description="m/s (ours)")
     turn_rate: float = Field(30.0, gt=0.0, le=360.0, description="degrees/s (ours)")

@@ -58,7 +58,7 @@ class DaskExecutor(Executor):
         # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which fixes glibc's mmap threshold
         # so that every grid-sized temporary is mapped and unmapped: runs took 1.45x as long (28.3 s vs
         # 19.6 s of run time for 40 Hotel runs). Unset here, and NumPy's huge pages off as in our own
-        # processes (semsearch_cli/__init__.py); README "Running on a cluster" for your own workers.
+        # processes (semsearch_cli/__init__.py); docs/usage.md "Running on a cluster" for your own workers.
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                               "distributed.nanny.pre-spawn-environ.NUMPY_MADVISE_HUGEPAGE": "0"}):
             cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",

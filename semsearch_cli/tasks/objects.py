@@ -8,7 +8,7 @@ class; a re-plan (the next target) happens when the path is used up, after looki
 quarter turns, no distance). It ends ``found``, ``not_found`` when the planner has no target left
 (Last Seen after its one spot, Brute Force after its route), or ``budget``.
 
-Choices the seeds leave open (also in the README):
+Choices the seeds leave open (also in docs/object-search.md):
 
 - **Timelines.** ``timelines[pattern][class] = {hour: place(s)}``: from that hour on the class
   stands at those places, until the next listed hour (the clock wraps, so before the first entry

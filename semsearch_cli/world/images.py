@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import ScenarioError
 from ..files import blame, user_file
 
-MAX_CELLS = 25_000_000  # 5000 x 5000: the largest map accepted (memory per run, README "Limits")
+MAX_CELLS = 25_000_000  # 5000 x 5000: the largest map accepted (memory per run, docs/usage.md "Limits")
 MIN_SIDE = 3  # cells: a map narrower than this holds no free cell inside a wall
 
 
