@@ -543,7 +543,8 @@ def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy", formats=("png",)
     if len(n_b):
         handles.append(Line2D([], [], c=colors.get(baseline, "black"), ls="--", label=f"{baseline} (n={'/'.join(map(str, n_b))})"))
     handles.append(Patch(color="0.6", alpha=0.4, label=f"95% CI over {stats.unit_kind(runs)}"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=3, handlelength=1.6, columnspacing=1.0)
+    handles.append(Line2D([], [], c="0.5", lw=0.6, label="the shortest path (ratio 1)"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=4, handlelength=1.6, columnspacing=1.0)
     return _save(fig, out, formats)
 
 
@@ -751,7 +752,7 @@ def plot_chain_stages(stage_rows, order: list, out: Path, formats=("png",), colo
                 ax.bar(x + (2 * j + m - len(order)) * width + width / 2, mean, width, yerr=err, capsize=1.5,
                        color=colors[p], alpha=1.0 if mode == "kept" else 0.45, hatch=None if mode == "kept" else "////",
                        error_kw=dict(lw=0.7))
-        ax.set_xticks(x, labels)
+        ax.set_xticks(x, [f"stage {lab.split(':', 1)[0]}\ndoor {lab.split(':', 1)[1]}" if ":" in lab else lab for lab in labels])
         ax.set_ylabel("distance (m)")
         ax.set_title(f"chain {ch}")
     n = stage_rows.groupby(["planner", "goal", "stage", "map"]).size().groupby(level=0).agg(["min", "max"])

@@ -40,7 +40,16 @@ def unit_kind(df: pd.DataFrame, cluster: str | None = None) -> str:
     ``cluster`` column), ``"episodes"`` or ``"repeats"`` (of one episode). Words for captions."""
     if _has_cluster(df, cluster):
         return f"{cluster}s"
-    return "episodes" if episodes(df).nunique() > 1 else "repeats"
+    many = _many_episodes(df)
+    return "episodes" if many.all() else "repeats" if not many.any() else "episodes (repeats where a goal has one)"
+
+
+def _many_episodes(df: pd.DataFrame) -> pd.Series:
+    """Per row, whether its goal spans more than one episode in ``df`` (all rows are one goal
+    when there is no ``goal`` column)."""
+    ep = episodes(df)
+    goal = df["goal"].astype(str) if "goal" in df.columns else pd.Series("", index=df.index)
+    return ep.groupby(goal).transform("nunique") > 1
 
 
 def units(df: pd.DataFrame, cluster: str | None = None) -> pd.Series:
@@ -58,17 +67,17 @@ def units(df: pd.DataFrame, cluster: str | None = None) -> pd.Series:
 
     Returns
     -------
-    Series of str, named ``unit``: ``"e3"`` (the episode) when the rows span more than one episode,
-    else ``"e0/s2"`` (episode and seed: the repeats of the one episode are the units), or the
-    cluster's value.
+    Series of str, named ``unit``: ``"e3"`` (the episode) for the rows of a goal that spans more
+    than one episode, else ``"e0/s2"`` (episode and seed: the repeats of a goal's one episode are
+    its units), or the cluster's value. Decided goal by goal, so that goals with one episode each
+    (the thesis configs) are never taken for one episode set.
     """
     if _has_cluster(df, cluster):
         return df[cluster].astype(str).rename("unit")
     ep = episodes(df)
-    if ep.nunique() > 1:
-        return ("e" + ep.astype(str)).rename("unit")
     seed = pd.to_numeric(df["seed"], errors="coerce").fillna(-1).astype("int64")
-    return ("e" + ep.astype(str) + "/s" + seed.astype(str)).rename("unit")
+    by_episode = "e" + ep.astype(str)
+    return by_episode.where(_many_episodes(df), by_episode + "/s" + seed.astype(str)).rename("unit")
 
 
 def _unit_means(values, unit_labels) -> pd.Series:

@@ -99,7 +99,9 @@ class Task:
     def __init__(self, sc: Scenario, world: World, path: Path):
         self.sc, self.world, self.path = sc, world, Path(path)
         self.file = str(path)
-        self.shortest: dict = {}
+        self.shortest: dict = {}  # goal -> shortest path (m) from the scenario's start, set by each kind's build
+        self._episodes: list[Episode] | None = None
+        self._fields: dict[str, np.ndarray] = {}  # goal -> distance field, only while episodes are drawn
 
     # ---- built from the scenario ------------------------------------------------------
     @property
@@ -129,25 +131,24 @@ class Task:
     @property
     def episodes(self) -> list[Episode]:
         """The scenario's episode set (see :mod:`.episodes`), built on first use."""
-        if getattr(self, "_episodes", None) is None:
+        if self._episodes is None:
             self._episodes = self.build_episodes()
         return self._episodes
 
     def goal_field(self, goal) -> np.ndarray:
         """(H, W) float, m: the ground-truth geodesic distance from every cell to ``goal`` (to the
-        nearest pose that achieves it), inf where unreachable; kept while the episodes are built
+        nearest pose that achieves it), inf where unreachable; kept while the episodes are drawn
         (one map-sized array per goal), then dropped."""
-        cache = self.__dict__.setdefault("_fields", {})
         key = str(goal)
-        if key not in cache:
+        if key not in self._fields:
             w = self.world
             rr, cc = np.nonzero(self.goal_cells(goal))
             if not len(rr):
-                cache[key] = np.full(w.reach.shape, np.inf)
+                self._fields[key] = np.full(w.reach.shape, np.inf)
             else:
                 _, length, _ = dijkstra(w.reach, np.ones((1, 1), np.float32), rr, cc, np.zeros_like(w.reach), 0, np.inf)
-                cache[key] = length * w.frame.res
-        return cache[key]
+                self._fields[key] = length * w.frame.res
+        return self._fields[key]
 
     def goal_cells(self, goal) -> np.ndarray:  # pragma: no cover
         """(H, W) bool: the reachable poses that achieve ``goal`` (a kind defines it)."""
@@ -157,7 +158,7 @@ class Task:
         """Geodesic distance (m) from (x, y) to ``goal``; inf when unreachable."""
         w = self.world
         r, c = w.frame.to_index(x, y)
-        if "_fields" in self.__dict__ and str(goal) in self._fields:
+        if str(goal) in self._fields:
             f = self._fields[str(goal)]
             return float(f[r, c]) if 0 <= r < f.shape[0] and 0 <= c < f.shape[1] else math.inf
         if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
@@ -173,7 +174,7 @@ class Task:
         try:
             return self._build_episodes()
         finally:
-            self.__dict__.pop("_fields", None)
+            self._fields.clear()
 
     def _build_episodes(self) -> list[Episode]:
         spec, w = self.sc.episodes, self.world
@@ -189,20 +190,21 @@ class Task:
             if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
                 raise ScenarioError(e["file"], e["field"], f"the start ({e['x']:g}, {e['y']:g}) m is not free space "
                                     "reachable from the scenario's start (or lies closer than the robot radius to a wall)")
-        shortest = {}
-        for g in dict.fromkeys(map(str, goals)):  # goal by goal: one map-sized field alive at a time
-            for k, (goal, e) in enumerate(zip(goals, eps)):
-                if str(goal) == g:  # inf only for a goal nothing achieves (an object absent at its hour)
-                    shortest[k] = e["shortest"] if "shortest" in e else self.shortest_from(goal, e["x"], e["y"])
-            self.__dict__.get("_fields", {}).pop(g, None)
-        return [Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None, shortest[k])
+        # a drawn or default episode brings its shortest path; inf only for a goal nothing achieves
+        # (an object absent at its hour)
+        return [Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None,
+                        e["shortest"] if "shortest" in e else self.shortest_from(goal, e["x"], e["y"]))
                 for k, (goal, e) in enumerate(zip(goals, eps))]
 
     def start_episode(self, goal) -> dict:
-        """The episode of ``goal`` from the scenario's start (its heading, or None: per repeat)."""
+        """The episode of ``goal`` from the scenario's start (its heading, or None: per repeat), with
+        the shortest path the kind's build measured from there."""
         w = self.world
         h = None if w.start_heading is None else float(np.degrees(w.start_heading))
-        return dict(goal=goal, x=w.start_xy[0], y=w.start_xy[1], heading=h, file=self.file, field="start")
+        e = dict(goal=goal, x=w.start_xy[0], y=w.start_xy[1], heading=h, file=self.file, field="start")
+        if goal in self.shortest:
+            e["shortest"] = self.shortest[goal]
+        return e
 
     def check_episode_goal(self, e: dict):
         """The goal an episode names, as the scenario writes it; a :class:`ScenarioError` when it
@@ -249,7 +251,7 @@ class Task:
             if str(e.goal) == str(ep) or (isinstance(ep, float) and str(e.goal) == f"{ep:g}"):
                 return e
         e = self.start_episode(ep)  # a goal without episodes: from the scenario's start
-        return Episode(-1, ep, e["x"], e["y"], e["heading"], None, self.shortest_from(ep, e["x"], e["y"]))
+        return Episode(-1, ep, e["x"], e["y"], e["heading"], None, e.get("shortest", self.shortest_from(ep, e["x"], e["y"])))
 
     # ---- running ----------------------------------------------------------------------
     def start_state(self, ep: Episode, rng: np.random.Generator) -> RobotState:

@@ -64,7 +64,7 @@ class ChainTask(Task):
             raise ScenarioError(self.file, "chains", "chain names must be unique")
         self.stages: dict[str, list[Stage]] = {}
         self.logs: dict[str, pd.DataFrame] = {}
-        self.legs: dict[str, list[float]] = {}
+        self.legs: dict[tuple, list[float]] = {}  # (chain, start x, start y) -> its shortest legs
 
     @classmethod
     def build(cls, sc, world, path):
@@ -78,8 +78,9 @@ class ChainTask(Task):
             if any(s.cls is not None for s in stages):
                 task._check_object_stages(ch, stages, field)
             task.stages[ch.name] = stages
-            task.legs[ch.name] = task._shortest_legs(ch, stages, field, world.start_cell)
-            task.shortest[ch.name] = float(sum(task.legs[ch.name]))
+            legs = task._shortest_legs(ch, stages, field, world.start_cell)
+            task.legs[(ch.name, *world.start_xy)] = legs
+            task.shortest[ch.name] = float(sum(legs))
         task.variants()
         return task
 
@@ -149,15 +150,15 @@ class ChainTask(Task):
         return self.world.reading_cells(self.stages[str(goal)][0].door)
 
     def shortest_from(self, goal, x: float, y: float) -> float:
-        ch = self.chains[str(goal)]
-        if (x, y) == tuple(self.world.start_xy):
-            return self.shortest[ch.name]
-        k = self.sc.chains.index(ch)
-        return float(sum(self._legs_from(ch, x, y, f"chains[{k}]")))
+        return float(sum(self.legs_from(self.chains[str(goal)], x, y)))
 
-    def _legs_from(self, ch, x: float, y: float, field: str = "episodes") -> list[float]:
-        r, c = self.world.frame.to_index(x, y)
-        return self._shortest_legs(ch, self.stages[ch.name], field, (int(r), int(c)))
+    def legs_from(self, ch, x: float, y: float) -> list[float]:
+        """The shortest legs of chain ``ch`` from a start at (x, y), computed once per start."""
+        key = (ch.name, x, y)
+        if key not in self.legs:
+            r, c = self.world.frame.to_index(x, y)
+            self.legs[key] = self._shortest_legs(ch, self.stages[ch.name], "episodes", (int(r), int(c)))
+        return self.legs[key]
 
     # ---- running ----------------------------------------------------------------------
     def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, trace: bool):
@@ -184,7 +185,7 @@ class ChainTask(Task):
         st.belief = self.doors.new_belief()
         stages, decisions, trace_all = [], 0, []
         outcome = "found"
-        legs = self.legs[ch.name] if (ep.x, ep.y) == tuple(self.world.start_xy) else self._legs_from(ch, ep.x, ep.y)
+        legs = self.legs_from(ch, ep.x, ep.y)
         leg = iter(legs)
         used = 0
         left = 0.0

@@ -266,7 +266,7 @@ class IndirectTask(Task):
         self.grids: list[RoomGrid] = []
         self._masks: dict = {}
         self._cones: dict = {}
-        self._shortest: dict = {}
+        self._views: dict = {}  # (room, scale) -> path length field to the cells that see A
         self.relations: dict = {}
         self.believed = self.spec.model_relations()
         self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in self.believed.items()}
@@ -329,7 +329,7 @@ class IndirectTask(Task):
         A is in view at ``scale`` for some heading and the detection table gives a chance of
         detecting it (A is not seen from every side); inf where no such cell is reachable."""
         key = (k, scale)
-        if key not in self._shortest:
+        if key not in self._views:
             g = self.grids[k]
             t = g.room.objects[self.spec.target]
             fr = g.frame
@@ -354,12 +354,12 @@ class IndirectTask(Task):
                         ok[a, b] = False
             rr, cc = np.nonzero(ok)
             if not len(rr):
-                self._shortest[key] = np.full(g.stand.shape, np.inf)
+                self._views[key] = np.full(g.stand.shape, np.inf)
             else:
                 g.search.run(g.stand, g.cost, rr, cc, np.zeros(0, np.int64), np.zeros(0, np.int64), 0)
                 done = g.search.closed == g.search.gen
-                self._shortest[key] = np.where(done, g.search.length_ * fr.res, np.inf)
-        return self._shortest[key]
+                self._views[key] = np.where(done, g.search.length_ * fr.res, np.inf)
+        return self._views[key]
 
     def shortest_of(self, k: int, scale: float, x: float | None = None, y: float | None = None) -> float:
         """Shortest path (m) in room ``k`` at ``scale`` from (x, y) (default: the room's start)."""
