@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal, Union
 
+import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from .base import MAX_RANGE, Strict
@@ -26,15 +27,44 @@ TABLE2 = {"keyboard": (0.773, 0.143, 0.046, 0.038),
 LUT_DISTANCES = (0.8, 1.2, 1.6, 2.0, 2.5)  # m, the paper's Table 1 axes (80-250 cm)
 LUT_YAWS = (0, 45, 90, 135, 180, 225, 270, 315)  # degrees, the object's yaw seen from the camera
 
-# OURS, not the paper's: Table 1 (detection rates by distance and yaw) is lost in our copy. Rows
-# are yaws 0..315 (the direction from the object to the camera, relative to the way the object
-# faces), columns distances 0.8..2.5 m, values in percent. What survives of Table 1 has two to four
-# numbers per yaw out of the twenty (four objects x five distances), so most of its cells were
-# empty or zero: each detector (HOG + SVM per orientation) finds its object from a few directions
-# only. Ours keeps that shape: an object is found from its front (and, less often, its back or one
-# side), rarely from elsewhere, and less often far away; the surviving values (e.g. 81, 76, 33, 40
-# and 88, 94, 41, 43 along a row) set the scale.
-OUR_LUT = {
+# Table 1 (detection rates by distance and yaw) is lost in our copy but for one line, which keeps
+# these values per yaw row with their columns (class and distance) lost, and two of the twenty
+# header labels lost too (SPEC 7):
+TABLE1_SURVIVING = {0: (81, 76, 33, 40), 45: (12, 38), 90: (12, 35, 36, 80), 135: (), 180: (88, 94, 41, 43),
+                    225: (11, 39), 270: (68, 78), 315: (20, 32, 10, 56)}
+
+
+def every_yaw_table() -> tuple[tuple[int, ...], ...]:
+    """OURS, built from :data:`TABLE1_SURVIVING`: a detection table (percent, rows yaw 0..315,
+    columns 0.8, 1.2, 1.6, 2.0, 2.5 m) that detects from every yaw, as a detector trained per class
+    and orientation does (no zero survives anywhere in the line, so a blank is not a zero).
+
+    - A yaw's level is the largest value surviving in its row, read as its rate at near range.
+      Yaw 135 has none: it takes the level of its mirror image, 225 (a monitor, a keyboard, a system
+      unit and a router look alike from the left and the right; the surviving mirror pairs agree:
+      90 and 270 read 80 and 78, 45 and 315 read 38 and 56).
+    - The falloff with distance comes from the two rows where four values survive in a run (0:
+      81 76 33 40; 180: 88 94 41 43), read as 80, 120, 160 and 200 cm: each divided by its first
+      value and the two averaged (1, 1.00, 0.44, 0.49), capped at 1 and made non-increasing (a
+      running minimum: 1, 1, 0.44, 0.44); 250 cm, lost, keeps the 200 cm value.
+    - A cell is the level times the falloff, rounded. The classes of the values are lost, so one
+      table serves all four classes.
+    """
+    levels = {yaw: max(vals) for yaw, vals in TABLE1_SURVIVING.items() if vals}
+    levels[135] = levels[225]
+    runs = [np.asarray(TABLE1_SURVIVING[yaw], float) for yaw in (0, 180)]
+    falloff = np.minimum.accumulate(np.minimum(np.mean([r / r[0] for r in runs], axis=0), 1.0))
+    falloff = np.append(falloff, falloff[-1])
+    return tuple(tuple(int(round(levels[yaw] * f)) for f in falloff) for yaw in LUT_YAWS)
+
+
+EVERY_YAW_TABLE = every_yaw_table()
+
+# OURS, the ablation ``camera.table: side_blind`` (our earlier default): each class found from its
+# front and, less often, its back or one side, and never from the others (the monitor from 4 of 8
+# yaws), as if the line's blanks were zeros; the surviving values set the scale. Rows and columns as
+# above.
+SIDE_BLIND_TABLES = {
     "monitor": ((85, 80, 60, 40, 25), (40, 30, 15, 5, 0), (0, 0, 0, 0, 0), (0, 0, 0, 0, 0),
                 (30, 20, 10, 0, 0), (0, 0, 0, 0, 0), (0, 0, 0, 0, 0), (40, 30, 15, 5, 0)),
     "keyboard": ((80, 76, 33, 40, 20), (35, 25, 12, 5, 0), (12, 10, 5, 0, 0), (0, 0, 0, 0, 0),
@@ -72,9 +102,17 @@ class SemanticCameraSpec(Strict):
     diameters: dict[str, Annotated[float, Field(gt=0.0, le=10.0)]] = Field(
         default_factory=lambda: {"monitor": 0.5, "keyboard": 0.45, "system_unit": 0.45, "router": 0.25},
         description="m, each class's sphere for occlusion (Algorithm 4; ours: the paper gives no sizes)")
+    table: Literal["every_yaw", "side_blind"] = Field(
+        "every_yaw", description="the detection table (ours: Table 1 is lost): every_yaw, built from its surviving "
+        "values (config/indirect.py every_yaw_table), one table for all classes; side_blind, the ablation where each "
+        "class is never found from some yaws (the monitor from 4 of 8)")
+    model: Literal["yaws", "mean"] = Field(
+        "yaws", description="the robot's model of not seeing A: yaws keeps one hypothesis per yaw of A (0..315) and "
+        "the product of non-detections under each, which stays correct when A is looked at from one side many "
+        "times; mean multiplies (1 - the table's mean over yaws) at every frame (our earlier model)")
     detection: dict[str, list[list[float]]] | None = Field(
         None, description="per class, rows yaw 0..315 by 45, columns 0.8, 1.2, 1.6, 2.0, 2.5 m, percent; "
-        "default: our table (OUR_LUT), not the paper's")
+        "replaces the table for that class")
 
     @field_validator("detection")
     @classmethod
@@ -88,10 +126,12 @@ class SemanticCameraSpec(Strict):
         return v
 
     def lut(self, cls_name: str) -> tuple[tuple[float, ...], ...]:
-        table = (self.detection or {}).get(cls_name) or OUR_LUT.get(cls_name)
-        if table is None:
-            raise KeyError(cls_name)
-        return table
+        given = (self.detection or {}).get(cls_name)
+        if given is not None:
+            return tuple(tuple(r) for r in given)
+        if self.table == "every_yaw":
+            return EVERY_YAW_TABLE
+        return SIDE_BLIND_TABLES[cls_name]
 
 
 class MasksSpec(Strict):

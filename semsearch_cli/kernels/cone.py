@@ -10,6 +10,17 @@ from numba import njit
 
 
 @njit(cache=True)
+def cone_box(H, W, ox, oy, res, x, y, max_range, dz):
+    """The bounding box (r0, r1, c0, c1), half-open, of the cells :func:`cone_image` visits."""
+    reach = math.sqrt(max(max_range * max_range - dz * dz, 0.0))
+    c0 = max(0, int(math.floor((x - reach - ox) / res)))
+    c1 = min(W, int(math.ceil((x + reach - ox) / res)) + 1)
+    r0 = max(0, int(math.floor(H - (y + reach - oy) / res)))
+    r1 = min(H, int(math.ceil(H - (y - reach - oy) / res)) + 1)
+    return r0, r1, c0, c1
+
+
+@njit(cache=True)
 def cone_image(out, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_depth, max_range, dz, lut_d, lut_p):
     """Write into ``out`` (H, W), for every cell whose centre (at height offset ``dz`` from the
     camera) is in view from (x, y, heading), the detection probability interpolated in
@@ -18,11 +29,7 @@ def cone_image(out, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_depth, 
     ``ox, oy`` is the grid's bottom-left corner (m), row 0 at the top. Returns the bounding box
     (r0, r1, c0, c1) of the cells visited (half-open)."""
     H, W = out.shape
-    reach = math.sqrt(max(max_range * max_range - dz * dz, 0.0))
-    c0 = max(0, int(math.floor((x - reach - ox) / res)))
-    c1 = min(W, int(math.ceil((x + reach - ox) / res)) + 1)
-    r0 = max(0, int(math.floor(H - (y + reach - oy) / res)))
-    r1 = min(H, int(math.ceil(H - (y - reach - oy) / res)) + 1)
+    r0, r1, c0, c1 = cone_box(H, W, ox, oy, res, x, y, max_range, dz)
     ch, sh = math.cos(heading), math.sin(heading)
     cp, sp = math.cos(pitch), math.sin(pitch)
     n = lut_d.shape[0]
@@ -71,3 +78,53 @@ def cone_mass(p_pad, pad, rows, cols, bins, offs_r, offs_c, counts):
             s += p_pad[r + offs_r[b, j], c + offs_c[b, j]]
         out[k] = s
     return out
+
+
+@njit(cache=True)
+def cone_nondetect(nd, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_depth, max_range, dz, lut_d, lut_p,
+                   hidden, hr0, hc0):
+    """Multiply ``nd`` (K, H, W), the probability under each of K yaw hypotheses that an object in
+    each cell has not been detected yet, by the probability of not detecting it from (x, y,
+    heading), for the cells in view (as :func:`cone_image`). Hypothesis k: the object's yaw is
+    360 k / K degrees; the table row is the direction from the cell to the camera relative to that
+    yaw, the nearest of ``lut_p``'s K rows (each interpolated in ``lut_d``). ``hidden`` (h, w):
+    cells (offset by hr0, hc0) the camera cannot see for obstacles; an empty array for none."""
+    K, H, W = nd.shape
+    r0, r1, c0, c1 = cone_box(H, W, ox, oy, res, x, y, max_range, dz)
+    ch, sh = math.cos(heading), math.sin(heading)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    n = lut_d.shape[0]
+    step = 2.0 * math.pi / K
+    check = hidden.shape[0] > 0
+    for r in range(r0, r1):
+        cy = oy + (H - r - 0.5) * res - y
+        for c in range(c0, c1):
+            cx = ox + (c + 0.5) * res - x
+            xr = ch * cx + sh * cy
+            yr = -sh * cx + ch * cy
+            xc = cp * xr - sp * dz
+            if xc <= 0.0:
+                continue
+            zc = sp * xr + cp * dz
+            if abs(yr) > tan_h * xc or abs(zc) > tan_v * xc:
+                continue
+            d = math.sqrt(xc * xc + yr * yr + zc * zc)
+            if d < min_depth or d > max_range:
+                continue
+            if check and hidden[r - hr0, c - hc0]:
+                continue
+            if d <= lut_d[0]:
+                k, t = 1, 0.0
+            elif d >= lut_d[n - 1]:
+                k, t = n - 1, 1.0
+            else:
+                k = 1
+                while lut_d[k] < d:
+                    k += 1
+                t = (d - lut_d[k - 1]) / (lut_d[k] - lut_d[k - 1])
+            b = int(math.floor(math.atan2(-cy, -cx) / step + 0.5))  # the bearing from the cell to the camera
+            for h in range(K):
+                row = (b - h) % K
+                p = lut_p[row, k - 1] + t * (lut_p[row, k] - lut_p[row, k - 1])
+                nd[h, r, c] *= 1.0 - p
+    return r0, r1, c0, c1

@@ -10,15 +10,22 @@ spheres (Algorithm 4): when the angular distance of two centres is at most the s
 ``occlusion: diameter``), the farther one is not detected. ``occlusion: radius`` halves rho (the
 sum of angular radii: where two projected discs actually meet; our earlier reading, kept as an
 option: the printed test hides more objects). Each object left is then
-detected with the probability of the look-up table (Table 1's axes; ours unless the scenario gives
-its own): the yaw bin is the direction from the object to the camera relative to the object's
-yaw, the nearest of the eight; the distance is interpolated linearly between the table's columns
-and clamped at its ends.
+detected with the probability of the look-up table (Table 1's axes; by default our table that
+detects from every yaw, built from Table 1's surviving values: ``config/indirect.py``
+``every_yaw_table``): the yaw bin is the direction from the object to the camera relative to the
+object's yaw, the nearest of the eight; the distance is interpolated linearly between the table's
+columns and clamped at its ends.
 
-The robot's model (:meth:`SemanticCamera.detect_image`): per map cell, the probability that an
-object of a class standing there (at the objects' height) would be detected from a pose: the same
-view test, line of sight on the obstacle map, and the table's mean over the eight yaws (the robot
-does not know the yaw of an object it has not seen), without occlusion by other objects.
+The robot's model, per map cell: the probability that an object of a class standing there (at the
+objects' height) would be detected from a pose, by the same view test and line of sight on the
+obstacle map, without occlusion by other objects. The robot does not know the yaw of an object it
+has not seen. For the main object A (:meth:`SemanticCamera.not_detected`, the default) it keeps one
+hypothesis per yaw and multiplies, per hypothesis, the probability of not detecting A at each
+frame, so that looking from one side many times is worth what it is worth: the mean over the
+hypotheses is the exact probability of all those non-detections. :meth:`SemanticCamera.detect_image`
+gives the table's mean over the eight yaws instead (one frame's exact detection probability), for
+the secondary objects' non-detections, whose per-frame update (Eqs. 8-13) is the paper's, and for
+``camera.model: mean``.
 """
 
 from __future__ import annotations
@@ -30,7 +37,7 @@ import numpy as np
 
 from ..config.indirect import LUT_DISTANCES, LUT_YAWS, SemanticCameraSpec
 from ..geometry import GridFrame, wrap_angle
-from ..kernels.cone import cone_image, cone_mass
+from ..kernels.cone import cone_box, cone_image, cone_mass, cone_nondetect
 from ..kernels.raycast import cast_rays
 
 
@@ -173,6 +180,28 @@ class SemanticCamera:
             win[~self.line_of_sight(frame, x, y, heading, occ, np.hypot(dx, dy), np.arctan2(dy, dx))] = 0.0
         return out
 
+    def not_detected(self, nd: np.ndarray, frame: GridFrame, x: float, y: float, heading: float, cls: str,
+                     max_range: float, occ: np.ndarray | None = None) -> None:
+        """Multiply ``nd`` (8, H, W), per yaw hypothesis of an object of ``cls`` (k: its yaw is 45 k
+        degrees) the probability that it stands in each cell undetected so far, by the probability
+        of not detecting it from (x, y, heading): under hypothesis k a cell's table row is the
+        direction from the cell to the camera relative to 45 k degrees (as :meth:`visible` reads the
+        table). The mean over k of ``nd`` is then the exact probability of no detection in all the
+        frames so far, however many of them looked from one side; multiplying the mean over yaws
+        at every frame is not (it treats the frames as if each drew the yaw anew)."""
+        dz = self.object_height - self.spec.height
+        hidden, hr0, hc0 = _NONE_HIDDEN, 0, 0
+        if occ is not None:
+            r0, r1, c0, c1 = cone_box(frame.height, frame.width, frame.origin_x, frame.origin_y, frame.res, x, y,
+                                      max_range, dz)
+            if r1 > r0 and c1 > c0 and occ[r0:r1, c0:c1].any():
+                cx, cy = frame.to_world(np.arange(r0, r1)[:, None], np.arange(c0, c1)[None, :])
+                dx, dy = cx - x, cy - y
+                hidden = ~self.line_of_sight(frame, x, y, heading, occ, np.hypot(dx, dy), np.arctan2(dy, dx))
+                hr0, hc0 = r0, c0
+        cone_nondetect(nd, frame.origin_x, frame.origin_y, frame.res, x, y, heading, self.pitch, self.tan_h,
+                       self.tan_v, self.spec.min_depth, max_range, dz, self.lut_d, self.table(cls), hidden, hr0, hc0)
+
     def line_of_sight(self, frame: GridFrame, x: float, y: float, heading: float, occ: np.ndarray,
                       dist: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         """Cells not hidden by obstacles: rays every half degree over a field wide enough for the
@@ -226,6 +255,9 @@ class ConeTemplates:
         b = np.round(np.asarray(headings) / (2 * math.pi) * self.bins).astype(np.int64) % self.bins
         return cone_mass(p_pad, self.pad, np.asarray(rows, np.int64), np.asarray(cols, np.int64), b,
                          self.offs_r, self.offs_c, self.counts)
+
+
+_NONE_HIDDEN = np.zeros((0, 0), np.bool_)
 
 
 def _segment_blocked(boxes, x0: float, y0: float, x1: float, y1: float) -> bool:

@@ -155,7 +155,10 @@ class IndirectSearch:
 
     def update(self, st: RobotState) -> None:
         spec, b, fr, cam = self.task.spec, st.belief, self.grid.frame, self.task.camera
-        b.not_seen_main(cam.detect_image(fr, st.x, st.y, st.heading, spec.target, self.scale, self.occ, self.D))
+        if spec.camera.model == "yaws":
+            cam.not_detected(b.undetected_main(), fr, st.x, st.y, st.heading, spec.target, self.scale, self.occ)
+        else:
+            b.not_seen_main(cam.detect_image(fr, st.x, st.y, st.heading, spec.target, self.scale, self.occ, self.D))
         for cls in self.masks:
             if cls in self.latest:
                 if not (spec.count_once and cls in self.in_view_before):
