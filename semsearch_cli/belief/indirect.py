@@ -203,11 +203,15 @@ class IndirectBelief:
             self.nd = np.ones((yaws, self.H, self.W))
         return self.nd
 
-    def seen_secondary(self, cls: str, row: int, col: int) -> None:
-        """B seen at cell (row, col) (Eqs. 8-9, 12-13): the mask centred there; outside, 1/n."""
+    def seen_secondary(self, cls: str, row: int, col: int, false_positive: float = 0.0) -> None:
+        """B seen at cell (row, col) (Eqs. 8-9, 12-13): the mask centred there; outside, 1/n.
+        With a detector that reports B where it is not at rate ``false_positive`` (eps), the
+        likelihood image is (1 - eps) at the cell plus eps / n everywhere, which gives the map
+        (1 - eps) mask / S + eps / n and the outside cell 1/n still."""
         m = self.masks[cls]
         ci, cj = m.full_centre
-        self._factor *= m.full[ci - row:ci - row + self.H, cj - col:cj - col + self.W] / m.S
+        like = m.full[ci - row:ci - row + self.H, cj - col:cj - col + self.W] / m.S
+        self._factor *= like if not false_positive else (1.0 - false_positive) * like + false_positive / self.n
         self._factor0 *= 1.0 / self.n
 
     @property

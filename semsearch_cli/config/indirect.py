@@ -151,14 +151,39 @@ class MasksSpec(Strict):
 
 
 class IndirectRobotSpec(Strict):
-    """Ours: the paper gives no speeds. We chose a slow robot, so that five minutes do not cover a
-    6 m x 6 m room (an earlier measurement, with N = 50 and fixed starts, had UIS find the monitor
-    in 80-90% of the searches at 0.3 m/s and 60 degrees/s); ``benchmarks/indirect_calibration.py``
-    measures what each value does (docs/indirect-search.md)."""
+    """Ours: the paper gives no speeds. Its simulated robot avoided collisions with Player/Stage's
+    laser; we take the defaults of Player's vfh driver, the local navigator Player/Stage offers for
+    that (Player manual 1.5, section 7.45: max_speed 200 mm/s, max_turnrate 40 degrees/s), chosen
+    for that reason alone and before measuring anything with them. Our earlier 0.15 m/s and 30
+    degrees/s had been picked by looking at the results (so that uninformed search was not too
+    strong); ``benchmarks/indirect_calibration.py`` measures what each value does
+    (docs/indirect-search.md)."""
 
-    speed: float = Field(0.15, gt=0.0, le=2.0, description="m/s (ours)")
-    turn_rate: float = Field(30.0, gt=0.0, le=360.0, description="degrees/s (ours)")
+    speed: float = Field(0.2, gt=0.0, le=2.0, description="m/s (ours: Player's vfh default)")
+    turn_rate: float = Field(40.0, gt=0.0, le=360.0, description="degrees/s (ours: Player's vfh default)")
     radius: float = Field(0.2, gt=0.0, le=2.0, description="m, for paths around obstacles")
+
+
+class LearnedSpec(Strict):
+    """Relations learned rather than given (ours, after cos-pomdp's ablations): the robot's
+    co-occurrences are estimated from ``rooms`` training rooms, generated with the true relations
+    from ``seed`` (apart from the test rooms' seed), by counting each secondary object's distance
+    to A in its category, add-one smoothed (world/rooms.py ``estimate_relations``)."""
+
+    rooms: int = Field(20, ge=1, le=100000, description="training rooms")
+    seed: int = Field(1000, ge=0, description="the training rooms' seed (keep it apart from the test rooms')")
+
+
+class DetectorNoiseSpec(Strict):
+    """A secondary-object detector that errs (ours; the paper's L_B is "high at the detected cell,
+    a false-positive rate elsewhere"): at each frame a secondary class not detected is reported
+    anyway with probability ``false_positive``, at a point drawn uniformly in the camera's view
+    (out to its range); a true detection is reported displaced by a normal error of
+    ``position_sd`` m on each axis. The robot knows the false-positive rate: a detection's
+    likelihood image is (1 - rate) at the detected cell plus rate spread over the map."""
+
+    false_positive: float = Field(0.0, ge=0.0, lt=1.0, description="per frame and class")
+    position_sd: float = Field(0.0, ge=0.0, le=5.0, description="m, per axis")
 
 
 class IndirectSpec(Strict):
@@ -183,6 +208,11 @@ class IndirectSpec(Strict):
         "none", description="shuffled: the robot's relations are another class's (keyboard gets the system unit's "
         "co-occurrences, the system unit the router's, the router the keyboard's), the rooms stay as generated; "
         "no_secondary: the rooms hold A alone")
+    objects_block: bool = Field(False, description="the objects block the robot's path, as discs of their diameter "
+                                "(ours: the paper does not say; its objects stand 0.5 m high, as on desks)")
+    learned: LearnedSpec | None = Field(None, description="learn the robot's co-occurrences from training rooms "
+                                        "instead of being given the true ones")
+    noise: DetectorNoiseSpec = DetectorNoiseSpec()
     camera: SemanticCameraSpec = SemanticCameraSpec()
     masks: MasksSpec = MasksSpec()
     robot: IndirectRobotSpec = IndirectRobotSpec()
@@ -201,6 +231,12 @@ class IndirectSpec(Strict):
         if len(set(v)) != len(v) or any(s <= 0 for s in v):
             raise ValueError("view scales must be positive and distinct")
         return v
+
+    @model_validator(mode="after")
+    def _one_belief(self):
+        if self.learned is not None and self.ablation == "shuffled":
+            raise ValueError("learned and ablation: shuffled both set what the robot believes; give one")
+        return self
 
     @property
     def secondary(self) -> list[str]:

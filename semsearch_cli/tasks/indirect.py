@@ -34,7 +34,7 @@ from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.semantic import SemanticCamera
-from ..world.rooms import Room, generate_rooms, read_rooms
+from ..world.rooms import Room, estimate_relations, generate_rooms, read_rooms
 from .base import Outcome, RobotState, RunResult, Task, register_task
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
 from .loop import run_loop
@@ -54,10 +54,17 @@ class RoomGrid:
     full_from: tuple = (-1, -1, -1)  # (row, col, search generation) of the last whole-room search
 
     @classmethod
-    def of(cls, room: Room, res: float, radius: float) -> "RoomGrid":
+    def of(cls, room: Room, res: float, radius: float, bodies: dict[str, float] | None = None) -> "RoomGrid":
+        """``bodies``: class -> diameter (m) of the objects that block the robot's path (not its
+        view: objects hide each other by Algorithm 4); none by default."""
         fr = room.frame(res)
         blocked = room.blocked(fr)
-        walls = np.pad(blocked, 1, constant_values=True)
+        body = blocked.copy()
+        if bodies:
+            cx, cy = fr.to_world(np.arange(fr.height)[:, None], np.arange(fr.width)[None, :])
+            for cls_name, t in room.objects.items():
+                body |= np.hypot(cx - t.x, cy - t.y) <= bodies.get(cls_name, 0.0) / 2
+        walls = np.pad(body, 1, constant_values=True)
         clear = ndimage.distance_transform_edt(~walls)[1:-1, 1:-1] * res
         stand = clear >= radius
         r, c = fr.to_index(*room.start[:2])
@@ -146,12 +153,38 @@ class IndirectSearch:
     # ---- the loop's steps -------------------------------------------------------------------
     def sense(self, st: RobotState):
         spec = self.task.spec
-        got = self.task.camera.frame(self.grid.room, st.x, st.y, st.heading, self.ranges, self.rng)
+        room = self.grid.room
+        got = self.task.camera.frame(room, st.x, st.y, st.heading, self.ranges, self.rng)
         self.latest = got - {spec.target}
         for cls in self.latest:
-            t = self.grid.room.objects[cls]
+            t = room.objects[cls]
             self.seen[cls] = (t.x, t.y)  # the camera gives the object's position
+        if spec.noise.false_positive or spec.noise.position_sd:
+            self.err(st)
         return spec.target in got, bool(self.latest)
+
+    def err(self, st: RobotState) -> None:
+        """The noisy detector (``indirect.noise``): true detections displaced, and each secondary
+        class not detected reported with the false-positive rate at a point drawn uniformly in the
+        view (a fixed number of draws per frame, but for the rejection of points out of view)."""
+        noise, room, w, h = self.task.spec.noise, self.grid.room, *self.grid.room.size
+        classes = list(self.task.spec.secondary)
+        u, e = self.rng.random(len(classes)), self.rng.normal(0.0, 1.0, (len(classes), 2)) * noise.position_sd
+        half = self.task.camera.half_h
+        for k, cls in enumerate(classes):
+            if cls in self.latest:
+                x, y = self.seen[cls]
+                self.seen[cls] = (min(max(x + e[k, 0], 0.0), w), min(max(y + e[k, 1], 0.0), h))
+            elif u[k] < noise.false_positive:
+                for _ in range(50):
+                    r = self.ranges[cls] * math.sqrt(self.rng.random())
+                    a = st.heading + self.rng.uniform(-half, half)
+                    x, y = st.x + r * math.cos(a), st.y + r * math.sin(a)
+                    if 0.0 <= x <= w and 0.0 <= y <= h and self.sees(np.array([st.x, st.y, st.heading]), [x], [y],
+                                                                      self.ranges[cls])[0, 0]:
+                        self.seen[cls] = (x, y)
+                        self.latest.add(cls)
+                        break
 
     def update(self, st: RobotState) -> None:
         spec, b, fr, cam = self.task.spec, st.belief, self.grid.frame, self.task.camera
@@ -163,7 +196,8 @@ class IndirectSearch:
             if cls in self.latest:
                 if not (spec.count_once and cls in self.in_view_before):
                     r, c = (int(v) for v in fr.to_index(*self.seen[cls]))
-                    b.seen_secondary(cls, r, c)
+                    b.seen_secondary(cls, min(max(r, 0), fr.height - 1), min(max(c, 0), fr.width - 1),
+                                     spec.noise.false_positive)
             elif self.negative:
                 b.not_seen_secondary(cls, cam.detect_image(self.neg_frame, st.x, st.y, st.heading, cls, self.ranges[cls],
                                                            self.neg_occ))
@@ -171,8 +205,8 @@ class IndirectSearch:
         self.frames_since_plan += 1
         self.since_plan.append((st.x, st.y, st.heading))
 
-    def sees(self, poses, xs, ys) -> np.ndarray:
-        return self.task.camera.sees(poses, xs, ys, self.scale)
+    def sees(self, poses, xs, ys, max_range: float | None = None) -> np.ndarray:
+        return self.task.camera.sees(poses, xs, ys, self.scale if max_range is None else max_range)
 
     def replan_due(self, path_done: bool, since_plan: float, event: bool) -> bool:
         return path_done or self.frames_since_plan >= self.replan_frames or (event and self.planner.replan_on_detection)
@@ -271,8 +305,13 @@ class IndirectTask(Task):
         self._cones: dict = {}
         self._views: dict = {}  # (room, scale) -> path length field to the cells that see A
         self.relations: dict = {}
-        self.believed = self.spec.model_relations()
-        self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in self.believed.items()}
+        self.believe(self.spec.model_relations())
+
+    def believe(self, relations: dict) -> None:
+        """Set the co-occurrences the robot believes (and p(o | A) = 1 - C^VF of each class)."""
+        self.believed = relations
+        self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in relations.items()}
+        self._masks = {}
 
     @classmethod
     def build(cls, sc, world, path):
@@ -287,6 +326,10 @@ class IndirectTask(Task):
                 rooms = generate_rooms(g.count, g.seed, spec.relations, spec.masks, spec.target, g.size, g.obstacles)
             except ValueError as exc:
                 raise ScenarioError(task.file, field, str(exc)) from None
+        if spec.learned is not None:
+            training = generate_rooms(spec.learned.rooms, spec.learned.seed, spec.relations, spec.masks, spec.target,
+                                      rooms[0].size)
+            task.believe(estimate_relations(training, spec.target, spec.secondary, spec.masks))
         if spec.ablation == "no_secondary":
             for r in rooms:
                 r.objects = {spec.target: r.objects[spec.target]}
@@ -297,7 +340,8 @@ class IndirectTask(Task):
                 raise ScenarioError(task.file, "indirect.camera.detection", f"no detection table for {cls_name!r}; give "
                                     "one (rows yaw 0..315, columns 0.8..2.5 m)") from None
         try:
-            task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius) for r in rooms]
+            bodies = spec.camera.diameters if spec.objects_block else None
+            task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius, bodies) for r in rooms]
         except ValueError as exc:
             raise ScenarioError(task.file, field, str(exc)) from None
         if len({g.stand.shape for g in task.grids}) > 1:

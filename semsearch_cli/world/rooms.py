@@ -152,6 +152,23 @@ def generate_rooms(n: int, seed: int, relations: dict, masks: MasksSpec, target:
             for k, s in enumerate(streams)]
 
 
+def estimate_relations(rooms: list[Room], target: str, secondary: list[str], masks: MasksSpec) -> dict[str, tuple]:
+    """Co-occurrences (VN, N, F, VF) of each secondary class around ``target`` as a robot would
+    learn them from these rooms: each object's distance to the target falls in one category (u1,
+    u2, u3) and is counted there; the shares are add-one smoothed (Laplace), so that a category no
+    training room happened to show is unlikely, not impossible (with a zero weight, one detection
+    of the class would rule out every cell at that distance)."""
+    edges = (masks.u1, masks.u2, masks.u3)
+    out = {}
+    for cls in secondary:
+        counts = np.ones(len(CATEGORIES))
+        for r in rooms:
+            a, b = r.objects[target], r.objects[cls]
+            counts[int(np.searchsorted(edges, np.hypot(b.x - a.x, b.y - a.y), side="right"))] += 1
+        out[cls] = tuple(float(c) for c in counts / counts.sum())
+    return out
+
+
 def write_rooms(path: Path, rooms: list[Room]) -> Path:
     path = Path(path)
     size = rooms[0].size if rooms else (6.0, 6.0)
