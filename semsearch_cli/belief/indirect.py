@@ -6,14 +6,12 @@ observation multiplies it by a likelihood image (and the outside cell by a numbe
 renormalises:
 
 - A not seen (Eqs. 6-7): ``1 - D_A``, D_A the robot's model of detecting A in each cell from the
-  pose; the outside cell 1. By default the model keeps A's yaw (:meth:`IndirectBelief.undetected_main`):
-  one product of non-detections per yaw hypothesis, their mean the likelihood, exact however many
-  frames look from one side; ``camera.model: mean`` multiplies ``1 - D_A`` with D_A the table's
-  mean over yaws (:meth:`~semsearch_cli.sensors.semantic.SemanticCamera.detect_image`) at every frame.
+  pose (:class:`~semsearch_cli.sensors.semantic.YawMemory`: the probability of detecting A in this
+  frame given the frames before missed it); the outside cell 1.
 - B seen at cell c (Eqs. 8-9, 12-13): the likelihood image of B is 1 at c and 0 elsewhere, so the
   cross-likelihood (Eq. 14) is the relation mask centred on c, R_B/A(ij - c) / S(ij), and the
   outside cell gets the image's mean, 1 / n (Eq. 13 as SPEC reads it).
-- B not seen (Eqs. 8-9, 12-13): the likelihood image is ``1 - D_B``; its convolution with the
+- B not seen (Eqs. 8-9, 12-13): the likelihood image is ``1 - D_B`` (D_B as D_A); its convolution with the
   relation is ``1 - (D_B * R_B/A) / S``, done by FFT; the outside cell gets the image's mean.
 
 S(ij) = sum over the map's cells uv of R_B/A(ij - uv), computed once: given A at ij, B stands in
@@ -180,9 +178,6 @@ class IndirectBelief:
         prior = np.asarray(prior, float)
         self.p = prior / prior.sum() * (1.0 - p_outside)
         self.p0 = float(p_outside)
-        # the map but for A's non-detections under yaw hypotheses (q, q0), and those (nd)
-        self.q, self.q0 = self.p.copy(), self.p0
-        self.nd: np.ndarray | None = None
         self.n = self.H * self.W
         self._factor = np.ones(shape)  # product of the pending likelihood images
         self._factor0 = 1.0
@@ -192,16 +187,6 @@ class IndirectBelief:
     def not_seen_main(self, D: np.ndarray) -> None:
         """A not seen (Eqs. 6-7): likelihood ``1 - D`` in the map, 1 outside."""
         self._factor *= 1.0 - D
-
-    def undetected_main(self, yaws: int = 8) -> np.ndarray:
-        """(yaws, H, W): per yaw hypothesis of A, the probability that A standing in each cell has
-        escaped detection in every frame so far (Eqs. 6-7 with the yaw kept: the camera's
-        :meth:`~semsearch_cli.sensors.semantic.SemanticCamera.not_detected` multiplies it in
-        place). The map's likelihood of A's non-detections is its mean over the hypotheses (A's
-        yaw is uniform a priori); the outside cell's is 1."""
-        if self.nd is None:
-            self.nd = np.ones((yaws, self.H, self.W))
-        return self.nd
 
     def seen_secondary(self, cls: str, row: int, col: int, false_positive: float = 0.0) -> None:
         """B seen at cell (row, col) (Eqs. 8-9, 12-13): the mask centred there; outside, 1/n.
@@ -242,14 +227,11 @@ class IndirectBelief:
             f = f * like
             f0 *= float(np.prod(1.0 - sums * (q * q) / self.n))
             Ds.clear()
-        q, q0 = self.q * f, self.q0 * f0
-        s = q.sum() + q0
-        if s > 0:
-            self.q, self.q0 = q / s, q0 / s
-        p = self.q * self.nd.mean(axis=0) if self.nd is not None else self.q
-        z = p.sum() + self.q0
+        p = self.p * f
+        p0 = self.p0 * f0
+        z = p.sum() + p0
         if z > 0:
-            self.p, self.p0 = p / z, self.q0 / z
+            self.p, self.p0 = p / z, p0 / z
         self._factor = np.ones((self.H, self.W))
         self._factor0 = 1.0
 

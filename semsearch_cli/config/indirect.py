@@ -107,9 +107,10 @@ class SemanticCameraSpec(Strict):
         "values (config/indirect.py every_yaw_table), one table for all classes; side_blind, the ablation where each "
         "class is never found from some yaws (the monitor from 4 of 8)")
     model: Literal["yaws", "mean"] = Field(
-        "yaws", description="the robot's model of not seeing A: yaws keeps one hypothesis per yaw of A (0..315) and "
-        "the product of non-detections under each, which stays correct when A is looked at from one side many "
-        "times; mean multiplies (1 - the table's mean over yaws) at every frame (our earlier model)")
+        "yaws", description="the robot's model of detecting an object it has not seen: yaws keeps one hypothesis per "
+        "yaw (0..315) and gives each frame's detection probability given the misses before, which stays correct when "
+        "an object is looked at from one side many times; mean takes the table's mean over yaws at every frame (our "
+        "earlier model)")
     detection: dict[str, list[list[float]]] | None = Field(
         None, description="per class, rows yaw 0..315 by 45, columns 0.8, 1.2, 1.6, 2.0, 2.5 m, percent; "
         "replaces the table for that class")

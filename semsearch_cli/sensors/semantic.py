@@ -19,13 +19,13 @@ columns and clamped at its ends.
 The robot's model, per map cell: the probability that an object of a class standing there (at the
 objects' height) would be detected from a pose, by the same view test and line of sight on the
 obstacle map, without occlusion by other objects. The robot does not know the yaw of an object it
-has not seen. For the main object A (:meth:`SemanticCamera.not_detected`, the default) it keeps one
-hypothesis per yaw and multiplies, per hypothesis, the probability of not detecting A at each
-frame, so that looking from one side many times is worth what it is worth: the mean over the
-hypotheses is the exact probability of all those non-detections. :meth:`SemanticCamera.detect_image`
-gives the table's mean over the eight yaws instead (one frame's exact detection probability), for
-the secondary objects' non-detections, whose per-frame update (Eqs. 8-13) is the paper's, and for
-``camera.model: mean``.
+has not seen, and the frames of a search all see one object at one yaw, so the model keeps one
+hypothesis per yaw (:class:`YawMemory`, the default ``camera.model: yaws``) and gives, per frame,
+the probability of detecting the object given that the frames before missed it: the product of
+the paper's per-frame updates is then the exact probability of all the misses, however many frames
+looked from one side. ``camera.model: mean`` (our earlier model) takes the table's mean over the
+eight yaws at every frame (:meth:`SemanticCamera.detect_image`), which is right for one frame only.
+Both serve A's non-detections and the secondary objects'.
 """
 
 from __future__ import annotations
@@ -181,14 +181,12 @@ class SemanticCamera:
         return out
 
     def not_detected(self, nd: np.ndarray, frame: GridFrame, x: float, y: float, heading: float, cls: str,
-                     max_range: float, occ: np.ndarray | None = None) -> None:
+                     max_range: float, occ: np.ndarray | None = None) -> tuple[int, int, int, int]:
         """Multiply ``nd`` (8, H, W), per yaw hypothesis of an object of ``cls`` (k: its yaw is 45 k
         degrees) the probability that it stands in each cell undetected so far, by the probability
         of not detecting it from (x, y, heading): under hypothesis k a cell's table row is the
         direction from the cell to the camera relative to 45 k degrees (as :meth:`visible` reads the
-        table). The mean over k of ``nd`` is then the exact probability of no detection in all the
-        frames so far, however many of them looked from one side; multiplying the mean over yaws
-        at every frame is not (it treats the frames as if each drew the yaw anew)."""
+        table). Returns the box (r0, r1, c0, c1) of the cells it may have changed."""
         dz = self.object_height - self.spec.height
         hidden, hr0, hc0 = _NONE_HIDDEN, 0, 0
         if occ is not None:
@@ -199,8 +197,9 @@ class SemanticCamera:
                 dx, dy = cx - x, cy - y
                 hidden = ~self.line_of_sight(frame, x, y, heading, occ, np.hypot(dx, dy), np.arctan2(dy, dx))
                 hr0, hc0 = r0, c0
-        cone_nondetect(nd, frame.origin_x, frame.origin_y, frame.res, x, y, heading, self.pitch, self.tan_h,
-                       self.tan_v, self.spec.min_depth, max_range, dz, self.lut_d, self.table(cls), hidden, hr0, hc0)
+        return cone_nondetect(nd, frame.origin_x, frame.origin_y, frame.res, x, y, heading, self.pitch, self.tan_h,
+                              self.tan_v, self.spec.min_depth, max_range, dz, self.lut_d, self.table(cls), hidden, hr0,
+                              hc0)
 
     def line_of_sight(self, frame: GridFrame, x: float, y: float, heading: float, occ: np.ndarray,
                       dist: np.ndarray, bearing: np.ndarray) -> np.ndarray:
@@ -237,6 +236,42 @@ class SemanticCamera:
         for b, (rr, cc) in enumerate(offs):
             offs_r[b, :len(rr)], offs_c[b, :len(cc)], counts[b] = rr, cc, len(rr)
         return ConeTemplates(R, offs_r, offs_c, counts, bins)
+
+
+class YawMemory:
+    """The robot's model of detecting one class on one grid over a search, correct however many
+    frames look from one side.
+
+    The robot does not know the yaw of an object it has not seen, and the table depends on it. One
+    frame's detection probability is the table's mean over the eight yaws; but the frames of a
+    search are not independent draws of the yaw (the object does not turn), so multiplying
+    (1 - that mean) at every frame is wrong: nine looks from a side the detector misses would rule a
+    cell out. The memory keeps, per yaw hypothesis, the product of the non-detections so far
+    (``nd``, 8 x H x W), and :meth:`look` returns the probability of detecting the object in each
+    cell in this frame given that the frames before missed it: 1 - mean_k nd_k(after) / mean_k
+    nd_k(before). The product over frames of (1 - that) is mean_k nd_k, the exact probability of no
+    detection in all of them, so the paper's per-frame update (Eqs. 6-9) stays as printed."""
+
+    def __init__(self, camera: SemanticCamera, cls: str, frame: GridFrame, occ: np.ndarray | None = None):
+        self.camera, self.cls, self.frame, self.occ = camera, cls, frame, occ
+        self.nd = np.ones((len(LUT_YAWS), frame.height, frame.width))
+        self.mean = np.ones((frame.height, frame.width))
+        self.D = np.zeros((frame.height, frame.width))
+        self._box = (0, 0, 0, 0)
+
+    def look(self, x: float, y: float, heading: float, max_range: float) -> np.ndarray:
+        """(H, W) this frame's detection probability per cell, given the misses before (the array is
+        reused at the next call: copy it to keep it)."""
+        r0, r1, c0, c1 = self._box
+        self.D[r0:r1, c0:c1] = 0.0
+        r0, r1, c0, c1 = self._box = self.camera.not_detected(self.nd, self.frame, x, y, heading, self.cls, max_range,
+                                                               self.occ)
+        if r1 > r0 and c1 > c0:
+            new = self.nd[:, r0:r1, c0:c1].mean(axis=0)
+            old = self.mean[r0:r1, c0:c1]
+            self.D[r0:r1, c0:c1] = np.where(old > 0.0, 1.0 - new / np.where(old > 0.0, old, 1.0), 0.0)
+            self.mean[r0:r1, c0:c1] = new
+        return self.D
 
 
 @dataclass(frozen=True)

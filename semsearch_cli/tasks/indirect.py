@@ -33,7 +33,7 @@ from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
-from ..sensors.semantic import SemanticCamera
+from ..sensors.semantic import SemanticCamera, YawMemory
 from ..world.rooms import Room, estimate_relations, generate_rooms, read_rooms
 from .base import Outcome, RobotState, RunResult, Task, register_task
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
@@ -135,6 +135,7 @@ class IndirectSearch:
         self.keep_trace = trace
         self.trace: list = []
         self.D = np.zeros((grid.frame.height, grid.frame.width))
+        self.memory: dict[str, YawMemory] = {}
         self.occ = grid.blocked if grid.blocked.any() else None
         # the grid of the secondary objects' non-detections (coarser by spec.coarse)
         q = spec.coarse if self.masks else 1
@@ -187,11 +188,8 @@ class IndirectSearch:
                         break
 
     def update(self, st: RobotState) -> None:
-        spec, b, fr, cam = self.task.spec, st.belief, self.grid.frame, self.task.camera
-        if spec.camera.model == "yaws":
-            cam.not_detected(b.undetected_main(), fr, st.x, st.y, st.heading, spec.target, self.scale, self.occ)
-        else:
-            b.not_seen_main(cam.detect_image(fr, st.x, st.y, st.heading, spec.target, self.scale, self.occ, self.D))
+        spec, b, fr = self.task.spec, st.belief, self.grid.frame
+        b.not_seen_main(self.detection(spec.target, st))
         for cls in self.masks:
             if cls in self.latest:
                 if not (spec.count_once and cls in self.in_view_before):
@@ -199,11 +197,24 @@ class IndirectSearch:
                     b.seen_secondary(cls, min(max(r, 0), fr.height - 1), min(max(c, 0), fr.width - 1),
                                      spec.noise.false_positive)
             elif self.negative:
-                b.not_seen_secondary(cls, cam.detect_image(self.neg_frame, st.x, st.y, st.heading, cls, self.ranges[cls],
-                                                           self.neg_occ))
+                b.not_seen_secondary(cls, self.detection(cls, st).copy())
         self.in_view_before = set(self.latest)
         self.frames_since_plan += 1
         self.since_plan.append((st.x, st.y, st.heading))
+
+    def detection(self, cls: str, st: RobotState) -> np.ndarray:
+        """The robot's model of detecting ``cls`` in each cell from this frame's pose: A on the
+        map's grid, the secondary objects on the grid of their non-detections; given the misses
+        before, per yaw hypothesis (:class:`~semsearch_cli.sensors.semantic.YawMemory`), or the
+        table's mean over yaws (``camera.model: mean``). Reused at the next frame."""
+        main = cls == self.task.spec.target
+        fr, occ = (self.grid.frame, self.occ) if main else (self.neg_frame, self.neg_occ)
+        if self.task.spec.camera.model == "mean":
+            out = self.D if main else None
+            return self.task.camera.detect_image(fr, st.x, st.y, st.heading, cls, self.ranges[cls], occ, out)
+        if cls not in self.memory:
+            self.memory[cls] = YawMemory(self.task.camera, cls, fr, occ)
+        return self.memory[cls].look(st.x, st.y, st.heading, self.ranges[cls])
 
     def sees(self, poses, xs, ys, max_range: float | None = None) -> np.ndarray:
         return self.task.camera.sees(poses, xs, ys, self.scale if max_range is None else max_range)
