@@ -201,7 +201,8 @@ def claims_table(runs: pd.DataFrame) -> pd.DataFrame:
             rows.append({"claim": f"success grows from {s0:g} m to {s1:g} m", "better": f"{method} at {s1:g} m",
                          "worse": f"{method} at {s0:g} m", "pairs": n, "ours": 100 * m, "lo": 100 * lo, "hi": 100 * hi,
                          "paper": paper, "verdict": _verdict(paper, lo, hi)})
-    return pd.DataFrame(rows, columns=["claim", "better", "worse", "pairs", "ours", "lo", "hi", "paper", "verdict"]).round(1)
+    out = pd.DataFrame(rows, columns=["claim", "better", "worse", "pairs", "ours", "lo", "hi", "paper", "verdict"]).round(1)
+    return out.astype({"pairs": int})
 
 
 def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, notes: list) -> None:
