@@ -21,6 +21,44 @@ def cone_box(H, W, ox, oy, res, x, y, max_range, dz):
 
 
 @njit(cache=True)
+def _view_distance(cx, cy, ch, sh, cp, sp, dz, tan_h, tan_v, min_depth, max_range):
+    """The camera-to-point distance of the offset (cx, cy) (m, at height offset dz) when the point
+    is in view (x_cam > 0, |y_cam| <= tan_h x_cam, |z_cam| <= tan_v x_cam, min_depth <= r <=
+    max_range), else -1."""
+    xr = ch * cx + sh * cy
+    yr = -sh * cx + ch * cy
+    xc = cp * xr - sp * dz
+    if xc <= 0.0:
+        return -1.0
+    zc = sp * xr + cp * dz
+    if abs(yr) > tan_h * xc or abs(zc) > tan_v * xc:
+        return -1.0
+    d = math.sqrt(xc * xc + yr * yr + zc * zc)
+    if d < min_depth or d > max_range:
+        return -1.0
+    return d
+
+
+@njit(cache=True)
+def _bracket(lut_d, d):
+    """(k, t): ``d`` lies at fraction t between lut_d[k - 1] and lut_d[k], clamped at the ends."""
+    n = lut_d.shape[0]
+    if d <= lut_d[0]:
+        return 1, 0.0
+    if d >= lut_d[n - 1]:
+        return n - 1, 1.0
+    k = 1
+    while lut_d[k] < d:
+        k += 1
+    return k, (d - lut_d[k - 1]) / (lut_d[k] - lut_d[k - 1])
+
+
+@njit(cache=True)
+def _lerp(lo, hi, t):
+    return hi if t == 1.0 else lo + t * (hi - lo)
+
+
+@njit(cache=True)
 def cone_image(out, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_depth, max_range, dz, lut_d, lut_p):
     """Write into ``out`` (H, W), for every cell whose centre (at height offset ``dz`` from the
     camera) is in view from (x, y, heading), the detection probability interpolated in
@@ -32,33 +70,14 @@ def cone_image(out, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_depth, 
     r0, r1, c0, c1 = cone_box(H, W, ox, oy, res, x, y, max_range, dz)
     ch, sh = math.cos(heading), math.sin(heading)
     cp, sp = math.cos(pitch), math.sin(pitch)
-    n = lut_d.shape[0]
     for r in range(r0, r1):
         cy = oy + (H - r - 0.5) * res - y
         for c in range(c0, c1):
-            cx = ox + (c + 0.5) * res - x
-            xr = ch * cx + sh * cy
-            yr = -sh * cx + ch * cy
-            xc = cp * xr - sp * dz
-            if xc <= 0.0:
+            d = _view_distance(ox + (c + 0.5) * res - x, cy, ch, sh, cp, sp, dz, tan_h, tan_v, min_depth, max_range)
+            if d < 0.0:
                 continue
-            zc = sp * xr + cp * dz
-            if abs(yr) > tan_h * xc or abs(zc) > tan_v * xc:
-                continue
-            d = math.sqrt(xc * xc + yr * yr + zc * zc)
-            if d < min_depth or d > max_range:
-                continue
-            if d <= lut_d[0]:
-                p = lut_p[0]
-            elif d >= lut_d[n - 1]:
-                p = lut_p[n - 1]
-            else:
-                k = 1
-                while lut_d[k] < d:
-                    k += 1
-                t = (d - lut_d[k - 1]) / (lut_d[k] - lut_d[k - 1])
-                p = lut_p[k - 1] + t * (lut_p[k] - lut_p[k - 1])
-            out[r, c] = p
+            k, t = _bracket(lut_d, d)
+            out[r, c] = _lerp(lut_p[k - 1], lut_p[k], t)
     return r0, r1, c0, c1
 
 
@@ -93,38 +112,18 @@ def cone_nondetect(nd, ox, oy, res, x, y, heading, pitch, tan_h, tan_v, min_dept
     r0, r1, c0, c1 = cone_box(H, W, ox, oy, res, x, y, max_range, dz)
     ch, sh = math.cos(heading), math.sin(heading)
     cp, sp = math.cos(pitch), math.sin(pitch)
-    n = lut_d.shape[0]
     step = 2.0 * math.pi / K
     check = hidden.shape[0] > 0
     for r in range(r0, r1):
         cy = oy + (H - r - 0.5) * res - y
         for c in range(c0, c1):
             cx = ox + (c + 0.5) * res - x
-            xr = ch * cx + sh * cy
-            yr = -sh * cx + ch * cy
-            xc = cp * xr - sp * dz
-            if xc <= 0.0:
+            d = _view_distance(cx, cy, ch, sh, cp, sp, dz, tan_h, tan_v, min_depth, max_range)
+            if d < 0.0 or (check and hidden[r - hr0, c - hc0]):
                 continue
-            zc = sp * xr + cp * dz
-            if abs(yr) > tan_h * xc or abs(zc) > tan_v * xc:
-                continue
-            d = math.sqrt(xc * xc + yr * yr + zc * zc)
-            if d < min_depth or d > max_range:
-                continue
-            if check and hidden[r - hr0, c - hc0]:
-                continue
-            if d <= lut_d[0]:
-                k, t = 1, 0.0
-            elif d >= lut_d[n - 1]:
-                k, t = n - 1, 1.0
-            else:
-                k = 1
-                while lut_d[k] < d:
-                    k += 1
-                t = (d - lut_d[k - 1]) / (lut_d[k] - lut_d[k - 1])
+            k, t = _bracket(lut_d, d)
             b = int(math.floor(math.atan2(-cy, -cx) / step + 0.5))  # the bearing from the cell to the camera
             for h in range(K):
                 row = (b - h) % K
-                p = lut_p[row, k - 1] + t * (lut_p[row, k] - lut_p[row, k - 1])
-                nd[h, r, c] *= 1.0 - p
+                nd[h, r, c] *= 1.0 - _lerp(lut_p[row, k - 1], lut_p[row, k], t)
     return r0, r1, c0, c1
