@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +21,7 @@ from .report.tables import summarise, sweep_table
 from .runner import Loaded, check_folder, check_kind, expand, folder_lock, make_executor, run_batch, run_rows
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
-from .files import output_file, output_folder, temp_path
+from .files import inside, output_file, output_folder, temp_path
 
 
 @dataclass
@@ -177,11 +178,11 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
     path = Path(scenario)
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
-    out_dir = Path(out) if out else Path("results") / f"{loaded[0].sc.name}-sweep-{param}"
+    out_dir = Path(out) if out else inside(Path("results"), f"{loaded[0].sc.name}-sweep-{param}")
     # one Dask cluster (or client) for every value; the process pool starts per value (a fork costs little)
     shared = make_executor(workers, None, executor, scheduler) if executor != "processes" else nullcontext()
     with folder_lock(out_dir), shared as runner:
-        subs = [out_dir / f"{param}={v}" for v in values]
+        subs = [inside(out_dir, f"{param}={v}") for v in values]
         for ld, sub in zip(loaded, subs):  # refuse foreign rows before anything runs
             check_folder(ld, sub, force)
         frames = []
@@ -229,10 +230,34 @@ def record(scenario: str | Path, out: str | Path, cases=None) -> list[tuple[Path
     for name in names:
         if cases and name not in {str(c) for c in cases}:
             continue
-        f = Path(out) / f"{name}.csv"
+        f = inside(Path(out), f"{name}.csv")
         write_log(logs[name], f)
         written.append((f, len(logs[name])))
     return written
+
+
+def imported(importer, out: str | Path, *args, **kwargs) -> tuple[Path, list[str]]:
+    """Run an importer (``import_ros``, ``import_kth``, ``import_mobilesim``: ``importer(*args,
+    out=folder, **kwargs)`` -> (scenario path, notes)) into a hidden folder beside ``out``,
+    validate what it wrote with the same code as :func:`validate`, and only then move the files
+    into ``out``. A scenario that would not validate is a :class:`ScenarioError` (exit 2), and
+    ``out`` is left as it was."""
+    out = output_folder(out)
+    work = out / f".import.{os.getpid()}"
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir()
+    try:
+        path, notes = importer(*args, out=work, **kwargs)
+        try:
+            validate(path)
+        except ScenarioError as exc:
+            raise ScenarioError(str(out / path.name), exc.field, f"the imported scenario would not validate, so "
+                                f"nothing was written: {exc.message}") from None
+        for f in sorted(work.iterdir()):
+            os.replace(f, out / f.name)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return out / path.name, notes
 
 
 def validate(scenario: str | Path) -> dict:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import signal
 import sys
 import time
 from pathlib import Path
@@ -20,7 +21,7 @@ from .provenance import version_line
 from .belief.presence import presence_scores, read_counts
 from .config.base import MAX_SEEDS
 from .config.indirect import IndirectSpec
-from .errors import ScenarioError
+from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated
 from .report.build import console_tables
 from .world.generate import LAYOUTS, SCHEMES
 from .world.generate import generate_batch as gen_batch
@@ -31,7 +32,7 @@ from .world.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
 from .world.kth import import_kth as imp_kth
 from .world.mobilesim import import_mobilesim as imp_mobilesim
 from .world.ros_import import import_ros as imp_ros
-from .files import output_folder, temp_path
+from .files import atomic_text, output_file, output_folder
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 import_app = typer.Typer(no_args_is_help=True, help="Convert maps from other tools into scenarios.")
@@ -199,10 +200,12 @@ def _with_progress(call):
             return call(tick)
     except ScenarioError as exc:
         _fail(exc)
-    except KeyboardInterrupt:
-        err.print(f"interrupted: the {done} run(s) finished are kept in runs.csv; run the same command again to resume "
+    except (KeyboardInterrupt, Terminated, BatchStopped) as exc:
+        what, status = {KeyboardInterrupt: ("interrupted", 130), Terminated: ("stopped (SIGTERM)", 143)}.get(
+            type(exc), (f"stopped: {exc}", getattr(exc, "status", 1)))
+        err.print(f"{what}: the {done} run(s) finished are kept in runs.csv; run the same command again to resume "
                   "(runs already in runs.csv are not run again)", highlight=False, soft_wrap=True)
-        raise typer.Exit(130) from None
+        raise typer.Exit(status) from None
 
 
 def _warn_errors(runs) -> None:
@@ -275,6 +278,8 @@ def presence(
         if not hs or any(not 0 <= h < 24 for h in hs):
             raise ScenarioError("<command line>", "--hours", f"hours must lie in 0-23, got {hours!r}")
         scores = presence_scores(read_counts(counts_file), hs)
+        if out_file:
+            out_file = output_file(out_file, "--out", (".csv",))
     except ScenarioError as exc:
         _fail(exc)
     t = Table(title="presence score per place (sum of counts x W, Eq. 5.3), * = highest")
@@ -286,9 +291,7 @@ def presence(
         t.add_row(f"{rh:g}", *[f"{v:.2f}" + ("*" if c == best else "") for c, v in row.items()])
     out.print(t)
     if out_file:
-        tmp = temp_path(out_file)
-        scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv(tmp)
-        tmp.replace(out_file)
+        atomic_text(out_file, scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv())
         out.print(f"wrote {out_file}")
 
 
@@ -428,8 +431,8 @@ def import_mobilesim(
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
-        path, notes = imp_mobilesim(map_file, doors_file, output_folder(out_dir), resolution, _xy(start, "--start"),
-                             _split([goals], "--goals") if goals is not None else None, density_delta)
+        path, notes = api.imported(imp_mobilesim, out_dir, map_file, doors_file, res=resolution, start=_xy(start, "--start"),
+                                   goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
@@ -460,8 +463,8 @@ def import_ros(
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
-        path, notes = imp_ros(map_file, doors_file, output_folder(out_dir), _xy(start, "--start"), _split([goals], "--goals") if goals is not None else None,
-                       density_delta=density_delta)
+        path, notes = api.imported(imp_ros, out_dir, map_file, doors_file, start=_xy(start, "--start"),
+                                   goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
@@ -479,7 +482,8 @@ def import_kth(
     """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
         types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
-        path, notes = imp_kth(xml_file, output_folder(out_dir), resolution, _split([goals], "--goals") if goals is not None else None, corridor_types=types)
+        path, notes = api.imported(imp_kth, out_dir, xml_file, res=resolution,
+                                   goals=_split([goals], "--goals") if goals is not None else None, corridor_types=types)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
@@ -539,9 +543,30 @@ def planners_cmd(scenario: Optional[Path] = typer.Argument(None, help="Also list
     out.print(t)
 
 
+def _terminate(signum, frame) -> None:
+    raise Terminated()
+
+
 def main() -> None:
+    """The command line. Faults end with one paragraph and a status, never a traceback: Ctrl-C
+    (130), SIGTERM (143), a batch stopped by a dead worker (1), a full disk (1)."""
+    signal.signal(signal.SIGTERM, _terminate)
+    resume = "finished runs are kept in runs.csv; run the same command again to resume"
     try:
         app()
     except KeyboardInterrupt:
-        err.print("interrupted: finished runs are kept in runs.csv; run the same command again to resume")
+        err.print(f"interrupted: {resume}")
         sys.exit(130)
+    except Terminated:
+        err.print(f"stopped (SIGTERM): {resume}")
+        sys.exit(143)
+    except BatchStopped as exc:
+        err.print(f"stopped: {exc}; {resume}", highlight=False, soft_wrap=True)
+        sys.exit(exc.status)
+    except OSError as exc:
+        if exc.errno not in DISK_FULL:
+            raise
+        err.print(f"stopped: the disk is full ({exc.filename or 'writing an output file'}); nothing written before "
+                  f"is lost: free some space and run the same command again ({resume.split('; ')[0]})",
+                  highlight=False, soft_wrap=True)
+        sys.exit(1)

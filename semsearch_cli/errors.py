@@ -1,4 +1,9 @@
-"""User-facing errors: one clear paragraph, exit status 2, never a traceback."""
+"""User-facing errors: one clear paragraph, exit status 2, never a traceback; and the faults that
+stop a batch (one paragraph too, with the status they end with)."""
+
+import errno
+
+DISK_FULL = (errno.ENOSPC, errno.EDQUOT)  # what a write on a full disk (or quota) raises
 
 
 class ScenarioError(Exception):
@@ -18,3 +23,36 @@ class ScenarioError(Exception):
         self.file, self.field, self.message = str(file), field, message
         where = f"{self.file}" + (f", field '{field}'" if field else "")
         super().__init__(f"{where}: {message}")
+
+
+class BatchStopped(Exception):
+    """A batch stopped by a fault, not by bad input: a worker process died, the disk filled, the
+    batch was told to stop (SIGTERM). The rows finished are kept; the same command resumes.
+
+    Parameters
+    ----------
+    what : str
+        What happened, in a sentence.
+    status : int
+        The exit status the command ends with (1; 143 for SIGTERM).
+    """
+
+    def __init__(self, what: str, status: int = 1):
+        self.what, self.status = what, status
+        super().__init__(what)
+
+
+class PlannerError(Exception):
+    """A planner's decision the simulator cannot follow (off the map, not a free cell, not a
+    number): the run is recorded with outcome ``error`` and this message, naming the planner and
+    the value."""
+
+
+class RunTimeout(BaseException):
+    """A run past its wall-clock limit (``experiment.run_time_limit``); a BaseException, so that a
+    planner's ``except Exception`` cannot swallow it."""
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread (like KeyboardInterrupt for SIGINT), so that a batch
+    told to stop stops its workers and says what it kept."""

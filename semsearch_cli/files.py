@@ -10,7 +10,9 @@ processes writing the same file never share a temporary name."""
 
 from __future__ import annotations
 
+import hashlib
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -22,6 +24,18 @@ def temp_path(path: Path) -> Path:
     with the same suffix (libraries that pick a format from it still do)."""
     path = Path(path)
     return path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+
+
+def atomic_text(path: Path, text: str) -> None:
+    """Write a text file atomically (a reader never sees half of it); a failed write (a full
+    disk) leaves neither half a file nor its temporary file behind."""
+    tmp = temp_path(path)
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 MAX_TEXT_BYTES = 64 * 2**20  # a scenario, doors or log file larger than this is not one
@@ -113,4 +127,29 @@ def output_file(path: str | Path, flag: str, suffixes: tuple[str, ...]) -> Path:
         raise ScenarioError("<command line>", flag, f"cannot write {path.suffix or 'a file without an extension'}; "
                             f"give a file name ending in {', '.join(suffixes)}")
     output_folder(path.parent, flag)
+    return path
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9._+=\-]")
+MAX_COMPONENT = 120  # characters of a name made from a value, before its hash
+
+
+def component(text) -> str:
+    """``text`` (a value, a case name: anything a user wrote) as one file-name component that
+    stays where it is put: characters other than letters, digits and ``._+=-`` become ``_``,
+    leading dots go (no ``..``, no hidden file), and a name that had to change, or is long, gets a
+    short hash of the original, so two values never share a folder."""
+    text = str(text)
+    safe = _UNSAFE.sub("_", text).lstrip(".") or "_"
+    if safe == text and len(safe) <= MAX_COMPONENT:
+        return safe
+    return f"{safe[:MAX_COMPONENT]}-{hashlib.sha1(text.encode()).hexdigest()[:8]}"
+
+
+def inside(folder: Path, name, flag: str = "--out") -> Path:
+    """``folder / component(name)``, checked to lie inside ``folder`` (a :class:`ScenarioError`
+    for ``flag`` otherwise: every file a command writes lies inside its output folder)."""
+    path = Path(folder) / component(name)
+    if path.resolve().parent != Path(folder).resolve():
+        raise ScenarioError("<command line>", flag, f"{name!r} would write outside {folder}")
     return path

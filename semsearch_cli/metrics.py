@@ -10,7 +10,8 @@ COLUMNS = ["kind", "scenario", "planner", "params", "goal", "episode", "seed", "
            "left_m", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint", "code"]
 
 # the failure cause of each outcome (empty for a run that found its goal)
-CAUSES = {"found": "", "not_found": "explored", "stuck": "stuck", "budget": "budget", "error": "error"}
+CAUSES = {"found": "", "not_found": "explored", "stuck": "stuck", "budget": "budget", "error": "error",
+          "timeout": "timeout"}
 
 
 def spl(success: bool, shortest: float, distance: float) -> float:

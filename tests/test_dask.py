@@ -17,7 +17,10 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from typer.testing import CliRunner
+
 from semsearch_cli import api
+from semsearch_cli.cli import app
 from semsearch_cli.runner import read_runs
 
 distributed = pytest.importorskip("distributed")
@@ -122,3 +125,12 @@ def test_a_sweep_uses_one_cluster_for_all_its_values(demo_dir, tmp_path, monkeyp
     for v in ("0", "0.5", "0.9"):
         pd.testing.assert_frame_equal(_rows(tmp_path / "dask" / f"door_camera.p_misread={v}"),
                                       _rows(tmp_path / "pool" / f"door_camera.p_misread={v}"))
+
+
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:1", "not an address"])
+def test_a_wrong_scheduler_is_exit_2_naming_the_flag_within_10_s(demo_dir, tmp_path, address):
+    t0 = time.monotonic()
+    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "1", "--executor", "dask",
+                                   "--scheduler", address, "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "--scheduler" in res.output and "Traceback" not in res.output, res.output
+    assert time.monotonic() - t0 < 10

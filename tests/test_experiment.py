@@ -1,5 +1,7 @@
 """End-to-end runs on the demo building (a small map of our own)."""
 
+import os
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -238,3 +240,25 @@ def test_a_camera_that_misses_half_its_reads_still_finds_the_dead_end_sign(tmp_p
     d["door_camera"] = {"p_read": 0.5}
     L = Loaded.load(p, d)
     assert all(L.task.run(Variant("greedy", ()), 99, s).outcome == "found" for s in range(6))
+
+
+def test_a_sweep_value_holding_dots_writes_inside_out(demo_dir, tmp_path):
+    """``map.image=../<demo>/map.png`` names a folder made safe (one name: no "/", a hash of the
+    value): every file the sweep writes lies inside --out."""
+    work = tmp_path / "work"
+    work.mkdir()
+    value = os.path.relpath(demo_dir / "map.png", work)  # ../../.../map.png
+    assert value.startswith("..")
+    d = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    d["map"]["image"] = value
+    d["doors"] = str(demo_dir / "doors.csv")
+    (work / "s.yaml").write_text(yaml.safe_dump(d))
+    out = work / "sw"
+    before = set(tmp_path.rglob("*"))
+    r = CliRunner().invoke(app, ["sweep", str(work / "s.yaml"), "--param", f"map.image={value}", "--seeds", "1",
+                                 "--planner", "greedy", "--goal", "452", "--workers", "1", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    written = set(tmp_path.rglob("*")) - before
+    assert written and all(out in p.parents or p == out for p in written), sorted(map(str, written - set(out.rglob("*"))))
+    (sub,) = [p for p in out.iterdir() if p.is_dir()]
+    assert sub.name.startswith("map.image=") and sub.parent == out and (sub / "runs.csv").is_file()

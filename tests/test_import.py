@@ -5,6 +5,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pandas as pd
+import pytest
 import yaml
 from typer.testing import CliRunner
 
@@ -211,3 +212,56 @@ def test_import_kth_drives_in_passages_and_untyped_halls(tmp_path):
     res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "g.xml"), "--out", str(tmp_path / "g"),
                                    "--corridor-types", "KORRIDOR"])
     assert res.exit_code == 2 and "no circulation space" in res.output and "PASSAGE" in res.output, res.output
+
+
+@pytest.mark.parametrize("line,key", [("occupied_thresh: 1.5", "occupied_thresh"), ("free_thresh: -0.1", "free_thresh"),
+                                      ("free_thresh: 0.9", "free_thresh"), ("negate: 'yes'", "negate"),
+                                      ("negate: 2", "negate"), ("occupied_thresh: abc", "occupied_thresh"),
+                                      ("mode: fancy", "mode")])
+def test_ros_keys_are_checked_as_map_server_checks_them_each_error_naming_its_key(tmp_path, line, key):
+    saved_like_map_saver(tmp_path)
+    (tmp_path / "bad.yaml").write_text(f"image: lab.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n{line}\n")
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "bad.yaml"), str(tmp_path / "doors.csv"),
+                                   "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and f"field '{key}'" in res.output and "Traceback" not in res.output, res.output
+
+
+def test_a_string_origin_is_not_read_as_digits(tmp_path):
+    saved_like_map_saver(tmp_path)
+    (tmp_path / "bad.yaml").write_text("image: lab.pgm\nresolution: 0.1\norigin: '100'\n")
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "bad.yaml"), str(tmp_path / "doors.csv"),
+                                   "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "field 'origin'" in res.output and "three numbers" in res.output, res.output
+
+
+def test_import_ros_keeps_each_signs_facing_and_lists_what_it_changed(tmp_path):
+    """Every demo sign given a slanted facing (30 degrees off its wall's normal) keeps it; one
+    turned to face its own wall is re-faced, square to the wall, and listed."""
+    saved_like_map_saver(tmp_path)
+    lines = (tmp_path / "doors.csv").read_text().splitlines()
+    rows = [ln.split(",") for ln in lines[1:]]
+    given = {int(n): (float(f) + 30.0) for n, x, y, f in rows}
+    n0 = int(rows[0][0])
+    given[n0] = float(rows[0][3]) + 180.0  # faces its own wall
+    (tmp_path / "doors.csv").write_text(lines[0] + "\n" + "\n".join(f"{n},{x},{y},{given[int(n)]}" for n, x, y, f in rows) + "\n")
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "lab.yaml"), str(tmp_path / "doors.csv"), "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    got = {int(r["number"]): float(r["facing"]) for _, r in pd.read_csv(out / "doors.csv").iterrows()}
+    for n, f in given.items():
+        if n != n0:
+            assert (got[n] - f + 180) % 360 - 180 == pytest.approx(0.0, abs=0.01), n
+    assert (got[n0] - float(rows[0][3]) + 180) % 360 - 180 == pytest.approx(0.0, abs=0.01)
+    text = res.output.replace("\n", " ")
+    assert "re-faced 1 signs" in text and f"sign {n0}: " in text and "pointed into the wall" in text
+
+
+def test_an_import_that_would_not_validate_is_exit_2_and_writes_nothing(tmp_path):
+    """A goal that is not a sign: the scenario the import would write fails `semsearch validate`,
+    so the import says so (exit 2) and leaves --out as it was."""
+    saved_like_map_saver(tmp_path)
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "lab.yaml"), str(tmp_path / "doors.csv"),
+                                   "--out", str(out), "--goals", "12345"])
+    assert res.exit_code == 2 and "would not validate" in res.output and "Traceback" not in res.output, res.output
+    assert list(out.iterdir()) == []

@@ -7,6 +7,7 @@ with W(rh, h) = 1 - dh / 12 and dh the hour difference on the 24-hour clock (23:
 
 from __future__ import annotations
 
+import csv
 import io
 from pathlib import Path
 
@@ -29,15 +30,21 @@ def hour_weight(rh, h):
 
 
 def read_counts(path: Path) -> pd.DataFrame:
-    """Hourly counts per place: first column the hour (0-23), one column per place. Rows whose
-    first cell is not a number (a "Total" row) are ignored."""
+    """Hourly counts per place: first column the hour (0-23), one column per place, every row as
+    long as the header; counts finite and not negative. Rows whose first cell is not a number (a
+    "Total" row) are ignored; a file with no hour row is refused."""
     text = read_user_text(path, "counts file")
     try:
-        df = pd.read_csv(io.StringIO(text))
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        rows = list(csv.reader(io.StringIO(text)))
+    except csv.Error as exc:
         raise ScenarioError(str(path), "", f"not a readable CSV: {exc}") from None
-    if df.shape[1] < 2:
+    rows = [r for r in rows if any(c.strip() for c in r)]
+    if not rows or len(rows[0]) < 2:
         raise ScenarioError(str(path), "", "expected a first column with the hour and one column per place")
+    for k, r in enumerate(rows[1:], start=2):
+        if len(r) != len(rows[0]):
+            raise ScenarioError(str(path), f"line {k}", f"{len(r)} cells where the header has {len(rows[0])}")
+    df = pd.DataFrame(rows[1:], columns=rows[0])
     hours = pd.to_numeric(df.iloc[:, 0], errors="coerce")
     df = df[hours.notna()].copy()
     df.index = hours[hours.notna()].astype(float)
@@ -45,10 +52,12 @@ def read_counts(path: Path) -> pd.DataFrame:
     df = df.iloc[:, 1:]
     if ((df.index < 0) | (df.index >= 24)).any():
         raise ScenarioError(str(path), str(first), "hours must lie in 0-23")
+    if df.empty:
+        raise ScenarioError(str(path), str(first), "no row with an hour: give one row per hour (0-23)")
     counts = df.apply(pd.to_numeric, errors="coerce")
-    bad = counts.isna().any()
+    bad = (counts.isna() | ~np.isfinite(counts) | (counts < 0)).any()
     if bad.any():
-        raise ScenarioError(str(path), str(bad[bad].index[0]), "counts must be numbers")
+        raise ScenarioError(str(path), str(bad[bad].index[0]), "counts must be finite numbers, 0 or more")
     return counts
 
 

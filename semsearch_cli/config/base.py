@@ -155,6 +155,9 @@ class ExperimentSpec(Strict):
     base_seed: int = Field(0, ge=0, le=2**31)
     max_distance: float = Field(2000.0, gt=0.0, le=MAX_COORD, description="m, budget per run")
     max_steps: int | None = Field(None, ge=1, le=10**9)
+    run_time_limit: float = Field(3600.0, gt=0.0, le=7 * 86400.0, description="s of wall-clock time a run may take; "
+                                  "past it the run is recorded as timeout (a planner that hangs) and the batch goes on. "
+                                  "Generous: our longest runs take about 2 minutes. Not enforced on Dask workers")
     out: str | None = Field(None, description="output folder (default results/<name>)")
 
 

@@ -137,7 +137,7 @@ def load_planner_file(path: str | Path) -> list[str]:
     except SyntaxError as exc:
         del sys.modules[mod_name]
         raise ScenarioError(key, f"line {exc.lineno}", f"not valid Python: {exc.msg}") from None
-    except Exception as exc:
+    except (Exception, SystemExit) as exc:  # sys.exit() at import too: exit 2, naming the file
         del sys.modules[mod_name]
         line = traceback.extract_tb(exc.__traceback__)[-1].lineno
         raise ScenarioError(key, f"line {line}", f"the planner file raised {type(exc).__name__}: {exc}") from None

@@ -13,7 +13,7 @@ from pathlib import Path
 import pandas as pd
 
 from .tables import cells
-from ..files import temp_path
+from ..files import atomic_text, temp_path  # noqa: F401 (atomic_text: the report modules import it from here)
 
 
 @dataclass
@@ -129,13 +129,6 @@ def markdown_table(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}
     for row in rows:
         lines.append("| " + " | ".join(wrap[m].format(t) if t else t for t, m in row) + " |")
     return "\n".join(lines)
-
-
-def atomic_text(path: Path, text: str) -> None:
-    """Write a text file atomically (a reader never sees half of it)."""
-    tmp = temp_path(path)
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def write_table(tdir: Path, name: str, df: pd.DataFrame, formats) -> None:

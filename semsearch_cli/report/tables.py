@@ -166,7 +166,7 @@ def percent_of_optimal(runs: pd.DataFrame, summary: pd.DataFrame | None = None) 
     return t.reindex(columns=planner_order(t.columns))
 
 
-CAUSES = ("budget", "stuck", "explored", "error")
+CAUSES = ("budget", "stuck", "explored", "error", "timeout")
 
 
 def causes(runs: pd.DataFrame) -> pd.Series:

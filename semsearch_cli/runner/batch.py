@@ -10,7 +10,7 @@ from typing import Callable, Sequence
 
 import pandas as pd
 
-from ..errors import ScenarioError
+from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import temp_path
 from ..planners import code_of
 from .executors import Executor, SerialExecutor, make_executor
@@ -135,7 +135,14 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
                 n += 1
                 if progress:
                     progress(rows[0], n, total)
+        except OSError as exc:
+            if exc.errno in DISK_FULL:
+                raise BatchStopped(f"the disk is full ({exc.filename or runs_csv}); free some space") from None
+            raise
         finally:
-            writer.close()
+            try:
+                writer.close()
+            except OSError:
+                pass
         return read_runs(runs_csv)
 

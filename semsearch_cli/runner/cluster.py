@@ -18,9 +18,13 @@ from typing import Iterable, Iterator
 import dask
 from distributed import Client, LocalCluster, as_completed
 
+from ..errors import ScenarioError
 from .executors import Executor, execute
 from .specs import Loaded, RunSpec
 from .store import save_run_files
+
+
+CONNECT_S = 8  # s to reach a scheduler before the command gives up
 
 
 def _run_chunk(loaded: Loaded, specs: list[RunSpec], trace: bool) -> list[tuple]:
@@ -54,7 +58,12 @@ class DaskExecutor(Executor):
 
     def _client(self):
         if self.address:
-            return Client(self.address, set_as_default=False), None
+            try:
+                return Client(self.address, set_as_default=False, timeout=CONNECT_S), None
+            except (OSError, TimeoutError, ValueError, TypeError) as exc:  # unreachable, refused, a malformed address
+                raise ScenarioError("<command line>", "--scheduler", f"no Dask scheduler answers at {self.address!r} "
+                                    f"within {CONNECT_S} s ({type(exc).__name__}: {exc}); give tcp://HOST:PORT of a "
+                                    "running scheduler, or leave --scheduler out for a local cluster") from None
         # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which fixes glibc's mmap threshold
         # so that every grid-sized temporary is mapped and unmapped: runs took 1.45x as long (28.3 s vs
         # 19.6 s of run time for 40 Hotel runs). Unset here, and NumPy's huge pages off as in our own
@@ -96,7 +105,7 @@ class DaskExecutor(Executor):
                 fut.release()
                 submit(1)
                 for stem, rows, res in done:
-                    if res.outcome != "error":
+                    if res.outcome not in ("error", "timeout"):
                         save_run_files(out, stem, res)
                     yield rows
         except BaseException:

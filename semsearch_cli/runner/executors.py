@@ -9,36 +9,69 @@ import importlib.util
 import itertools
 import math
 import multiprocessing
+import os
 import signal
+import threading
+import time
 import traceback
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterable, Iterator
 
 import numpy as np
 
-from ..errors import ScenarioError
+from ..errors import BatchStopped, RunTimeout, ScenarioError
 from ..tasks import RunResult
 from .specs import Loaded, RunSpec
 from .store import save_run_files
 
 
 def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[dict], RunResult]:
-    """Run one spec; returns (rows, result). A planner that raises gives one row with outcome
-    ``error`` and the message, so the rest of the batch goes on."""
+    """Run one spec; returns (rows, result). A planner that raises or exits (``sys.exit``
+    included) gives one row with outcome ``error`` and the message; a run past
+    ``experiment.run_time_limit`` s of wall-clock time, one with outcome ``timeout``; either
+    way the rest of the batch goes on."""
     task = loaded.task
+    limit = loaded.sc.experiment.run_time_limit
+    empty = np.zeros((0, 2), np.float32)
     try:
-        res = task.run(spec.variant, spec.episode, spec.seed, trace)
-    except Exception as exc:  # a user's planner (or a bug): recorded, not fatal to the batch
+        with wall_clock_limit(limit):
+            res = task.run(spec.variant, spec.episode, spec.seed, trace)
+    except RunTimeout:
+        res = RunResult("timeout", math.nan, 0, 0, limit, empty,
+                        message=f"the run took longer than {limit:g} s of wall-clock time (experiment.run_time_limit)")
+    except (Exception, SystemExit) as exc:  # a user's planner (or a bug): recorded, not fatal to the batch
         where = traceback.extract_tb(exc.__traceback__)[-1]
         msg = f"{type(exc).__name__}: {exc} ({Path(where.filename).name}:{where.lineno})"
-        res = RunResult("error", math.nan, 0, 0, 0.0, np.zeros((0, 2), np.float32), message=msg)
+        res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=msg)
     return task.rows(spec.variant, spec.episode, spec.seed, res), res
+
+
+@contextmanager
+def wall_clock_limit(seconds: float):
+    """Raise :class:`RunTimeout` in the block after ``seconds`` of wall-clock time (SIGALRM;
+    only in a process's main thread, where signals arrive: not on Dask's worker threads)."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def alarm(signum, frame):
+        raise RunTimeout()
+
+    before = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, before)
 
 
 def _run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list[dict]:
     rows, res = execute(loaded, spec, trace)
-    if res.outcome != "error":
+    if res.outcome not in ("error", "timeout"):
         save_run_files(out, spec.stem, res)
     return rows
 
@@ -74,7 +107,20 @@ def _worker_init(loaded: Loaded) -> None:
     # Ctrl-C reaches every process of the terminal's group: the batch (the parent) handles it and
     # stops the workers, which would otherwise each print a KeyboardInterrupt traceback
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # the parent's handler is not the worker's
     _CACHE["loaded"] = loaded
+    threading.Thread(target=_die_with, args=(os.getppid(),), daemon=True, name="semsearch-parent-watch").start()
+
+
+def _die_with(parent: int) -> None:
+    """A worker's watch: when its parent is gone (killed, even by SIGKILL, which no handler sees),
+    the worker is re-parented, and it exits at once rather than run on, orphaned."""
+    while os.getppid() == parent:
+        time.sleep(WATCH_S)
+    os._exit(1)
+
+
+WATCH_S = 0.5  # s between a worker's looks at its parent
 
 
 def _worker_run(spec: RunSpec, out: str, trace: bool) -> list[dict]:
@@ -104,17 +150,31 @@ class ProcessExecutor(Executor):
         try:
             while running:
                 finished, running = wait(running, return_when=FIRST_COMPLETED)
+                broken = [f for f in finished if isinstance(f.exception(), BrokenProcessPool)]
+                for f in finished:  # the runs that did finish are kept, even beside a dead worker
+                    if f not in broken:
+                        yield f.result()
+                if broken:
+                    raise broken[0].exception()
                 running |= {pool.submit(_worker_run, s, str(out), trace) for s in itertools.islice(specs, len(finished))}
-                for f in finished:
-                    yield f.result()
+        except BrokenProcessPool:
+            self._stop(pool, running)
+            raise BatchStopped("a worker process died (killed by a signal, or by the system for lack of memory), "
+                               "and the pool cannot go on") from None
         except BaseException:
-            for f in running:
-                f.cancel()
-            for proc in list((getattr(pool, "_processes", None) or {}).values()):  # no public call stops them (3.14 adds one)
-                proc.terminate()
-            pool.shutdown(wait=True, cancel_futures=True)  # joins the manager thread: nothing left to wake at exit
+            self._stop(pool, running)
             raise
         pool.shutdown()
+
+    @staticmethod
+    def _stop(pool: ProcessPoolExecutor, running) -> None:
+        """Stop the workers at once, dropping their unfinished runs (no public call stops a pool's
+        processes; 3.14 adds one); joining the manager thread leaves nothing to wake at exit."""
+        for f in running:
+            f.cancel()
+        for proc in list((getattr(pool, "_processes", None) or {}).values()):
+            proc.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 EXECUTORS = ("processes", "dask")

@@ -96,7 +96,7 @@ class Loaded:
             d = self.sc.model_dump(mode="json")
             for key in ("planners", "goals"):  # the name stays: rows of a renamed copy are not resumed under the old name
                 d.pop(key, None)
-            for key in ("seeds", "out"):
+            for key in ("seeds", "out", "run_time_limit"):
                 d["experiment"].pop(key, None)
             d = _files_by_content(d, self.path.parent)
             h = hashlib.sha256(json.dumps(d, sort_keys=True).encode())

@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 from pathlib import Path
 
@@ -91,13 +92,53 @@ class RowWriter:
             self.fh.flush()
 
     def write(self, rows: list[dict]) -> None:
-        """Append the rows of one run together."""
-        self.w.writerows(rows)
+        """Append the rows of one run together, all or none: when the write fails (a full disk),
+        the file is cut back to where it was, so a run is never half recorded."""
+        buf = io.StringIO()
+        csv.DictWriter(buf, fieldnames=self.w.fieldnames, extrasaction="ignore").writerows(rows)
         self.fh.flush()
-        os.fsync(self.fh.fileno())
+        start = self.fh.tell()
+        try:
+            self.fh.write(buf.getvalue())
+            self.fh.flush()
+            os.fsync(self.fh.fileno())
+        except OSError:
+            self.fh = _cut_back(self.fh, start)
+            raise
 
     def close(self) -> None:
         self.fh.close()
+
+
+def _cut_back(fh, size: int):
+    """``fh``'s file cut back to ``size`` bytes and reopened for appending: what a failed write
+    left after it (part of a run's rows) is dropped."""
+    path = fh.name
+    try:
+        fh.close()  # flushing what is still buffered may fail again
+    except OSError:
+        pass
+    os.truncate(path, size)
+    return open(path, "a", newline="")
+
+
+def json_safe(v):
+    """``v`` as strict JSON can hold it, whatever a planner put in ``Decision.info``: NaN and
+    infinities become null, NumPy numbers and arrays plain numbers and lists, keys text, anything
+    else its ``repr``."""
+    if isinstance(v, dict):
+        return {str(k): json_safe(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple, set, frozenset)):
+        return [json_safe(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return json_safe(v.tolist())
+    if isinstance(v, np.generic):
+        return json_safe(v.item())
+    if isinstance(v, float):
+        return v if math.isfinite(v) else None
+    if v is None or isinstance(v, (bool, int, str)):
+        return v
+    return repr(v)
 
 
 def save_run_files(out: Path, stem: str, res) -> None:
@@ -115,5 +156,5 @@ def save_run_files(out: Path, stem: str, res) -> None:
         tmp = temp_path(traces / f"{stem}.jsonl")
         with open(tmp, "w") as fh:
             for d in res.trace:
-                fh.write(json.dumps(d) + "\n")
+                fh.write(json.dumps(json_safe(d), allow_nan=False) + "\n")
         os.replace(tmp, traces / f"{stem}.jsonl")

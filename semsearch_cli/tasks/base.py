@@ -21,7 +21,7 @@ import numpy as np
 
 from ..config import Scenario
 from ..kernels.grid import dijkstra
-from ..errors import ScenarioError
+from ..errors import PlannerError, ScenarioError
 from ..metrics import run_row
 from ..planners import Variant, expand_variants
 from ..world.scenario import World
@@ -65,7 +65,7 @@ class Outcome:
 
 @dataclass
 class RunResult:
-    outcome: str  # found | not_found | stuck | budget | error
+    outcome: str  # found | not_found | stuck | budget | error | timeout
     distance_m: float
     steps: int
     decisions: int
@@ -78,6 +78,39 @@ class RunResult:
     time_s: float = float("nan")  # simulated seconds, for tasks with a clock
     left_m: float = float("nan")  # geodesic distance left to the goal where the run ended (0 when found)
     start_heading: float = float("nan")  # rad, the heading the run started with
+
+
+def checked_cell(planner: str, row, col, free: np.ndarray) -> tuple[int, int]:
+    """A planner's target cell after the checks every decision gets: whole numbers, on the map,
+    a free cell of the belief; else a :class:`~semsearch_cli.errors.PlannerError` naming the
+    planner and the value (the run is recorded as ``error``)."""
+    H, W = free.shape
+    try:
+        r, c = int(row), int(col)
+        if (r, c) != (row, col):
+            raise ValueError
+    except (TypeError, ValueError, OverflowError):
+        raise PlannerError(f"planner {planner!r} chose the cell ({row!r}, {col!r}): not a pair of whole numbers") from None
+    if not (0 <= r < H and 0 <= c < W):
+        raise PlannerError(f"planner {planner!r} chose the cell ({r}, {c}), off the map ({H} x {W} cells)")
+    if not free[r, c]:
+        raise PlannerError(f"planner {planner!r} chose the cell ({r}, {c}), which the belief does not hold free")
+    return r, c
+
+
+def checked_point(planner: str, x, y, frame) -> tuple[float, float]:
+    """A planner's target point (m) after the checks every decision gets: finite numbers, on the
+    map; else a :class:`~semsearch_cli.errors.PlannerError` naming the planner and the value."""
+    try:
+        fx, fy = float(x), float(y)
+    except (TypeError, ValueError):
+        raise PlannerError(f"planner {planner!r} chose the point ({x!r}, {y!r}): not numbers") from None
+    if not (math.isfinite(fx) and math.isfinite(fy)):
+        raise PlannerError(f"planner {planner!r} chose the point ({fx}, {fy}): not finite")
+    r, c = frame.to_index(fx, fy)
+    if not (0 <= r < frame.height and 0 <= c < frame.width):
+        raise PlannerError(f"planner {planner!r} chose the point ({fx:.2f}, {fy:.2f}) m, off the map")
+    return fx, fy
 
 
 TASKS: dict[str, type["Task"]] = {}

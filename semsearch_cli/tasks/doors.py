@@ -23,7 +23,7 @@ from ..planners import PlanContext
 from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.scenario import check_goals_reachable
-from .base import Outcome, RobotState, Task, register_task
+from .base import Outcome, RobotState, Task, checked_cell, register_task
 from .loop import run_loop
 
 MAX_RETRIES = 5
@@ -140,6 +140,7 @@ class DoorSearch(DoorSensing):
             dec = self.planner.choose(ctx, cands)
             if dec is None:
                 break
+            checked_cell(self.planner.name, dec.row, dec.col, b.free)
             p = self.go(st, ctx, cands, dec)
             if p is not None:
                 return p

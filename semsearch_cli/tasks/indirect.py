@@ -28,14 +28,14 @@ from scipy import ndimage
 
 from ..belief.indirect import IndirectBelief, relation_mask
 from ..config.indirect import CATEGORIES
-from ..errors import ScenarioError
+from ..errors import PlannerError, ScenarioError
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.semantic import SemanticCamera, YawMemory
 from ..world.rooms import Room, estimate_relations, generate_rooms, read_rooms
-from .base import Outcome, RobotState, RunResult, Task, register_task
+from .base import Outcome, RobotState, RunResult, Task, checked_point, register_task
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
 from .loop import run_loop
 
@@ -244,6 +244,9 @@ class IndirectSearch:
                               np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
                               self.task.cooccurrence)
         goal = self.planner.plan(ctx)
+        checked_point(self.planner.name, goal.x, goal.y, g.frame)
+        if goal.heading is not None and not math.isfinite(float(goal.heading)):
+            raise PlannerError(f"planner {self.planner.name!r} chose the heading {goal.heading!r}: not finite")
         if self.recorder is not None:
             self.recorder(st.belief.p, st.belief.p0, np.asarray(st.trail), st.steps * self.dt, goal, dict(self.seen))
         self.frames_since_plan = 0

@@ -47,7 +47,7 @@ from ..kernels.grid import dijkstra
 from ..navigation import KnownMap
 from ..planners import ObjectContext
 from ..sensors import PlaceCamera
-from .base import Outcome, RobotState, Task, register_task
+from .base import Outcome, RobotState, Task, checked_point, register_task
 from .loop import run_loop
 from ..files import read_user_text, temp_path, user_file
 
@@ -125,6 +125,7 @@ class ObjectSearch:
         self.decisions = 0
         self.trace: list = []
         self.start_distance = 0.0
+        self.planner_name = ""  # for the checks of its targets
 
     def sense(self, st):
         seen, detected = self.camera.look(st.x, st.y, st.heading, self.rng)
@@ -154,6 +155,7 @@ class ObjectSearch:
             if nxt is None:
                 return "not_found"
             x, y, info = nxt
+            x, y = checked_point(self.planner_name, x, y, self.task.world.frame)
             self.decisions += 1
             if self.keep_trace:
                 self.trace.append({"distance_m": round(st.distance - self.start_distance, 3), "target": [round(x, 2), round(y, 2)], **info})
@@ -261,6 +263,7 @@ class ObjectTask(Task):
         camera = PlaceCamera(self.world, self.spec.camera, self.places, self.facing, instances)
         ctx = ObjectContext(self.world.frame, self.known, self.places, list(route), home, cls, hour, log, rng)
         search = ObjectSearch(self, planner.targets(ctx), cls, instances, camera, ctx, rng, trace)
+        search.planner_name = planner.name
         search.start_distance = d0
         outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state

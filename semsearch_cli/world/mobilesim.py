@@ -82,30 +82,44 @@ MAX_SNAP_M = 2.0  # a sign farther than this from the free space is dropped: no 
 
 def snap_report(signs: list[tuple], snapped: list[tuple], frame: GridFrame) -> tuple[list[tuple], list[str]]:
     """Drop the signs that :func:`snap_signs` had to move more than ``MAX_SNAP_M``, and say what
-    happened: how many signs were moved onto the walls (by more than a cell) and how far, how many
-    were dropped, and why. Returns (the signs kept, the lines of the report)."""
+    happened: a summary (how many signs were moved onto the walls, by more than a cell, and how
+    far; how many re-faced; how many dropped, and why), then one line per sign moved, re-faced or
+    dropped. Returns (the signs kept, the lines of the report)."""
     moved = [float(np.hypot(a[1] - b[1], a[2] - b[2])) for a, b in zip(signs, snapped)]
+    turned = [abs((b[3] - a[3] + 180.0) % 360.0 - 180.0) > 0.01 for a, b in zip(signs, snapped)]
     kept = [b for b, m in zip(snapped, moved) if m <= MAX_SNAP_M]
     lines = []
-    far = [(str(a[0]), m) for a, m in zip(signs, moved) if m > MAX_SNAP_M]
+    far = [k for k, m in enumerate(moved) if m > MAX_SNAP_M]
     near = [m for m in moved if frame.res < m <= MAX_SNAP_M]
     if near:
         lines.append(f"snapped {len(near)} of {len(signs)} signs onto the walls of the free space (moved {min(near):.2f}-"
-                     f"{max(near):.2f} m): they stood off the walls the robot drives along")
+                     f"{max(near):.2f} m), each keeping its facing: they stood off the walls the robot drives along")
+    if any(t for t, m in zip(turned, moved) if m <= MAX_SNAP_M):
+        lines.append(f"re-faced {sum(t for t, m in zip(turned, moved) if m <= MAX_SNAP_M)} signs whose facing pointed "
+                     "into the wall they stand on: they now face the free space, square to the wall")
     if far:
         lines.append(f"dropped {len(far)} signs more than {MAX_SNAP_M:g} m from the free space the robot can reach "
-                     f"(no pose could read them): " + ", ".join(f"{n} ({m:.1f} m)" for n, m in far))
+                     f"(no pose could read them)")
     if not lines:
-        lines.append(f"kept all {len(signs)} signs where they stood (within a cell of the walls)")
+        lines.append(f"kept all {len(signs)} signs where they stood (within a cell of the walls), with their facings")
+    for a, b, m, t in zip(signs, snapped, moved, turned):
+        if m > MAX_SNAP_M:
+            lines.append(f"  sign {a[0]}: dropped, {m:.1f} m from the free space")
+        elif m > frame.res or t:
+            what = [f"moved {m:.2f} m"] if m > frame.res else []
+            what.append(f"facing {a[3]:g} -> {b[3]:g} degrees (pointed into the wall)" if t else f"facing {a[3]:g} kept")
+            lines.append(f"  sign {a[0]}: " + ", ".join(what))
     return kept, lines
 
 
 def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[tuple]:
-    """Move each sign onto the nearest wall face of ``free``, facing into the free cell."""
+    """Move each sign onto the nearest wall face of ``free``. A sign keeps its facing (the
+    direction it faces, degrees) unless that points into the wall it now stands on (no reader
+    could stand there); it then faces the free cell, square to the wall."""
     _, (ir, ic) = ndimage.distance_transform_edt(~free, return_indices=True)
     H, W = free.shape
     out = []
-    for label, x, y, _ in signs:
+    for label, x, y, facing in signs:
         r, c = frame.to_index(x, y)
         r = int(np.clip(r, 0, H - 1))
         c = int(np.clip(c, 0, W - 1))
@@ -126,8 +140,10 @@ def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[t
             bdir = (float(v[0]), float(v[1]))
         sx = fx + 0.5 * frame.res * bdir[0]
         sy = fy + 0.5 * frame.res * bdir[1]
-        facing = float(np.degrees(np.arctan2(-bdir[1], -bdir[0])))
-        out.append((label, round(float(sx), 4), round(float(sy), 4), round(facing, 2)))
+        a = np.radians(float(facing))
+        if np.cos(a) * -bdir[0] + np.sin(a) * -bdir[1] <= 0.0:  # faces the wall: no reader can stand there
+            facing = float(np.degrees(np.arctan2(-bdir[1], -bdir[0])))
+        out.append((label, round(float(sx), 4), round(float(sy), 4), round(float(facing), 2)))
     return out
 
 

@@ -33,24 +33,51 @@ def read_ros_yaml(path: Path, owner: str | None = None) -> dict:
     for key in ("image", "resolution", "origin"):
         if key not in d:
             raise ScenarioError(str(path), key, "required by the map_server format")
-    try:
-        res = float(d["resolution"])
-        ox, oy, yaw = (float(v) for v in d["origin"])
-        occupied, free = float(d.get("occupied_thresh", 0.65)), float(d.get("free_thresh", 0.196))
-    except (TypeError, ValueError):
-        raise ScenarioError(str(path), "origin", "expected resolution (m/cell) and origin [x, y, yaw]") from None
+    res = _number(path, d, "resolution", "m per cell")
     if not 0.005 <= res <= 1.0:
         raise ScenarioError(str(path), "resolution", f"expected 0.005 to 1 m per cell (got {res})")
+    origin = d["origin"]
+    if not isinstance(origin, (list, tuple)) or len(origin) != 3 or any(isinstance(v, (bool, str)) for v in origin):
+        raise ScenarioError(str(path), "origin", f"expected [x, y, yaw], three numbers (got {origin!r})")
+    try:
+        ox, oy, yaw = (float(v) for v in origin)
+    except (TypeError, ValueError):
+        raise ScenarioError(str(path), "origin", f"expected [x, y, yaw], three numbers (got {origin!r})") from None
     if not (np.isfinite([ox, oy, yaw]).all() and max(abs(ox), abs(oy)) <= 1e6):
-        raise ScenarioError(str(path), "origin", f"expected finite numbers within 1e6 m (got {d['origin']!r})")
+        raise ScenarioError(str(path), "origin", f"expected finite numbers within 1e6 m (got {origin!r})")
     if abs(yaw) > 1e-9:
         raise ScenarioError(str(path), "origin", f"a rotated map (yaw {yaw}) is not supported; save it with yaw 0")
-    mode = str(d.get("mode", "trinary"))
+    occupied = _number(path, d, "occupied_thresh", "a probability", 0.65)
+    free = _number(path, d, "free_thresh", "a probability", 0.196)
+    for key, v in (("occupied_thresh", occupied), ("free_thresh", free)):
+        if not 0.0 <= v <= 1.0:
+            raise ScenarioError(str(path), key, f"expected a probability, 0 to 1 (got {v})")
+    if free > occupied:
+        raise ScenarioError(str(path), "free_thresh", f"{free} lies above occupied_thresh {occupied}: a cell cannot be "
+                            "both free and occupied")
+    negate = d.get("negate", 0)
+    if negate not in (0, 1) or isinstance(negate, float):  # map_server reads an integer (True and False are 1 and 0)
+        raise ScenarioError(str(path), "negate", f"expected 0 or 1 (got {negate!r})")
+    mode = d.get("mode", "trinary")
     if mode not in ("trinary", "scale", "raw"):
         raise ScenarioError(str(path), "mode", f"trinary, scale or raw (got {mode!r})")
-    return {"image": str(d["image"]), "resolution": res, "origin": (ox, oy), "negate": bool(int(d.get("negate", 0))),
+    return {"image": str(d["image"]), "resolution": res, "origin": (ox, oy), "negate": bool(negate),
             "occupied_thresh": occupied, "free_thresh": free,
             "mode": mode}
+
+
+def _number(path: Path, d: dict, key: str, what: str, default: float | None = None) -> float:
+    """``d[key]`` as a finite number (YAML booleans and text are not numbers); errors name the key."""
+    v = d.get(key, default)
+    if isinstance(v, (bool, str)) or v is None:
+        raise ScenarioError(str(path), key, f"expected {what}, a number (got {v!r})")
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise ScenarioError(str(path), key, f"expected {what}, a number (got {v!r})") from None
+    if not np.isfinite(x):
+        raise ScenarioError(str(path), key, f"expected {what}, a finite number (got {v!r})")
+    return x
 
 
 def read_ros_map(path: Path, owner: str | None = None) -> tuple[np.ndarray, float, tuple[float, float]]:
