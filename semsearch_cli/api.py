@@ -151,6 +151,25 @@ class SweepOutput:
     table: pd.DataFrame
 
 
+def _typed(param: str, value, loaded: Loaded) -> None:
+    """A sweep value is typed by the field it sets: ``true`` or ``false`` sets a yes/no field
+    only (pydantic would read it as 1 or 0 in a number field)."""
+    if not isinstance(value, bool):
+        return
+    keys = param.split(".")
+    cls = PLANNERS.get(keys[0])
+    if cls is not None and len(keys) == 2 and keys[1] in cls.Params.model_fields:
+        is_bool = cls.Params.model_fields[keys[1]].annotation is bool
+    else:
+        got = loaded.sc.model_dump()
+        for k in keys:
+            got = got.get(k) if isinstance(got, dict) else None
+        is_bool = isinstance(got, bool)
+    if not is_bool:
+        raise ScenarioError("<command line>", "--param", f"{param}={str(value).lower()}: this field holds numbers or text, "
+                            "not yes/no; give its values")
+
+
 def parse_param(text: str) -> tuple[str, list]:
     """``SECTION.FIELD=V1,V2,...`` -> (dotted name, values read as YAML scalars)."""
     name, eq, vals = text.partition("=")
@@ -178,6 +197,8 @@ def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = No
     path = Path(scenario)
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
+    for v, ld in zip(values, loaded):
+        _typed(param, v, ld)
     out_dir = Path(out) if out else inside(Path("results"), f"{loaded[0].sc.name}-sweep-{param}")
     # one Dask cluster (or client) for every value; the process pool starts per value (a fork costs little)
     shared = make_executor(workers, None, executor, scheduler) if executor != "processes" else nullcontext()

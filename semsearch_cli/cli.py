@@ -348,7 +348,7 @@ app.add_typer(generate_app, name="generate")
 def generate_building(
     layout: str = typer.Option(..., "--layout", help="grid, wings, angled or single."),
     numbering: str = typer.Option(..., "--numbering", help=", ".join(SCHEMES) + "."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the layout's variations (and of random numbering)."),
+    seed: int = typer.Option(0, "--seed", min=0, max=2**32 - 1, help="Seed of the layout's variations (and of random numbering)."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
     spacing: float = typer.Option(2.5, "--spacing", callback=_finite, min=0.5, max=50.0, help="m between door slots along a wall."),
     signs: Optional[int] = typer.Option(None, "--signs", min=1, help="Keep exactly this many signs (doors trimmed at random, numbers kept)."),
@@ -359,11 +359,17 @@ def generate_building(
 ):
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
-        path = gen_building(layout, numbering, seed, output_folder(out_dir), spacing=spacing, signs=signs,
-                   goals=_split([goals], "--goals") if goals is not None else None, name=name, scale=scale)
+        wanted = _split([goals], "--goals") if goals is not None else None
+        if wanted and any(not isinstance(g, int) for g in wanted):
+            raise ScenarioError("<command line>", "--goals", f"expected door numbers, got {goals!r}")
+        path = gen_building(layout, numbering, seed, output_folder(out_dir), spacing=spacing, signs=signs, goals=wanted,
+                            name=name, scale=scale)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
+
+
+MAX_BATCH_SEEDS = 100  # generate batch: 2,800 buildings at most
 
 
 def _choices(text: Optional[str], valid: tuple, flag: str) -> tuple:
@@ -379,7 +385,8 @@ def _choices(text: Optional[str], valid: tuple, flag: str) -> tuple:
 @generate_app.command("batch")
 def generate_batch(
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for the buildings (one sub-folder each) and index.txt."),
-    seeds: int = typer.Option(3, "--seeds", min=1, help="Buildings per layout and numbering scheme."),
+    seeds: int = typer.Option(3, "--seeds", min=1, max=MAX_BATCH_SEEDS, help="Buildings per layout and numbering scheme "
+                              f"(at most {MAX_BATCH_SEEDS}: 4 x 7 x {MAX_BATCH_SEEDS} buildings)."),
     runs: int = typer.Option(3, "--runs", min=1, help="Runs per goal and planner in each scenario."),
     layouts: Optional[str] = typer.Option(None, "--layouts", help="Comma-separated layouts (default: all)."),
     schemes: Optional[str] = typer.Option(None, "--schemes", help="Comma-separated numbering schemes (default: all)."),

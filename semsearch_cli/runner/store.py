@@ -23,6 +23,8 @@ def read_runs(path: Path) -> pd.DataFrame:
     cut by power loss or a full disk, even inside a quoted field) is left out; a file that is not
     a runs.csv written by semsearch is a :class:`ScenarioError`. ``stage`` and ``map`` are read as
     text (empty for a run's own row)."""
+    if path.is_dir():
+        raise ScenarioError(str(path), "", "is a folder, not a runs.csv; move it away or write into another folder with --out")
     if not path.is_file() or path.stat().st_size == 0:
         return pd.DataFrame(columns=COLUMNS)
     data = path.read_bytes()
@@ -44,6 +46,15 @@ def read_runs(path: Path) -> pd.DataFrame:
         if c not in df.columns:
             df[c] = df["outcome"].map(CAUSES) if c == "cause" else default
     df[TEXT] = df[TEXT].fillna("")
+    for c in NUMBERS:
+        if c in df.columns and not pd.api.types.is_numeric_dtype(df[c]):  # a cell that is not a number
+            num = pd.to_numeric(df[c], errors="coerce")
+            bad = num.isna() & df[c].notna() & (df[c].astype(str).str.strip() != "")
+            if bad.any():
+                k = int(bad.to_numpy().nonzero()[0][0])
+                raise ScenarioError(str(path), c, f"expected numbers, found {df[c].iloc[k]!r} on line {k + 2} "
+                                    "(edited by hand?); fix it, or write into another folder with --out")
+            df[c] = num
     return df.dropna(subset=["wall_s"])
 
 
@@ -51,6 +62,8 @@ def read_runs(path: Path) -> pd.DataFrame:
 LATER = {"episode": 0, "start_x": float("nan"), "start_y": float("nan"), "start_heading": float("nan"), "room": "",
          "cause": None, "soft_spl": float("nan"), "left_m": float("nan"), "fingerprint": "", "code": ""}
 TEXT = ["stage", "map", "message", "room", "cause", "code"]
+NUMBERS = ["episode", "seed", "start_x", "start_y", "start_heading", "success", "distance_m", "shortest_m", "ratio", "spl",
+           "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s"]
 
 
 def _whole_lines(fh) -> int:

@@ -303,6 +303,9 @@ class IndirectSearch:
         return i, moved
 
 
+MAX_ROOM_CELLS = 1_000_000  # cells of one room's grid: the map, eight yaw hypotheses per class, the masks
+
+
 @register_task
 class IndirectTask(Task):
     """Indirect search: goals are view scales; each episode searches one room from one start."""
@@ -353,6 +356,12 @@ class IndirectTask(Task):
             except KeyError:
                 raise ScenarioError(task.file, "indirect.camera.detection", f"no detection table for {cls_name!r}; give "
                                     "one (rows yaw 0..315, columns 0.8..2.5 m)") from None
+        w, h = rooms[0].size
+        cells = math.ceil(w / spec.resolution) * math.ceil(h / spec.resolution)
+        if cells > MAX_ROOM_CELLS:
+            raise ScenarioError(task.file, "indirect.resolution", f"rooms of {w:g} x {h:g} m at {spec.resolution:g} m "
+                                f"cells are {cells:,} cells, more than the {MAX_ROOM_CELLS:,} a search holds in memory "
+                                "(about 150 bytes a cell); take coarser cells or smaller rooms")
         try:
             bodies = spec.camera.diameters if spec.objects_block else None
             task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius, bodies) for r in rooms]
