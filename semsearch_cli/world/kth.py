@@ -29,6 +29,7 @@ from ..errors import ScenarioError
 from ..files import user_file
 from ..geometry import GridFrame
 from .files import map_image, scenario_dict, write_building
+from .labels import parse_label
 from ..config import parse_scenario
 from .mobilesim import MARGIN_M, snap_report, snap_signs, spread_goals
 from .scenario import build_world
@@ -146,9 +147,10 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
         return path, report
     # default goals: only signs the written scenario can read from the start's free space
     world = build_world(parse_scenario(scen, path), out, str(path))
-    readable = [lab for lab, *_ in snapped if isinstance(lab, int) and np.isfinite(world.shortest_path(lab))]
+    readable = [lab for lab, *_ in snapped if parse_label(lab) is not None and np.isfinite(world.shortest_path(lab))]
     if not readable:
-        raise ScenarioError(str(xml_path), "space", "no numbered sign can be read from the corridors' free space")
+        raise ScenarioError(str(xml_path), "space", "no sign with a number (148, K202, 24D, ...) can be read from the "
+                            "corridors' free space")
     ok = [g for g in chosen if g in readable]
     if len(ok) < len(chosen):
         keep = [s for s in snapped if s[0] in readable]

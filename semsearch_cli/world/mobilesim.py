@@ -20,6 +20,7 @@ from ..files import read_user_text
 from ..geometry import GridFrame
 from ..kernels.grid import dijkstra
 from .files import map_image, scenario_dict, write_building
+from .labels import parse_label
 
 MARGIN_M = 1.0
 
@@ -179,20 +180,24 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
 
 
 def spread_goals(free, frame, signs, start, k=4):
-    """k numeric signs at evenly spread quantiles of distance from the start (a default only)."""
+    """k signs with a number (world/labels.py) at evenly spread quantiles of distance from the
+    start (a default only)."""
     r, c = frame.to_index(*start)
     _, length, _ = dijkstra(free, np.ones((1, 1), np.float32), np.array([r]), np.array([c]),
                             np.zeros(free.shape, bool), 0, np.inf)
     cand = []
     for label, x, y, _ in signs:
-        if isinstance(label, int):
+        if parse_label(label) is not None:
             sr, sc = frame.to_index(x, y)
             win = length[max(sr - 2, 0): sr + 3, max(sc - 2, 0): sc + 3]
             d = win[np.isfinite(win)]
             if d.size:
                 cand.append((float(d.min()), label))
-    cand.sort()
+    def order(label):  # numbers first by value (labels mix 1513 and K202)
+        return parse_label(label).number, str(label)
+
+    cand.sort(key=lambda dc: (dc[0], *order(dc[1])))
     if not cand:
         return [signs[0][0]]
     idx = np.linspace(0.2, 0.8, k) * (len(cand) - 1)
-    return sorted({cand[int(round(i))][1] for i in idx})
+    return sorted({cand[int(round(i))][1] for i in idx}, key=order)

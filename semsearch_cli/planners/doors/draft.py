@@ -45,6 +45,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from ...geometry import wrap_angle
+from ...world.labels import parse_label
 from ..base import Decision, register_planner
 from .nsos import KeepTarget, increasing_sum, pick
 
@@ -106,12 +107,14 @@ class Draft(KeepTarget):
         D, reach, gamma = dist
         tau = np.full(k, 0.5)
         omega = np.full(k, 0.5)
-        goal = ctx.goal if isinstance(ctx.goal, (int, np.integer)) else None
+        label = parse_label(ctx.goal)  # the numbers of the signs that share the goal's prefix (world/labels.py)
+        goal = None if label is None else label.number
         if goal is not None:
             seg, lists = b.segment_door_lists(cands.seg_rows, cands.seg_cols, 1)
             per_seg = []
             for lst in lists:
-                items = [(lab, cnt, x, y) for lab, (cnt, x, y) in lst.items() if isinstance(lab, (int, np.integer))]
+                items = [(q.number, cnt, x, y) for lab, (cnt, x, y) in lst.items()
+                         if (q := parse_label(lab)) is not None and q.prefix == label.prefix]
                 nums = np.array([i[0] for i in items], np.int64)
                 cnt = np.array([i[1] for i in items], np.int64)
                 per_seg.append((nums, np.array([i[2] for i in items]), np.array([i[3] for i in items]), nums[cnt > p.parity_reads]))

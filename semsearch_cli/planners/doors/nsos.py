@@ -34,6 +34,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from ...geometry import wrap_angle
+from ...world.labels import SignLabel, parse_label
 from ..base import Decision, Planner, register_planner
 
 
@@ -224,11 +225,13 @@ class NSOS(KeepTarget):
         self._h_r = RollingHistogram(self.params.robot_bins, False, self.params.lambda_r)
         self._terms: dict = {}  # (goal, door list) -> (zeta, theta_inc, phi_p), see _segment_terms
 
-    def _segment_terms(self, door_list: dict, goal: int) -> tuple:
-        """(zeta, theta_inc, phi_p) of a segment's numbered signs. A segment's door list changes
-        only when one of its signs is read again, so the terms are kept by the list's contents
-        (the same numbers, in the same order, as computing them afresh)."""
-        items = [(lab, x, y) for lab, (_, x, y) in door_list.items() if isinstance(lab, (int, np.integer))]
+    def _segment_terms(self, door_list: dict, goal: SignLabel) -> tuple:
+        """(zeta, theta_inc, phi_p) of a segment's numbered signs that share the goal's prefix
+        (world/labels.py: ``K202`` counts as 202 among the K signs, ``24D`` as 24). A segment's
+        door list changes only when one of its signs is read again, so the terms are kept by the
+        list's contents (the same numbers, in the same order, as computing them afresh)."""
+        items = [(p.number, x, y) for lab, (_, x, y) in door_list.items()
+                 if (p := parse_label(lab)) is not None and p.prefix == goal.prefix]
         key = (goal, tuple(items))
         terms = self._terms.get(key)
         if terms is None:
@@ -236,8 +239,8 @@ class NSOS(KeepTarget):
                 self._terms.clear()
             nums = np.array([i[0] for i in items], np.int64)
             p = self.params
-            terms = self._terms[key] = (*segment_growth(nums, [i[1] for i in items], [i[2] for i in items], goal, p.w_g),
-                                        parity(nums, goal, p.w_p))
+            terms = self._terms[key] = (*segment_growth(nums, [i[1] for i in items], [i[2] for i in items], goal.number,
+                                                        p.w_g), parity(nums, goal.number, p.w_p))
         return terms
 
     def _decide(self, ctx, cands, keep: int | None = None):
@@ -258,7 +261,7 @@ class NSOS(KeepTarget):
         zeta = np.zeros(k)
         gamma = np.zeros(k)
         seg = np.full(k, -1)
-        goal = ctx.goal if isinstance(ctx.goal, (int, np.integer)) else None
+        goal = parse_label(ctx.goal)
         if alpha > 0 and goal is not None:
             seg, lists = b.segment_door_lists(cands.seg_rows, cands.seg_cols, p.min_reads)
             per_seg = [self._segment_terms(lst, goal) for lst in lists]
