@@ -13,8 +13,9 @@ from pathlib import Path
 import pytest
 
 from semsearch_cli import cli
-from semsearch_cli.runner import read_runs
-from semsearch_cli.runner import store
+from semsearch_cli.errors import ScenarioError
+from semsearch_cli.runner import batch, expand, read_runs, run_batch, store
+from semsearch_cli.tasks import loop
 
 
 def start(demo_dir, out: Path, seeds: int = 100) -> subprocess.Popen:
@@ -156,3 +157,20 @@ def test_a_full_disk_ends_the_command_with_one_paragraph(demo_dir, tmp_path, mon
     err = capsys.readouterr().err
     assert stop.value.code == 1, err
     assert "the disk is full" in err and "run the same command again to resume" in err and "Traceback" not in err
+
+
+def test_a_batch_that_would_not_fit_in_memory_is_refused_with_the_workers_that_fit(demo_loaded, tmp_path, monkeypatch):
+    need = demo_loaded.task.memory_per_run()
+    monkeypatch.setattr(batch, "available_memory", lambda: int(need * 2.5))
+    with pytest.raises(ScenarioError) as err:
+        run_batch(demo_loaded, expand(demo_loaded, 2), tmp_path / "o", workers=4)
+    assert err.value.field == "--workers" and "run with --workers 2" in err.value.message
+    assert not (tmp_path / "o" / "runs.csv").exists() or len(read_runs(tmp_path / "o" / "runs.csv")) == 0
+
+
+def test_a_long_run_says_it_is_alive(demo_loaded, tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(loop, "PROGRESS_S", 0.0)
+    specs = list(expand(demo_loaded, 1))[:1]
+    run_batch(demo_loaded, specs, tmp_path / "o", workers=1)
+    err = capsys.readouterr().err
+    assert f"run {specs[0].variant.label} goal {specs[0].episode.goal}" in err and "m so far" in err

@@ -8,6 +8,8 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
+from semsearch_cli.errors import ScenarioError
+from semsearch_cli.tasks.objects import read_log
 
 runner = CliRunner()
 
@@ -70,3 +72,21 @@ def test_a_sweep_value_is_typed_by_its_field(demo_dir, tmp_path):
             "--param", "not yes/no")
     assert not (tmp_path / "s").exists() or not any((tmp_path / "s").rglob("runs.csv"))
     shutil.rmtree(tmp_path / "s", ignore_errors=True)
+
+
+def test_an_empty_list_of_planner_values_is_refused(demo_dir, tmp_path):
+    d = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    d["map"]["image"] = str(demo_dir / "map.png")
+    d["doors"] = str(demo_dir / "doors.csv")
+    d["planners"] = [{"name": "nsos", "alpha": []}]
+    p = tmp_path / "s.yaml"
+    p.write_text(yaml.safe_dump(d))
+    refused(["validate", p], "planners[0].alpha", "empty list")
+
+
+@pytest.mark.parametrize("row,col", [("mug,1,2,99,0,0", "hour"), ("mug,inf,2,10,0,0", "x")])
+def test_an_object_log_with_an_impossible_hour_or_coordinate_is_refused(tmp_path, row, col):
+    (tmp_path / "log.csv").write_text(f"class,x,y,hour,robot_x,robot_y\n{row}\n")
+    with pytest.raises(ScenarioError) as err:
+        read_log(tmp_path / "log.csv")
+    assert err.value.field == col

@@ -265,3 +265,18 @@ def test_an_import_that_would_not_validate_is_exit_2_and_writes_nothing(tmp_path
                                    "--out", str(out), "--goals", "12345"])
     assert res.exit_code == 2 and "would not validate" in res.output and "Traceback" not in res.output, res.output
     assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("old,new,where", [
+    ('PixelDistance="100"', 'PixelDistance="0"', "PixelDistance"),
+    ('RealDistance="1"', 'RealDistance="abc"', "RealDistance"),
+    ('x1="0" y1="0" x2="1000" y2="0"', 'y1="0" x2="1000" y2="0"', "x1"),
+    ('x1="0" y1="0" x2="1000" y2="0"', 'x1="1e12" y1="0" x2="1000" y2="0"', "from the origin"),
+    ('x1="0" y1="0" x2="1000" y2="0"', 'x1="nan" y1="0" x2="1000" y2="0"', "x1"),
+    ('<space name="B_301" type="KONTOR">', '<space type="KONTOR">', "without a name"),
+])
+def test_a_malformed_kth_floor_is_exit_2_naming_the_element_and_attribute(tmp_path, old, new, where):
+    assert old in KTH_PASSAGE
+    (tmp_path / "f.xml").write_text(KTH_PASSAGE.replace(old, new, 1))
+    res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "f.xml"), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and where in res.output and "Traceback" not in res.output, res.output

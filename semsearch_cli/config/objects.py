@@ -103,7 +103,7 @@ class ObjectsSpec(Strict):
 
     places: list[PlaceSpec] = Field(min_length=1)
     fixed: dict[str, Union[str, list[str]]] = Field(default_factory=dict, description="place -> class(es) standing there all day")
-    route: list[str] | None = Field(None, description="patrol order of the places (default: as listed)")
+    route: list[str] | None = Field(None, min_length=1, description="patrol order of the places (default: as listed)")
     timelines: dict[str, Timeline] = Field(default_factory=dict,
                                            description="pattern -> class -> {hour: place(s) from that hour on}")
     recording_hours: list[Hour] = Field(default_factory=lambda: [3, 5, 7, 9, 11, 15, 17, 19, 21, 23])

@@ -197,6 +197,9 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
         keys = sorted(params)
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]
         for k, vs in zip(keys, values):
+            if not vs:
+                raise ScenarioError(file, f"planners[{i}].{k}", "an empty list: give one value, or a list of values to "
+                                    "sweep")
             bad = [v for v in vs if isinstance(v, float) and not math.isfinite(v)]
             if bad:
                 raise ScenarioError(file, f"planners[{i}].{k}", f"expected a finite number, got {bad[0]!r}")

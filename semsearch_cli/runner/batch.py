@@ -91,6 +91,38 @@ def _supersede(out: Path, which, why: str) -> None:
     print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}; their runs run again", file=sys.stderr)
 
 
+LARGE_RUN = 1e9  # bytes: a batch whose runs need more than this each says so before it starts
+
+
+def available_memory() -> int | None:
+    """Bytes of memory the machine has available now (Linux: MemAvailable), or None."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def check_memory(loaded: Loaded, workers: int) -> None:
+    """Before a batch starts: the memory a run needs, times the workers, against what the machine
+    has available; refused (a :class:`ScenarioError` for ``--workers``) with the number of
+    workers that would fit, and said on stderr when a run needs more than 1 GB."""
+    need = loaded.task.memory_per_run()
+    have = available_memory()
+    if have is not None and need * workers > have:
+        fit = have // max(need, 1)
+        hint = (f"run with --workers {fit}" if fit >= 1 else "a run alone does not fit: take a coarser map resolution or "
+                "a smaller map")
+        raise ScenarioError("<command line>", "--workers", f"each run needs about {need / 1e9:.1f} GB, so {workers} "
+                            f"workers need {need * workers / 1e9:.1f} GB, and this machine has {have / 1e9:.1f} GB "
+                            f"available; {hint}")
+    if need > LARGE_RUN:
+        print(f"note: each run needs about {need / 1e9:.1f} GB of memory ({workers} worker(s)); a run on a map this large "
+              "prints its progress every few seconds", file=sys.stderr)
+
+
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,
               progress: Callable[[dict, int, int], None] | None = None, trace: bool = False,
               start_method: str | None = None, force: bool = False, executor: str = "processes",
@@ -121,6 +153,8 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
+        if total and executor == "processes" and runner is None:
+            check_memory(loaded, max(1, min(workers, total)))
         if runner is None:
             serial = total == 0 or (executor == "processes" and total == 1)
             runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), start_method, executor, scheduler)

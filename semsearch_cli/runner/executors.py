@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import BatchStopped, RunTimeout, ScenarioError
 from ..tasks import RunResult
+from ..tasks.loop import running
 from .specs import Loaded, RunSpec
 from .store import save_run_files
 
@@ -36,6 +37,7 @@ def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[di
     task = loaded.task
     limit = loaded.sc.experiment.run_time_limit
     empty = np.zeros((0, 2), np.float32)
+    running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
     try:
         with wall_clock_limit(limit):
             res = task.run(spec.variant, spec.episode, spec.seed, trace)
@@ -46,6 +48,8 @@ def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[di
         where = traceback.extract_tb(exc.__traceback__)[-1]
         msg = f"{type(exc).__name__}: {exc} ({Path(where.filename).name}:{where.lineno})"
         res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=msg)
+    finally:
+        running(None)
     return task.rows(spec.variant, spec.episode, spec.seed, res), res
 
 

@@ -330,6 +330,12 @@ class IndirectTask(Task):
         self.cooccurrence = {c: 1.0 - row[CATEGORIES.index("VF")] for c, row in relations.items()}
         self._masks = {}
 
+    def memory_per_run(self) -> int:
+        """A room's grid times what a search keeps per cell (the map, eight yaw hypotheses for A
+        and for each secondary object, the masks' convolutions)."""
+        H, W = self.grids[0].stand.shape
+        return int(H * W * (150 + 64 * len(self.spec.secondary)))
+
     @classmethod
     def build(cls, sc, world, path):
         task = cls(sc, world, path)

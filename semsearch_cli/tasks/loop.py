@@ -9,12 +9,30 @@ the robot's whole history, so a chain's stages share one budget.
 
 from __future__ import annotations
 
+import sys
+import time
 from typing import Protocol
 
 from ..navigation import advance
 from .base import RobotState
 
 STALL_STEPS = 50  # steps without moving before a run is stuck
+PROGRESS_S = 10.0  # s of wall-clock time between the lines a long run prints about itself
+_RUN = {"what": None, "last": 0.0}  # the run under way in this process (set by the runner)
+
+
+def running(what: str | None) -> None:
+    """Name the run this process starts (None when it ends): a run longer than ``PROGRESS_S``
+    then prints a line every ``PROGRESS_S`` seconds to stderr (distance so far), so that a long
+    run on a huge map shows it is alive, off a terminal too."""
+    _RUN["what"], _RUN["last"] = what, time.monotonic()
+
+
+def _alive(st: RobotState) -> None:
+    now = time.monotonic()
+    if _RUN["what"] is not None and now - _RUN["last"] >= PROGRESS_S:
+        _RUN["last"] = now
+        print(f"run {_RUN['what']}: {st.distance:.0f} m so far, {st.steps} steps", file=sys.stderr, flush=True)
 
 
 class Search(Protocol):
@@ -69,6 +87,8 @@ def run_loop(search: Search, st: RobotState, step: float, max_distance: float, m
         since_plan += moved
         st.steps += 1
         st.trail.append((st.x, st.y))
+        if not st.steps & 63:
+            _alive(st)
         stall = stall + 1 if moved < 1e-9 and st.heading == h0 else 0
         if stall >= STALL_STEPS:  # 6. budget
             return "stuck"

@@ -433,8 +433,13 @@ def read_log(path: Path) -> pd.DataFrame:
     if not need <= set(df.columns):
         raise ScenarioError(str(path), "", f"expected columns {', '.join(sorted(need))} (got {', '.join(df.columns)})")
     for col in ("x", "y", "hour", "robot_x", "robot_y"):
-        if pd.to_numeric(df[col], errors="coerce").isna().any():
-            raise ScenarioError(str(path), col, "must be numbers on every row")
+        num = pd.to_numeric(df[col], errors="coerce")
+        if num.isna().any() or not np.isfinite(num).all():
+            raise ScenarioError(str(path), col, "must be finite numbers on every row")
+        df[col] = num
+    hours = df["hour"]
+    if ((hours < 0) | (hours >= 24)).any():
+        raise ScenarioError(str(path), "hour", f"hours lie in 0-24 (got {hours[(hours < 0) | (hours >= 24)].iloc[0]:g})")
     if "day" not in df:
         df["day"] = 0
     if "place" not in df:

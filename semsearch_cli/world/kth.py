@@ -41,6 +41,25 @@ def _label(name: str):
 
 
 CORRIDOR_TYPES = ("KORRIDOR", "PASSAGE", "HALL", "KULVERT", "ENTRE")
+MAX_SPACES = 5000  # spaces of one floor (the public set's largest floors have a few hundred)
+MAX_SEGMENTS = 200_000  # line segments of one floor
+MAX_COORD_M = 1e5  # m: a floor spans less than 100 km
+MAX_CELLS = 50_000_000  # cells of the imported map
+
+
+def _number(path: Path, where: str, el, attr: str, positive: bool = False) -> float:
+    """Attribute ``attr`` of element ``el`` as a finite number (positive when asked); errors name
+    the element and the attribute."""
+    v = el.get(attr)
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise ScenarioError(str(path), f"{where} {attr}", f"expected a number, got {v!r}" if v is not None
+                            else "missing") from None
+    if not np.isfinite(x) or (positive and x <= 0):
+        raise ScenarioError(str(path), f"{where} {attr}", f"expected a {'positive ' if positive else ''}finite number, "
+                            f"got {v!r}")
+    return x
 
 
 def circulation(spaces, types=CORRIDOR_TYPES) -> set[str]:
@@ -71,8 +90,18 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
     scale = root.find("Scale")
     if scale is None:
         raise ScenarioError(str(xml_path), "Scale", "missing <Scale PixelDistance RealDistance> element")
-    ppm = float(scale.get("PixelDistance")) / float(scale.get("RealDistance"))
+    ppm = _number(xml_path, "Scale", scale, "PixelDistance", positive=True) / \
+        _number(xml_path, "Scale", scale, "RealDistance", positive=True)
     spaces = root.findall("space")
+    if len(spaces) > MAX_SPACES:
+        raise ScenarioError(str(xml_path), "space", f"{len(spaces):,} spaces, more than the {MAX_SPACES:,} a floor may have")
+    n_segs = sum(1 for _ in root.iter("linesegment"))
+    if n_segs > MAX_SEGMENTS:
+        raise ScenarioError(str(xml_path), "linesegment", f"{n_segs:,} line segments, more than the {MAX_SEGMENTS:,} a floor "
+                            "may have")
+    for k, s in enumerate(spaces):
+        if not (s.get("name") or "").strip():
+            raise ScenarioError(str(xml_path), f"space[{k}]", "a space without a name")
     corridors = circulation(spaces, corridor_types)
     if not corridors:
         found = sorted({(s.get("type") or "untyped") for s in spaces})
@@ -81,7 +110,15 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
                             f"types are {', '.join(found)}; name the circulation ones with --corridor-types")
 
     def seg(ls):
-        return [float(ls.get(k)) / ppm for k in ("x1", "y1", "x2", "y2")]
+        where = f"space {ls_space[ls]!r}, linesegment"
+        out = [_number(xml_path, where, ls, k) / ppm for k in ("x1", "y1", "x2", "y2")]
+        if max(abs(v) for v in out) > MAX_COORD_M:
+            raise ScenarioError(str(xml_path), f"{where} {[ls.get(k) for k in ('x1', 'y1', 'x2', 'y2')]}",
+                                f"a coordinate {max(abs(v) for v in out):.3g} m from the origin: a floor spans at most "
+                                f"{MAX_COORD_M:g} m (check Scale and the coordinates)")
+        return out
+
+    ls_space = {ls: s.get("name") for s in spaces for ls in s.iter("linesegment")}
 
     polys, portals, links = [], [], {}
     for s in spaces:
@@ -97,10 +134,17 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
                 if ls.get("type") == "Portal" and ls.get("target") in corridors:
                     x1, y1, x2, y2 = seg(ls)
                     portals.append((_label(s.get("name")), (x1 + x2) / 2, -(y1 + y2) / 2))
+    polys = [p for p in polys if len(p) >= 3]
+    if not polys:
+        raise ScenarioError(str(xml_path), "space", "the circulation spaces have no contour (three or more line segments "
+                            "each) to drive in")
     allpts = np.concatenate(polys)
     x0, y0 = allpts.min(axis=0) - MARGIN_M
     x1, y1 = allpts.max(axis=0) + MARGIN_M
     W, H = int(np.ceil((x1 - x0) / res)), int(np.ceil((y1 - y0) / res))
+    if W * H > MAX_CELLS:
+        raise ScenarioError(str(xml_path), "space", f"the circulation spans {x1 - x0:.0f} x {y1 - y0:.0f} m: {W * H:,} cells "
+                            f"at {res:g} m, more than {MAX_CELLS:,}; give a coarser --resolution")
     frame = GridFrame(res, float(x0), float(y0), H, W)
     free = np.zeros((H, W), np.uint8)
     for p in polys:
