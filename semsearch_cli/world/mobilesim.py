@@ -87,7 +87,7 @@ def snap_report(signs: list[tuple], snapped: list[tuple], frame: GridFrame) -> t
     far; how many re-faced; how many dropped, and why), then one line per sign moved, re-faced or
     dropped. Returns (the signs kept, the lines of the report)."""
     moved = [float(np.hypot(a[1] - b[1], a[2] - b[2])) for a, b in zip(signs, snapped)]
-    turned = [abs((b[3] - a[3] + 180.0) % 360.0 - 180.0) > 0.01 for a, b in zip(signs, snapped)]
+    turned = [a[3] is not None and abs((b[3] - a[3] + 180.0) % 360.0 - 180.0) > 0.01 for a, b in zip(signs, snapped)]
     kept = [b for b, m in zip(snapped, moved) if m <= MAX_SNAP_M]
     lines = []
     far = [k for k, m in enumerate(moved) if m > MAX_SNAP_M]
@@ -108,7 +108,10 @@ def snap_report(signs: list[tuple], snapped: list[tuple], frame: GridFrame) -> t
             lines.append(f"  sign {a[0]}: dropped, {m:.1f} m from the free space")
         elif m > frame.res or t:
             what = [f"moved {m:.2f} m"] if m > frame.res else []
-            what.append(f"facing {a[3]:g} -> {b[3]:g} degrees (pointed into the wall)" if t else f"facing {a[3]:g} kept")
+            if a[3] is None:
+                what.append(f"facing {b[3]:g} degrees (the file gives none: square to the wall)")
+            else:
+                what.append(f"facing {a[3]:g} -> {b[3]:g} degrees (pointed into the wall)" if t else f"facing {a[3]:g} kept")
             lines.append(f"  sign {a[0]}: " + ", ".join(what))
     return kept, lines
 
@@ -116,7 +119,8 @@ def snap_report(signs: list[tuple], snapped: list[tuple], frame: GridFrame) -> t
 def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[tuple]:
     """Move each sign onto the nearest wall face of ``free``. A sign keeps its facing (the
     direction it faces, degrees) unless that points into the wall it now stands on (no reader
-    could stand there); it then faces the free cell, square to the wall."""
+    could stand there), or is None (the file gives none, as KTH's); it then faces the free cell,
+    square to the wall."""
     _, (ir, ic) = ndimage.distance_transform_edt(~free, return_indices=True)
     H, W = free.shape
     out = []
@@ -141,8 +145,8 @@ def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[t
             bdir = (float(v[0]), float(v[1]))
         sx = fx + 0.5 * frame.res * bdir[0]
         sy = fy + 0.5 * frame.res * bdir[1]
-        a = np.radians(float(facing))
-        if np.cos(a) * -bdir[0] + np.sin(a) * -bdir[1] <= 0.0:  # faces the wall: no reader can stand there
+        if facing is None or np.cos(np.radians(float(facing))) * -bdir[0] + np.sin(np.radians(float(facing))) * -bdir[1] <= 0.0:
+            # no facing given, or one toward the wall (no reader can stand there): square to the wall
             facing = float(np.degrees(np.arctan2(-bdir[1], -bdir[0])))
         out.append((label, round(float(sx), 4), round(float(sy), 4), round(float(facing), 2)))
     return out
