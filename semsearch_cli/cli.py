@@ -467,11 +467,13 @@ def import_ros(
     start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
     density_delta: float = typer.Option(2.5, "--density-delta", callback=_finite, min=0.01, max=1e4, help="m^2, segmentation delta (Eq. 4.4)."),
+    clean: bool = typer.Option(False, "--clean", help="Clean a SLAM map: free space not reachable from the start, and laser fans narrower than the robot, become outside (map.clean)."),
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
         path, notes = api.imported(imp_ros, out_dir, map_file, doors_file, start=_xy(start, "--start"),
-                                   goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta)
+                                   goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta,
+                                   clean=clean)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))

@@ -280,3 +280,32 @@ def test_a_malformed_kth_floor_is_exit_2_naming_the_element_and_attribute(tmp_pa
     (tmp_path / "f.xml").write_text(KTH_PASSAGE.replace(old, new, 1))
     res = CliRunner().invoke(app, ["import", "kth", str(tmp_path / "f.xml"), "--out", str(tmp_path / "o")])
     assert res.exit_code == 2 and where in res.output and "Traceback" not in res.output, res.output
+
+
+def test_import_ros_clean_removes_laser_fans_and_unreachable_space(tmp_path):
+    """The demo map saved as map_saver saves it, plus what SLAM leaves: five one-pixel laser rays
+    from the corridor out through the walls, and a free blob outside. `--clean` makes them
+    outside, keeps the building's free space as the demo has it, and the scenario cleans alike."""
+    img, pgm = saved_like_map_saver(tmp_path)
+    demo = Loaded.load(ROOT / "configs" / "demo.yaml")
+    H, W = pgm.shape
+    r0, c0 = demo.world.frame.to_index(*demo.world.start_xy)
+    fans = np.zeros_like(pgm)
+    for k in range(5):
+        cv2.line(fans, (int(c0), int(r0)), (int(c0) + 40 * (k - 2), 0), 1, 1)
+    added = (fans > 0) & (pgm != 254)
+    pgm[added] = 254
+    pgm[H - 6:H - 2, 2:8] = 254  # a blob of free space no robot can reach
+    cv2.imwrite(str(tmp_path / "lab.pgm"), pgm)
+    res = CliRunner().invoke(app, ["import", "ros", str(tmp_path / "lab.yaml"), str(tmp_path / "doors.csv"),
+                                   "--out", str(tmp_path / "out"), "--clean", "--start",
+                                   ",".join(f"{v - o}" for v, o in zip(demo.world.start_xy, (3.0, 2.0)))])
+    assert res.exit_code == 0, res.output
+    assert "cleaned the map" in res.output and yaml.safe_load((tmp_path / "out" / "scenario.yaml").read_text())["map"]["clean"]
+    cleaned = Loaded.load(tmp_path / "out" / "scenario.yaml").world
+    # of the 439 ray cells, 7 stay: single notches in a wall beside free space, where the tip of
+    # the robot's disk fits
+    assert cleaned.free[added].sum() <= 0.02 * added.sum() and not cleaned.free[H - 6:H - 2, 2:8].any()
+    # the building's free space is the demo's, but for cells next to where a ray crossed a wall
+    diff = cleaned.free != demo.world.free
+    assert diff.sum() <= 0.01 * demo.world.free.sum()

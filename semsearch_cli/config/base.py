@@ -32,6 +32,8 @@ class MapSpec(Strict):
     ros: str | None = Field(None, description="a ROS map_server / map_saver YAML (PGM or PNG image)")
     resolution: float = Field(0.1, ge=0.005, le=1.0, description="m/cell")
     origin: tuple[Coord, Coord] = Field((0.0, 0.0), description="world (x, y) m of the image's bottom-left corner")
+    clean: bool = Field(False, description="clean a SLAM map: free space the robot cannot reach from the start, and "
+                        "laser fans narrower than the robot, become outside")
 
     @model_validator(mode="after")
     def _one_source(self):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import cv2
 import numpy as np
 import yaml
 
@@ -113,3 +114,25 @@ def copy_ros_map(path: Path, out: Path) -> Path:
     dest = out / "map.yaml"
     dest.write_text(yaml.safe_dump(text, sort_keys=False))
     return dest
+
+
+def clean_free(img: np.ndarray, res: float, start_rc: tuple[int, int], radius: float) -> tuple[np.ndarray, int]:
+    """A SLAM map cleaned for a robot of ``radius`` m starting at cell ``start_rc``: free space
+    narrower than the robot (a laser's ray fans beyond the walls, clutter), taken by a
+    morphological opening with a disk of the robot's diameter, and free space the robot cannot
+    reach from the start become outside (grey 128). Returns (the map, the cells removed). The
+    opening also trims corners narrower than the robot, where its centre cannot be anyway (24 of
+    the demo map's 10,800 free cells)."""
+    free = img == FREE
+    d = max(1, int(round(2 * radius / res)))
+    disk = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (d | 1, d | 1))
+    wide = cv2.morphologyEx(free.astype(np.uint8), cv2.MORPH_OPEN, disk).astype(bool)
+    r, c = start_rc
+    if not wide[r, c]:
+        wide |= free & (np.hypot(*np.mgrid[-r:img.shape[0] - r, -c:img.shape[1] - c]) * res <= radius)
+    _, lab = cv2.connectedComponents(wide.astype(np.uint8), connectivity=4)
+    keep = (lab == lab[r, c]) & wide
+    out = img.copy()
+    gone = free & ~keep
+    out[gone] = UNKNOWN
+    return out, int(gone.sum())

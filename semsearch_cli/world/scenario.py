@@ -22,7 +22,7 @@ from ..geometry import GridFrame
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from .images import read_gray
-from .ros import read_ros_map
+from .ros import clean_free, read_ros_map
 
 WALL_BELOW = 100
 FREE_FROM = 200
@@ -243,9 +243,15 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     else:
         img, res, origin = load_map(base / sc.map.image, owner=file), sc.map.resolution, sc.map.origin
         map_field = "map.image"
-    free = img >= FREE_FROM
-    H, W = free.shape
+    H, W = img.shape
     frame = GridFrame(res, origin[0], origin[1], H, W)
+    if sc.map.clean:
+        r, c = frame.to_index(sc.start.x, sc.start.y)
+        if not (0 <= r < H and 0 <= c < W) or img[r, c] < FREE_FROM:
+            raise ScenarioError(file, "start", f"map.clean keeps the free space reachable from the start, and the start "
+                                f"({sc.start.x:g}, {sc.start.y:g}) m is not on a free cell")
+        img = clean_free(img, res, (int(r), int(c)), sc.robot.radius)[0]
+    free = img >= FREE_FROM
     if not free.any():
         raise ScenarioError(file, map_field, f"the map has no free cells (light pixels, >= {FREE_FROM} of 255; a 16-bit image "
                             "is scaled to 8 bits): is it inverted, or all dark?")
