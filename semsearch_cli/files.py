@@ -127,6 +127,13 @@ def output_file(path: str | Path, flag: str, suffixes: tuple[str, ...]) -> Path:
         raise ScenarioError("<command line>", flag, f"cannot write {path.suffix or 'a file without an extension'}; "
                             f"give a file name ending in {', '.join(suffixes)}")
     output_folder(path.parent, flag)
+    probe = temp_path(path)
+    try:  # a folder that exists but takes no files (/proc, a read-only mount)
+        probe.open("w").close()
+        probe.unlink()
+    except OSError as exc:
+        raise ScenarioError("<command line>", flag, f"cannot write files in {path.parent}: "
+                            f"{exc.strerror or exc}") from None
     return path
 
 

@@ -304,5 +304,63 @@ def build_cases(root: Path) -> list[Case]:
     bigdoc = _set(_set(_set(base, ["map", "image"], str(maps / "big.png")), ["start"], {"x": 20.0, "y": 100.0, "heading": 0}),
                   ["doors"], [{"number": 1, "x": 150.0, "y": 110.05, "facing": -90}, {"number": 2, "x": 180.0, "y": 89.95, "facing": 90}])
     add("resources", "a 2000 x 2000 map validates", ["validate", scen("big2000", _set(bigdoc, ["goals"], [1, 2]))], "accept")
+
+    # -- issue 26: other commands, importers, planners, paths (process faults: tests/test_faults.py)
+    counts = root / "counts"
+    counts.mkdir(exist_ok=True)
+    for name, text in (("negative", "hour,A\n1,-2\n"), ("infinite", "hour,A\n1,inf\n"), ("header only", "hour,A\n"),
+                       ("ragged", "hour,A,B\n1,2\n")):
+        f = counts / f"{name.replace(' ', '_')}.csv"
+        f.write_text(text)
+        add("commands", f"presence counts {name}", ["presence", f, "--hours", "1"], issue=True, says=[str(f.name)])
+    add("commands", "presence --out a folder", ["presence", REPO / "configs" / "hh106_counts.csv", "--hours", "1", "--out", root],
+        issue=True, says=["--out"])
+    add("commands", "generate --seed -5", ["generate", "building", "--layout", "grid", "--numbering", "normal", "--seed", "-5",
+                                           "--out", root / "out" / "b"], issue=True, says=["--seed"])
+    add("commands", "generate --goals abc", ["generate", "building", "--layout", "grid", "--numbering", "normal", "--goals", "abc",
+                                             "--out", root / "out" / "b"], issue=True, says=["--goals"])
+    add("commands", "generate batch --seeds 1000000", ["generate", "batch", "--seeds", "1000000", "--out", root / "out" / "gb"],
+        issue=True, says=["--seeds"])
+    add("commands", "sweep true as a number", ["sweep", good, "--param", "door_camera.p_misread=true", "--out", root / "out" / "t"],
+        issue=True, says=["--param"])
+    add("commands", "show --out into /proc", ["show", good, "--out", "/proc/semsearch.png"], issue=True, says=["--out"])
+    add("commands", "indirect rooms of 25 million cells", ["validate", scen("ind_big", _set(_set(indirect, ["indirect", "rooms", "size"],
+                                                                                          [50, 50]), ["indirect", "resolution"], 0.01))],
+        issue=True, says=["indirect.resolution"])
+    add("commands", "an empty alpha list", ["validate", scen("alpha_empty", _set(base, ["planners"], [{"name": "nsos", "alpha": []}]))],
+        issue=True, says=["alpha"])
+    ros = root / "ros26"
+    ros.mkdir(exist_ok=True)
+    cv2.imwrite(str(ros / "m.pgm"), np.where(cv2.imread(str(demo / "map.png"), cv2.IMREAD_GRAYSCALE) >= 200, 254, 0).astype(np.uint8))
+    for name, line, key in (("occupied_thresh 1.5", "occupied_thresh: 1.5", "occupied_thresh"),
+                            ("free above occupied", "free_thresh: 0.9", "free_thresh"), ("negate yes", "negate: 'yes'", "negate"),
+                            ("occupied_thresh abc", "occupied_thresh: abc", "occupied_thresh")):
+        f = ros / f"{key}_{len(cases)}.yaml"
+        f.write_text(f"image: m.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n{line}\n")
+        add("importers", f"import ros {name}", ["import", "ros", f, demo / "doors.csv", "--out", root / "out" / "r"], issue=True,
+            says=[key])
+    f = ros / "origin_text.yaml"
+    f.write_text("image: m.pgm\nresolution: 0.1\norigin: '100'\n")
+    add("importers", "import ros origin as text", ["import", "ros", f, demo / "doors.csv", "--out", root / "out" / "r"], issue=True,
+        says=["origin"])
+    f = ros / "ok.yaml"
+    f.write_text("image: m.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n")
+    add("importers", "import ros, a goal that is no sign", ["import", "ros", f, demo / "doors.csv", "--out", root / "out" / "r",
+                                                            "--goals", "12345"], issue=True, says=["would not validate"])
+    kth = ('<floor><Scale PixelDistance="{p}" RealDistance="1"/><space name="B_C" type="KORRIDOR"><contour>'
+           '<linesegment {a} y1="0" x2="1000" y2="0" type="Wall"/><linesegment x1="1000" y1="0" x2="1000" y2="200" type="Wall"/>'
+           '<linesegment x1="1000" y1="200" x2="0" y2="200" type="Wall"/><linesegment x1="0" y1="200" x2="0" y2="0" type="Wall"/>'
+           '</contour></space><space name="B_1" type="KONTOR"><contour><linesegment x1="300" y1="-20" x2="400" y2="-20" '
+           'type="Portal" target="B_C"/></contour></space></floor>')
+    for name, p, a, says in (("PixelDistance 0", "0", 'x1="0"', "PixelDistance"), ("a missing x1", "100", "", "x1"),
+                             ("a coordinate of 1e12", "100", 'x1="1e12"', "from the origin")):
+        f = root / f"kth_{len(cases)}.xml"
+        f.write_text(kth.format(p=p, a=a))
+        add("importers", f"import kth {name}", ["import", "kth", f, "--out", root / "out" / "k"], issue=True, says=[says])
+    planner = root / "exits_at_import.py"
+    planner.write_text("import sys\nsys.exit(3)\n")
+    add("planners", "a planner file that exits at import",
+        ["validate", scen("exits", _set(base, ["planners"], [{"name": "x", "module": str(planner)}]))], issue=True,
+        says=["exits_at_import.py"])
     shutil.rmtree(root / "out", ignore_errors=True)
     return cases

@@ -1,4 +1,4 @@
-"""Every defect of issue 14 as a case of the hostile-input catalogue (tests/hostile_inputs.py),
+"""Every defect of issues 14 and 26 as a case of the hostile-input catalogue (tests/hostile_inputs.py),
 run in-process: a refused input exits 2 with one paragraph naming the file and the field (or the
 flag) and no traceback; an accepted one exits 0; nothing is written into the working folder.
 ``benchmarks/hostile.py`` runs the whole catalogue as real processes."""
@@ -22,7 +22,8 @@ runner = CliRunner()
 
 
 def test_the_catalogue_holds_every_group_of_the_issue():
-    assert {c.category for c in CASES} == {"numbers", "files", "structure", "output", "markup", "command line", "resources"}
+    assert {c.category for c in CASES} == {"numbers", "files", "structure", "output", "markup", "command line", "resources",
+                                           "commands", "importers", "planners"}
     assert len(CASES) >= 65
 
 

@@ -91,6 +91,7 @@ def _supersede(out: Path, which, why: str) -> None:
     print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}; their runs run again", file=sys.stderr)
 
 
+MANY_RUNS = 10_000  # a batch this large says how many runs it has before it starts
 LARGE_RUN = 1e9  # bytes: a batch whose runs need more than this each says so before it starts
 
 
@@ -153,6 +154,9 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
+        if total >= MANY_RUNS:
+            n_var = len(variants)
+            print(f"runs: {total:,} to do ({n_var:,} planner variant(s) x goals, episodes and seeds)", file=sys.stderr)
         if total and executor == "processes" and runner is None:
             check_memory(loaded, max(1, min(workers, total)))
         if runner is None:
