@@ -201,8 +201,7 @@ def _with_progress(call):
     except ScenarioError as exc:
         _fail(exc)
     except (KeyboardInterrupt, Terminated, BatchStopped) as exc:
-        what, status = {KeyboardInterrupt: ("interrupted", 130), Terminated: ("stopped (SIGTERM)", 143)}.get(
-            type(exc), (f"stopped: {exc}", getattr(exc, "status", 1)))
+        what, status = _stopped(exc)
         err.print(f"{what}: the {done} run(s) finished are kept in runs.csv; run the same command again to resume "
                   "(runs already in runs.csv are not run again)", highlight=False, soft_wrap=True)
         raise typer.Exit(status) from None
@@ -556,6 +555,15 @@ def _terminate(signum, frame) -> None:
     raise Terminated()
 
 
+def _stopped(exc: BaseException) -> tuple[str, int]:
+    """(how a command stopped, its exit status) for Ctrl-C, SIGTERM and a batch stopped by a fault."""
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted", 130
+    if isinstance(exc, Terminated):
+        return "stopped (SIGTERM)", 143
+    return f"stopped: {exc}", getattr(exc, "status", 1)
+
+
 def main() -> None:
     """The command line. Faults end with one paragraph and a status, never a traceback: Ctrl-C
     (130), SIGTERM (143), a batch stopped by a dead worker (1), a full disk (1)."""
@@ -563,15 +571,10 @@ def main() -> None:
     resume = "finished runs are kept in runs.csv; run the same command again to resume"
     try:
         app()
-    except KeyboardInterrupt:
-        err.print(f"interrupted: {resume}")
-        sys.exit(130)
-    except Terminated:
-        err.print(f"stopped (SIGTERM): {resume}")
-        sys.exit(143)
-    except BatchStopped as exc:
-        err.print(f"stopped: {exc}; {resume}", highlight=False, soft_wrap=True)
-        sys.exit(exc.status)
+    except (KeyboardInterrupt, Terminated, BatchStopped) as exc:
+        what, status = _stopped(exc)
+        err.print(f"{what}: {resume}", highlight=False, soft_wrap=True)
+        sys.exit(status)
     except OSError as exc:
         if exc.errno not in DISK_FULL:
             raise

@@ -137,8 +137,14 @@ def output_file(path: str | Path, flag: str, suffixes: tuple[str, ...]) -> Path:
     return path
 
 
-_UNSAFE = re.compile(r"[^A-Za-z0-9._+=\-]")
 MAX_COMPONENT = 120  # characters of a name made from a value, before its hash
+
+
+def safe_chars(text, keep: str = "") -> str:
+    """``text`` with every character but letters, digits, ``._+-`` (and those of ``keep``)
+    replaced by ``_``: one file-name component, whatever a label or value holds (a KTH room's
+    second door is the goal ``2512/2``)."""
+    return re.sub(rf"[^A-Za-z0-9._+\-{re.escape(keep)}]", "_", str(text))
 
 
 def component(text) -> str:
@@ -147,7 +153,7 @@ def component(text) -> str:
     leading dots go (no ``..``, no hidden file), and a name that had to change, or is long, gets a
     short hash of the original, so two values never share a folder."""
     text = str(text)
-    safe = _UNSAFE.sub("_", text).lstrip(".") or "_"
+    safe = safe_chars(text, "=").lstrip(".") or "_"
     if safe == text and len(safe) <= MAX_COMPONENT:
         return safe
     return f"{safe[:MAX_COMPONENT]}-{hashlib.sha1(text.encode()).hexdigest()[:8]}"

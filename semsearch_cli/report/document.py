@@ -96,12 +96,15 @@ class Document:
                 body.append(f"<pre>{e(b.text)}</pre>")
             elif b.kind == "table":
                 head, rows = cells(b.df, b.mark_rows, b.fmt)
-                t = ["<div class=scroll><table>", "<tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>"]
+                # words read from the left, numbers from the right: a column of words and its header align left
+                words = [all(r[k][0][:1].isalpha() or not r[k][0] for r in rows) for k in range(len(head))]
+                t = ["<div class=scroll><table>", "<tr>" + "".join(f"<th class=t>{e(h)}</th>" if w else f"<th>{e(h)}</th>"
+                                                                   for h, w in zip(head, words)) + "</tr>"]
                 for row in rows:
                     tds = []
                     for text, mark in row:
                         inner = e(text) if mark is None else f"<span class={mark}>{e(text)}</span>"
-                        tds.append(f"<td>{inner}</td>")
+                        tds.append(f"<td class=t>{inner}</td>" if text[:1].isalpha() else f"<td>{inner}</td>")
                     t.append("<tr>" + "".join(tds) + "</tr>")
                 body.append("\n".join(t + ["</table></div>"]))
             elif b.kind == "figure":
@@ -112,7 +115,7 @@ class Document:
                 body.append(f"<blockquote>{e(b.text)}</blockquote>")
         style = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.4}"
                  "table{border-collapse:collapse;font-size:12px;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 6px;"
-                 "text-align:right;white-space:nowrap}th{background:#f3f3f3}.scroll{overflow-x:auto;max-width:100%}"
+                 "text-align:right;white-space:nowrap}.t{text-align:left}th{background:#f3f3f3}.scroll{overflow-x:auto;max-width:100%}"
                  ".best{color:#1a7f37;font-weight:bold}.worst{color:#c62828;font-style:italic}img{max-width:100%}"
                  "figcaption{color:#555;font-size:13px}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap;"
                  "overflow-wrap:anywhere;font-size:12px}code{background:#f3f3f3;overflow-wrap:anywhere}"

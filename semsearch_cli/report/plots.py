@@ -786,7 +786,8 @@ def plot_success_by_scale(table, order: list, paper: dict, paper_scales, out: Pa
         ax.plot(d["view_scale"], 100 * d["success"], "o-", c=c, ms=3, lw=1.2, zorder=3)
         n = sorted(set(d["n"].astype(int)))
         ax.set_title(f"{m} (n={'/'.join(map(str, n))})", fontsize=8, color=c if c != "#000000" else "black")
-        ax.set_ylim(0, 100)
+        ax.set_ylim(-3, 104)  # room for the markers at 0 and 100%, which the frame would cut in half
+        ax.set_yticks([0, 25, 50, 75, 100])
         ax.grid(alpha=0.3, lw=0.5)
     for ax in axes.flat[len(order):]:
         ax.set_visible(False)

@@ -5,12 +5,12 @@ column: episode 0). The new stem is tried first, then the old one."""
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ..files import safe_chars
 from ..runner import file_stem
 from .stats import episodes
 
@@ -47,7 +47,7 @@ def load_paths(folder: Path, rows: pd.DataFrame) -> list[tuple[int, np.ndarray]]
 
 def safe_name(goal) -> str:
     """A goal as one file-name component (a KTH room's second door is ``2512/2``)."""
-    return re.sub(r"[^A-Za-z0-9._+\-]", "_", str(goal))
+    return safe_chars(goal)
 
 
 def median_label(rows: pd.DataFrame):

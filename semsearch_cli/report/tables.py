@@ -262,7 +262,10 @@ def cells(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> tup
             if isinstance(v, float) and pd.isna(v):
                 out.append(("", None))
                 continue
-            text = fmt.format(v) if isinstance(v, (float, int)) and not isinstance(v, bool) else str(v)
+            if isinstance(v, (int, np.integer)) and not isinstance(v, bool):
+                text = str(v)  # a count: no decimals
+            else:
+                text = fmt.format(v) if isinstance(v, float) else str(v)
             mark = "best" if lo is not None and nv == lo else "worst" if hi is not None and nv == hi and hi != lo else None
             out.append((text, mark))
         rows.append(out)

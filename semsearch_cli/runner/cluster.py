@@ -19,7 +19,7 @@ import dask
 from distributed import Client, LocalCluster, as_completed
 
 from ..errors import ScenarioError
-from .executors import Executor, execute
+from .executors import NO_PATH, Executor, execute
 from .specs import Loaded, RunSpec
 from .store import save_run_files
 
@@ -105,7 +105,7 @@ class DaskExecutor(Executor):
                 fut.release()
                 submit(1)
                 for stem, rows, res in done:
-                    if res.outcome not in ("error", "timeout"):
+                    if res.outcome not in NO_PATH:
                         save_run_files(out, stem, res)
                     yield rows
         except BaseException:

@@ -73,9 +73,12 @@ def wall_clock_limit(seconds: float):
         signal.signal(signal.SIGALRM, before)
 
 
+NO_PATH = ("error", "timeout")  # outcomes of runs that leave no path to save
+
+
 def _run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list[dict]:
     rows, res = execute(loaded, spec, trace)
-    if res.outcome not in ("error", "timeout"):
+    if res.outcome not in NO_PATH:
         save_run_files(out, spec.stem, res)
     return rows
 

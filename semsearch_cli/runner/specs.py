@@ -6,7 +6,6 @@ do not depend on the number of workers or the executor.
 
 from __future__ import annotations
 
-import re
 import hashlib
 import json
 from collections.abc import Sequence
@@ -14,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config import Scenario, load_scenario, parse_scenario
+from ..files import safe_chars
 from ..planners import Variant
 from ..tasks import Task, build_task
 from ..tasks.episodes import Episode
@@ -46,10 +46,7 @@ def file_stem(label: str, goal, seed=None, episode=None) -> str:
     whatever the planner label or goal holds (a KTH room's second door is the goal ``2512/2``)."""
     safe = label.replace("[", "_").replace("]", "").replace("=", "").replace(",", "_")
     stem = f"{safe}__goal{goal}" + (f"__ep{episode}" if episode is not None else "") + (f"__seed{seed}" if seed is not None else "")
-    return _UNSAFE.sub("_", stem)
-
-
-_UNSAFE = re.compile(r"[^A-Za-z0-9._+\-]")
+    return safe_chars(stem)
 
 
 @dataclass

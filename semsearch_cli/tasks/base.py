@@ -98,9 +98,12 @@ def checked_cell(planner: str, row, col, free: np.ndarray) -> tuple[int, int]:
     return r, c
 
 
-def checked_point(planner: str, x, y, frame) -> tuple[float, float]:
+def checked_point(planner: str, x, y, frame, heading=None) -> tuple[float, float]:
     """A planner's target point (m) after the checks every decision gets: finite numbers, on the
-    map; else a :class:`~semsearch_cli.errors.PlannerError` naming the planner and the value."""
+    map, and a finite ``heading`` when one is given; else a
+    :class:`~semsearch_cli.errors.PlannerError` naming the planner and the value."""
+    if heading is not None and not (isinstance(heading, (int, float, np.number)) and math.isfinite(heading)):
+        raise PlannerError(f"planner {planner!r} chose the heading {heading!r}: not a finite number")
     try:
         fx, fy = float(x), float(y)
     except (TypeError, ValueError):

@@ -28,7 +28,7 @@ from scipy import ndimage
 
 from ..belief.indirect import IndirectBelief, relation_mask
 from ..config.indirect import CATEGORIES
-from ..errors import PlannerError, ScenarioError
+from ..errors import ScenarioError
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
@@ -244,9 +244,7 @@ class IndirectSearch:
                               np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
                               self.task.cooccurrence)
         goal = self.planner.plan(ctx)
-        checked_point(self.planner.name, goal.x, goal.y, g.frame)
-        if goal.heading is not None and not math.isfinite(float(goal.heading)):
-            raise PlannerError(f"planner {self.planner.name!r} chose the heading {goal.heading!r}: not finite")
+        checked_point(self.planner.name, goal.x, goal.y, g.frame, goal.heading)
         if self.recorder is not None:
             self.recorder(st.belief.p, st.belief.p0, np.asarray(st.trail), st.steps * self.dt, goal, dict(self.seen))
         self.frames_since_plan = 0
@@ -366,8 +364,8 @@ class IndirectTask(Task):
         cells = math.ceil(w / spec.resolution) * math.ceil(h / spec.resolution)
         if cells > MAX_ROOM_CELLS:
             raise ScenarioError(task.file, "indirect.resolution", f"rooms of {w:g} x {h:g} m at {spec.resolution:g} m "
-                                f"cells are {cells:,} cells, more than the {MAX_ROOM_CELLS:,} a search holds in memory "
-                                "(about 150 bytes a cell); take coarser cells or smaller rooms")
+                                f"cells are {cells:,} cells, more than the {MAX_ROOM_CELLS:,} a search holds in memory"
+                                "; take coarser cells or smaller rooms")
         try:
             bodies = spec.camera.diameters if spec.objects_block else None
             task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius, bodies) for r in rooms]
