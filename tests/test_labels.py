@@ -63,3 +63,21 @@ def test_a_floor_of_mixed_labels_is_searched_on_the_goals_prefix(demo_dir, tmp_p
     rows = relabelled(demo_dir, tmp_path, lambda n: f"K{n}" if n % 2 else f"{n}A", ["K303", "452A"], PLANNERS)
     assert (rows["outcome"] == "found").all(), rows[["planner", "goal", "outcome"]]
     assert set(rows["goal"].astype(str)) == {"K303", "452A"}
+
+
+def test_a_floor_labelled_k201_k202_24a_24b_is_searched_by_nsos(demo_dir, tmp_path):
+    """The demo floor's west doors labelled K101 ... K204 and its wings 24A-24D, 25A-25D, 26A-26D,
+    27A-27D (rooms beside one number): nsos and the draft planner find K202 and 24B in every run."""
+    rows = relabelled(demo_dir, tmp_path, lambda n: f"K{n}" if n < 300 else f"{24 + (n - 301) // 50}{'ABCD'[(n - 1) % 50]}",
+                      ["K202", "24B"], PLANNERS)
+    assert (rows["outcome"] == "found").all(), rows[["planner", "goal", "outcome"]]
+    assert sorted(set(rows["goal"].astype(str))) == ["24B", "K202"]
+
+
+def test_a_goal_written_as_text_finds_the_sign_its_csv_writes_as_a_number(demo_dir, tmp_path):
+    """``goals: ["303"]`` and the sign 303 of doors.csv are one label (config.base.sign_label): the
+    run finds it, where a text goal never matched a number read by the camera and searched to the
+    budget."""
+    rows = relabelled(demo_dir, tmp_path, lambda n: n, ["303"], [{"name": "nsos", "alpha": 0.9}])
+    assert (rows["outcome"] == "found").all(), rows[["planner", "goal", "outcome", "distance_m"]]
+    assert (rows["distance_m"] < 200).all()

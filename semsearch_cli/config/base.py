@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 # upper bounds shared by the sections (m): far beyond any building, short of an array that fills memory
 MAX_RANGE = 50.0  # a sensor's range
@@ -18,6 +18,22 @@ MAX_SEEDS = 1_000_000  # runs per goal and planner variant
 
 Coord = Annotated[float, Field(ge=-MAX_COORD, le=MAX_COORD)]
 Angle = Annotated[float, Field(ge=-3600.0, le=3600.0, description="degrees")]
+
+
+def sign_label(value):
+    """A sign's label in its one canonical form, wherever it was written: a whole number (``148``,
+    ``"148"`` in YAML or a CSV, ``148`` from a spreadsheet column of numbers) is an int, anything else
+    (``K202``, ``24D``, ``2.14``) stripped text. A goal is then matched to its sign however either
+    was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV."""
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, int):
+        return int(value)
+    text = str(value).strip()
+    return int(text) if text.lstrip("-").isdigit() else text
+
+
+Label = Annotated[Union[int, str], AfterValidator(sign_label)]
 
 
 class Strict(BaseModel):
@@ -51,7 +67,7 @@ class StartSpec(Strict):
 
 
 class DoorSpec(Strict):
-    number: Union[int, str]
+    number: Label
     x: Coord
     y: Coord
     facing: Angle = Field(description="degrees, the direction the sign faces")

@@ -8,13 +8,13 @@ from typing import Literal, Union
 
 from pydantic import Field, model_validator
 
-from .base import Strict
+from .base import Label, Strict
 
 NAME = r"^[A-Za-z0-9_\-]+$"
 
 
 class StageSpec(Strict):
-    door: Union[int, str] = Field(description="number of the door sign to find")
+    door: Label = Field(description="number of the door sign to find")
     object: str | None = Field(None, pattern=NAME, description="object class to find in the room behind the door")
     hour: float | None = Field(None, ge=0.0, lt=24.0, description="hour of the object request")
 

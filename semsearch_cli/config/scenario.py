@@ -19,7 +19,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import ScenarioError
 from ..files import read_user_text
-from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
+from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, Label, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
 from .chain import ChainSpec
 from .indirect import IndirectSpec
@@ -40,7 +40,7 @@ class Scenario(Strict):
     map: MapSpec | None = None
     start: StartSpec | None = None
     doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
-    goals: list[Union[int, str]] = Field(default_factory=list)
+    goals: list[Label] = Field(default_factory=list)
     objects: ObjectsSpec | None = None
     chains: list[ChainSpec] | None = Field(None, description="chained searches (thesis ch. 6)")
     indirect: IndirectSpec | None = Field(None, description="indirect search with secondary objects (Loncomilla et al. 2018)")

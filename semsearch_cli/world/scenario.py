@@ -58,13 +58,6 @@ class Signs:
         return [i for i, n in enumerate(self.number) if str(n) == key]
 
 
-def _as_label(v):
-    if isinstance(v, (int, np.integer)):
-        return int(v)
-    s = str(v).strip()
-    return int(s) if s.lstrip("-").isdigit() else s
-
-
 def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> list[DoorSpec]:
     """Door signs from a CSV (columns number,x,y,facing) or YAML list file."""
     rows: list[dict]
@@ -83,7 +76,7 @@ def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> li
         if not isinstance(row, dict):
             raise ScenarioError(str(path), f"row {i + 1}", f"expected a sign {{number, x, y, facing}}, got {row!r}")
         try:
-            out.append(DoorSpec(number=_as_label(row["number"]), x=float(row["x"]), y=float(row["y"]), facing=float(row["facing"])))
+            out.append(DoorSpec(number=row["number"], x=float(row["x"]), y=float(row["y"]), facing=float(row["facing"])))
         except (KeyError, ValueError, TypeError) as exc:
             raise ScenarioError(str(path), f"row {i + 1}", f"cannot read a door sign from {row!r}: {exc}") from None
     return out
