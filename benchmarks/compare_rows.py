@@ -1,10 +1,11 @@
 """Compare the rows of two results folders (or runs.csv files), all columns they share but wall time.
 
-    python benchmarks/compare_rows.py OLD NEW
+    python benchmarks/compare_rows.py OLD NEW [--code]
 
 Rows are matched by (planner, goal, seed, stage, map); prints the rows that differ and exits 1
 when any does (or when one side has a run the other lacks). Used to check that a change which
-should not move numbers does not.
+should not move numbers does not. The ``code`` column (the hash of the code that made a row)
+differs after any change to the simulator's files, so it is left out unless ``--code`` is given.
 """
 
 from __future__ import annotations
@@ -27,9 +28,9 @@ def load(p: str) -> pd.DataFrame:
     return df.drop(columns=["wall_s"]).set_index(KEY).sort_index()
 
 
-def main(a: str, b: str) -> int:
+def main(a: str, b: str, code: bool = False) -> int:
     old, new = load(a), load(b)
-    cols = [c for c in old.columns if c in new.columns]
+    cols = [c for c in old.columns if c in new.columns and (code or c != "code")]
     only_old = old.index.difference(new.index)
     only_new = new.index.difference(old.index)
     both = old.index.intersection(new.index)
@@ -43,4 +44,4 @@ def main(a: str, b: str) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(*sys.argv[1:3]))
+    sys.exit(main(*sys.argv[1:3], code="--code" in sys.argv[3:]))

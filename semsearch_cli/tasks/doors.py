@@ -115,6 +115,22 @@ class DoorSearch(DoorSensing):
         return self.turn(st, self.look_turns, np.pi / (self.look_turns + 1), self.views_needed) or found
 
     def plan(self, st):
+        prep = self.prepare(st)
+        if isinstance(prep, str):
+            return prep
+        ctx, cands = prep
+        for _ in range(MAX_RETRIES):
+            p, cands = self.attempt(st, ctx, cands, self.planner.choose(ctx, cands))
+            if p is not None:
+                return p
+            if cands is None:
+                break
+        return self.sweep(st, ctx)
+
+    def prepare(self, st):
+        """The first half of a re-plan: at a wall face the robot came to look at, look all round;
+        then the planner's context and the frontier candidates (after turning on the spot once
+        when there are none). Returns ``(ctx, cands)``, or ``"found"`` when looking saw the goal."""
         b, fr = st.belief, self.task.world.frame
         r, c = (int(v) for v in fr.to_index(st.x, st.y))
         if self.sweep_target is not None and max(abs(r - self.sweep_target[0]), abs(c - self.sweep_target[1])) <= 1:
@@ -136,19 +152,22 @@ class DoorSearch(DoorSensing):
             cands = b.candidates()
         ctx = PlanContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
                           explain=self.keep_trace or self.recorder is not None)
-        for _ in range(MAX_RETRIES):
-            dec = self.planner.choose(ctx, cands)
-            if dec is None:
-                break
-            checked_cell(self.planner.name, dec.row, dec.col, b.free)
-            p = self.go(st, ctx, cands, dec)
-            if p is not None:
-                return p
-            keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
-            if keep.all():
-                break
-            cands = cands.take(np.flatnonzero(keep))
-        return self.sweep(st, ctx)
+        return ctx, cands
+
+    def attempt(self, st, ctx, cands, dec):
+        """The second half: decision ``dec`` (None: nowhere to go) checked and planned.
+        Returns ``(waypoints, cands)`` when there is a path; ``(None, cands without the chosen
+        cell)`` to ask again; ``(None, None)`` to give up on the frontier (then :meth:`sweep`)."""
+        if dec is None:
+            return None, None
+        checked_cell(self.planner.name, dec.row, dec.col, st.belief.free)
+        p = self.go(st, ctx, cands, dec)
+        if p is not None:
+            return p, cands
+        keep = ~((cands.rows == dec.row) & (cands.cols == dec.col))
+        if keep.all():
+            return None, None
+        return None, cands.take(np.flatnonzero(keep))
 
     def sweep(self, st, ctx):
         """No frontier left (or none reachable): go to the nearest wall face no camera has looked

@@ -56,41 +56,86 @@ class Search(Protocol):
         episode when there is nowhere to go (``found`` when looking around saw the target)."""
 
 
-def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None) -> str:
-    """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
-    :meth:`Search.plan` returns when there is nowhere to go. ``move(st, px, py, i) -> (i, moved)``
-    replaces the default motion (``step`` metres along the path, the heading following it), e.g.
-    for a robot that turns at a finite rate; a step in which the pose does not change at all
-    counts towards ``stuck``."""
-    px = py = None
-    i = 0
-    since_plan = 0.0
-    stall = 0
-    while True:
-        found, event = search.sense(st)  # 1. sense
-        search.update(st)  # 2. belief
-        if found:  # 3. success
-            return "found"
-        if search.replan_due(px is None or i >= len(px), since_plan, event):  # 4. re-plan on events
-            plan = search.plan(st)
-            if isinstance(plan, str):
-                return plan
-            px, py = plan
-            i = 1
-            since_plan = 0.0
+class Stepper:
+    """One episode's step loop, stopped at each re-plan so that someone else may make the plan:
+    :func:`run_loop` makes it with the task's planner, a Gymnasium environment
+    (``semsearch_cli.envs``) with an agent's action. Both run this one loop.
+
+    :meth:`advance` runs steps until the episode ends (returns the outcome) or a re-plan is due
+    (returns None); :meth:`follow` then takes the plan (waypoints, or the outcome that ends the
+    episode) and finishes the step with the move. ``move(st, px, py, i) -> (i, moved)`` replaces
+    the default motion (``step`` metres along the path, the heading following it), e.g. for a
+    robot that turns at a finite rate; a step in which the pose does not change at all counts
+    towards ``stuck``.
+    """
+
+    def __init__(self, search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None):
+        self.search, self.st, self.step = search, st, step
+        self.max_distance, self.max_steps, self.move = max_distance, max_steps, move
+        self.px = self.py = None
+        self.i = 0
+        self.since_plan = 0.0
+        self.stall = 0
+        self.outcome: str | None = None
+        self._moving = False  # a plan was taken: the step's move comes next
+
+    def advance(self) -> str | None:
+        """Steps until an outcome (returned, also kept in ``outcome``) or a due re-plan (None)."""
+        search, st = self.search, self.st
+        while self.outcome is None:
+            if self._moving:
+                self._moving = False
+                if (out := self._move()) is not None:
+                    self.outcome = out
+                    break
+            found, event = search.sense(st)  # 1. sense
+            search.update(st)  # 2. belief
+            if found:  # 3. success
+                self.outcome = "found"
+                break
+            if search.replan_due(self.px is None or self.i >= len(self.px), self.since_plan, event):  # 4. re-plan
+                return None
+            self._moving = True
+        return self.outcome
+
+    def follow(self, plan) -> str | None:
+        """Take ``plan`` (waypoints ``(xs, ys)`` in m, or an outcome) and go on to the next re-plan
+        or the end, as :meth:`advance`."""
+        if isinstance(plan, str):
+            self.outcome = plan
+            return plan
+        self.px, self.py = plan
+        self.i = 1
+        self.since_plan = 0.0
+        self._moving = True
+        return self.advance()
+
+    def _move(self) -> str | None:
+        st = self.st
         h0 = st.heading
-        if move is None:  # 5. move
-            st.x, st.y, i, st.heading, moved = advance(px, py, i, st.x, st.y, st.heading, step)
+        if self.move is None:  # 5. move
+            st.x, st.y, self.i, st.heading, moved = advance(self.px, self.py, self.i, st.x, st.y, st.heading, self.step)
         else:
-            i, moved = move(st, px, py, i)
+            self.i, moved = self.move(st, self.px, self.py, self.i)
         st.distance += moved
-        since_plan += moved
+        self.since_plan += moved
         st.steps += 1
         st.trail.append((st.x, st.y))
         if not st.steps & 63:
             _alive(st)
-        stall = stall + 1 if moved < 1e-9 and st.heading == h0 else 0
-        if stall >= STALL_STEPS:  # 6. budget
+        self.stall = self.stall + 1 if moved < 1e-9 and st.heading == h0 else 0
+        if self.stall >= STALL_STEPS:  # 6. budget
             return "stuck"
-        if st.distance >= max_distance or st.steps >= max_steps:
+        if st.distance >= self.max_distance or st.steps >= self.max_steps:
             return "budget"
+        return None
+
+
+def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None) -> str:
+    """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
+    :meth:`Search.plan` returns when there is nowhere to go (see :class:`Stepper`)."""
+    s = Stepper(search, st, step, max_distance, max_steps, move)
+    out = s.advance()
+    while out is None:
+        out = s.follow(search.plan(st))
+    return out
