@@ -35,8 +35,8 @@ class RobotState:
     x, y : float, m; heading : float, rad; belief : the map and sign reads built so far (door
     search), or None; clock : float, hour of day, or None; distance : float, m travelled so far;
     steps : int; trail : list of (x, y) m, every pose so far; headings : list of rad, the heading
-    at every pose (the robot-orientation histogram of nsos); read_signs : indices of the signs
-    read at least once.
+    at every pose (the robot-orientation histogram of nsos); read_signs : sign index -> its label
+    as last read, for every sign read at least once.
     """
 
     x: float
@@ -48,7 +48,7 @@ class RobotState:
     steps: int = 0
     trail: list = field(default_factory=list)
     headings: list = field(default_factory=list)
-    read_signs: set = field(default_factory=set)
+    read_signs: dict = field(default_factory=dict)
 
 
 @dataclass

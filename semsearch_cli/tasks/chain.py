@@ -209,7 +209,7 @@ class ChainTask(Task):
                 # left: to this stage's door and on to its object (when its door was not read), or
                 # to its object (the door read, the search in the room failed); then the legs after it
                 rest = float(sum(legs[used:]))
-                if st.read_signs.isdisjoint(self.world.signs.indices_of(s.door)):
+                if st.read_signs.keys().isdisjoint(self.world.signs.indices_of(s.door)):
                     left = self.doors.distance_left(s.door, st.x, st.y) + (legs[used - 1] if s.cls is not None else 0.0)
                 else:
                     r, c = self.world.frame.to_index(st.x, st.y)

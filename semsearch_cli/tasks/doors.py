@@ -45,7 +45,7 @@ class DoorSensing:
         b.views.append((v, u, st.heading))
         found = event = False
         for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
-            st.read_signs.add(i)
+            st.read_signs[i] = label
             if i in self.goal_idx and label == self.goal:
                 found = True
             if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:

@@ -1,0 +1,132 @@
+"""Steps per second of the Gymnasium environments, with Minigrid (and IR-SIM, when installed) timed
+beside them in the same run.
+
+    pip install 'semsearch[gym]' minigrid     # irsim-x too, for its column
+    python benchmarks/bench_env.py [--steps 20000] [--repeat 5] [--out FILE.md]
+
+One process, random actions (``action_space.sample()``; macro actions drawn among the valid ones
+of ``info["action_mask"]``), no rendering, environments made with ``gymnasium.make`` as a user would
+(so the order and checker wrappers are timed too), resets counted in. Each figure is the median of
+``--repeat`` timed runs of ``--steps`` steps; the ratios are against Minigrid's FourRooms in the
+same run, since this machine's speed varies from day to day.
+
+- semsearch primitive: ``semsearch/DoorSearch-v0`` on configs/hotel.yaml in the primitive mode
+  (laser into HIMM, door cameras, visited kernel and the observation at every step);
+- semsearch macro: the same in the macro mode (a step is a re-plan: about a metre of travel, the
+  skeleton and candidates refreshed);
+- Minigrid: ``MiniGrid-FourRooms-v0``;
+- IR-SIM (``pip install irsim-x``): a differential robot with a 181-beam, 10 m lidar on the Hotel
+  map, ``env.step()`` with a random velocity.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+import semsearch_cli.envs  # noqa: E402,F401  (registers the environments)
+
+
+def timed(env, steps: int, masked: bool, seed: int) -> float:
+    """Steps per second of ``steps`` random steps (resets included)."""
+    rng = np.random.default_rng(seed)
+    _, info = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        if masked:
+            a = int(rng.choice(np.flatnonzero(info["action_mask"])))
+        else:
+            a = env.action_space.sample()
+        _, _, term, trunc, info = env.step(a)
+        if term or trunc:
+            _, info = env.reset()
+    return steps / (time.perf_counter() - t0)
+
+
+def irsim_env(work: Path):
+    """An IR-SIM world on the Hotel map: one differential robot with a 181-beam, 10 m lidar; None
+    when irsim is not installed."""
+    try:
+        import irsim
+    except ImportError:
+        return None
+    (work / "hotel.yaml").write_text(f"""world:
+  height: 100
+  width: 100
+  step_time: 0.1
+  obstacle_map: {ROOT / 'maps/hotel/map.png'}
+  mdownsample: 1
+robot:
+  - kinematics: {{name: diff}}
+    shape: {{name: circle, radius: 0.2}}
+    state: [44.6, 64.0, 0]
+    behavior: {{name: dash}}
+    sensors:
+      - name: lidar2d
+        range_min: 0
+        range_max: 10
+        angle_range: 3.14159
+        number: 181
+""")
+    return irsim.make(str(work / "hotel.yaml"), display=False)
+
+
+def timed_irsim(env, steps: int) -> float:
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        env.step()
+    return steps / (time.perf_counter() - t0)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=20000)
+    ap.add_argument("--macro-steps", type=int, default=2000)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--out", type=Path, default=None)
+    a = ap.parse_args()
+    hotel = str(ROOT / "configs/hotel.yaml")
+    cases = {"semsearch primitive (hotel)": (lambda: gym.make("semsearch/DoorSearch-v0", scenario=hotel, action_mode="primitive"), a.steps, False),
+             "semsearch macro (hotel)": (lambda: gym.make("semsearch/DoorSearch-v0", scenario=hotel), a.macro_steps, True)}
+    try:
+        import minigrid  # noqa: F401
+        cases["Minigrid FourRooms"] = (lambda: gym.make("MiniGrid-FourRooms-v0"), a.steps, False)
+    except ImportError:
+        print("minigrid is not installed (pip install minigrid): its column is left out", file=sys.stderr)
+    rates: dict[str, list[float]] = {k: [] for k in cases}
+    envs = {k: make() for k, (make, _, _) in cases.items()}
+    with tempfile.TemporaryDirectory() as tmp:
+        ir = irsim_env(Path(tmp))
+        if ir is not None:
+            rates["IR-SIM (irsim-x), 181-beam lidar (hotel)"] = []
+        for r in range(a.repeat):  # interleaved, so that a slow spell of the machine hits every column
+            for k, (_, steps, masked) in cases.items():
+                rates[k].append(timed(envs[k], steps, masked, seed=r))
+            if ir is not None:
+                rates["IR-SIM (irsim-x), 181-beam lidar (hotel)"].append(timed_irsim(ir, a.steps // 4))
+    base = statistics.median(rates["Minigrid FourRooms"]) if "Minigrid FourRooms" in rates else None
+    lines = [f"steps per second, median of {a.repeat} runs (one process, random actions, no rendering)", "",
+             "| environment | steps/s | min | max | ratio to Minigrid FourRooms |", "|---|---|---|---|---|"]
+    for k, v in rates.items():
+        med = statistics.median(v)
+        ratio = f"{med / base:.2f}" if base else ""
+        lines.append(f"| {k} | {med:,.0f} | {min(v):,.0f} | {max(v):,.0f} | {ratio} |")
+    text = "\n".join(lines)
+    print(text)
+    if a.out:
+        a.out.write_text(text + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,49 @@
+"""Gymnasium environments over semsearch's scenarios (``pip install 'semsearch[gym]'``).
+
+Importing this package registers, under the ``semsearch/`` namespace:
+
+- ``semsearch/DoorSearch-v0`` (any door scenario: ``scenario="configs/hotel.yaml"``), and the
+  shipped buildings ``DoorSearch-Hotel-v0``, ``-Normal-v0``, ``-Inverse-v0``, ``-KTH-v0``;
+- ``semsearch/DoorSearch-Generated-v0``: a building generated at each reset from ``layout`` and
+  ``numbering`` (``semsearch generate building``), one of ``buildings`` seeds;
+- ``semsearch/ObjectSearch-v0`` (``ObjectSearch-Office-v0``) and ``semsearch/IndirectSearch-v0``
+  (``IndirectSearch-Quick-v0``).
+
+See docs/environments.md for the spaces, the reward and the equivalence with ``semsearch run``.
+"""
+
+from __future__ import annotations
+
+from gymnasium.envs.registration import register, registry
+
+from .doors import DoorSearchEnv
+from .generated import GeneratedDoorSearchEnv
+from .indirect import IndirectSearchEnv
+from .objects import ObjectSearchEnv
+from .policies import PlannerPolicy
+
+SHIPPED = {"DoorSearch-Hotel-v0": ("doors", "hotel"), "DoorSearch-Normal-v0": ("doors", "normal"),
+           "DoorSearch-Inverse-v0": ("doors", "inverse"), "DoorSearch-KTH-v0": ("doors", "kth"),
+           "ObjectSearch-Office-v0": ("objects", "office"), "IndirectSearch-Quick-v0": ("indirect", "indirect_quick")}
+ENTRY = {"doors": "semsearch_cli.envs.doors:DoorSearchEnv", "objects": "semsearch_cli.envs.objects:ObjectSearchEnv",
+         "indirect": "semsearch_cli.envs.indirect:IndirectSearchEnv"}
+
+
+def register_envs() -> list[str]:
+    """Register every environment id (once); returns the ids."""
+    ids = {"semsearch/DoorSearch-v0": (ENTRY["doors"], {}),
+           "semsearch/ObjectSearch-v0": (ENTRY["objects"], {}),
+           "semsearch/IndirectSearch-v0": (ENTRY["indirect"], {}),
+           "semsearch/DoorSearch-Generated-v0": ("semsearch_cli.envs.generated:GeneratedDoorSearchEnv", {})}
+    for name, (kind, config) in SHIPPED.items():
+        ids[f"semsearch/{name}"] = (ENTRY[kind], {"scenario": f"shipped:{config}"})
+    for env_id, (entry, kwargs) in ids.items():
+        if env_id not in registry:
+            register(id=env_id, entry_point=entry, kwargs=kwargs)
+    return list(ids)
+
+
+ENV_IDS = register_envs()
+
+__all__ = ["DoorSearchEnv", "ENV_IDS", "GeneratedDoorSearchEnv", "IndirectSearchEnv", "ObjectSearchEnv", "PlannerPolicy",
+           "register_envs"]

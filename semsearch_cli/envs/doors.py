@@ -1,0 +1,304 @@
+"""``semsearch/DoorSearch-v0``: find the door sign with the goal's label, one decision at a time.
+
+The environment is the batch's door search (:class:`~semsearch_cli.tasks.doors.DoorSearch` in
+the :class:`~semsearch_cli.tasks.loop.Stepper` loop); the agent takes the planner's place.
+
+Action modes
+------------
+``macro`` (default): ``Discrete(K + 1)``. At each re-plan of the batch (the path used up, every
+``navigation.replan_every`` metres, and, with ``replan_on_signs``, when a sign reaches
+``belief.min_reads``) the agent chooses one of the belief's frontier candidates, slots ``0..K-1``
+(``info["action_mask"]``, also :meth:`action_masks` for sb3-contrib's MaskablePPO); the navigator
+drives there until the next re-plan. Action ``K`` looks at the nearest wall face no camera has read
+yet (the batch's completeness sweep, what it does when a planner returns None); an action naming an
+empty slot is taken as ``K``. When a chosen candidate has no path the agent is asked again at once
+(no distance travelled), with that candidate removed, as a planner is. Re-plans that find no
+candidate are not shown to the agent: the robot turns on the spot or sweeps, as in the batch.
+
+``primitive``: ``Discrete(10)``. Actions 0-7 move ``robot.step`` metres towards east, north-east,
+north, ..., south-east (the heading turns to that direction; a move into a cell the robot's disk does
+not fit in leaves it where it is); 8 and 9 turn 45 degrees left and right on the spot. The robot
+senses after every action.
+
+Observation (``observation_mode="dict"``)
+-----------------------------------------
+- ``occupancy``: uint8 (2R+1, 2R+1), the belief's map around the robot (row 0 north, the robot at
+  the centre): 0 unknown (or off the map), 1 free, 2 occupied. R = ``window`` cells.
+- ``explored``: uint8 (2R+1, 2R+1), 1 where the robot's visited kernel has passed.
+- ``candidates`` (macro): uint8 (2R+1, 2R+1), k + 1 at the cell of candidate slot k, else 0.
+- ``targets`` (macro): float32 (K, 4), per slot: [1 if the slot holds a candidate, dx, dy (m, from
+  the robot, world axes), the branch direction theta_f (rad)].
+- ``signs``: float32 (S, 6), the signs read so far, nearest first: [1, 1 if its label shares the
+  goal's prefix, its number (-1 for a label without digits), dx, dy (m), facing (rad)].
+- ``goal``: float32 (2,): [the goal's number, 1 if it has a prefix or suffix (K202, 24D)].
+- ``pose``: float32 (3,): x, y (m), heading (rad).
+
+``observation_mode="text"`` renders the same as a short text (a ``Text`` space) for language-model
+agents. ``render_mode="rgb_array"`` draws the belief and the path (north up).
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import gymnasium as gym
+import numpy as np
+
+from ..geometry import wrap_angle
+from ..planners import Decision
+from ..tasks.doors import MAX_RETRIES, DoorSearch
+from ..tasks.loop import Stepper
+from ..world.labels import parse_label
+from .base import BIG, SearchEnv, box, clip_text, text_space, window
+
+DIRECTIONS = ("east", "north-east", "north", "north-west", "west", "south-west", "south", "south-east")
+
+
+class _Agent:
+    """Stands in the planner's place inside :class:`DoorSearch`: names the agent in the checks
+    and sets the re-plan cadence; its choices come through :meth:`DoorSearchEnv.step`."""
+
+    name = "agent"
+
+    def __init__(self, replan_on_signs: bool):
+        self.replan_on_signs = replan_on_signs
+
+    def choose(self, ctx, cands):  # pragma: no cover - the environment never lets DoorSearch call it
+        raise RuntimeError("the agent chooses through step()")
+
+
+class DoorSearchEnv(SearchEnv):
+    """Door-sign search over a door scenario (see the module docstring for the spaces)."""
+
+    kind = "doors"
+
+    def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
+                 success_bonus: float = 100.0, window: int = 32, max_candidates: int = 32, max_signs: int = 32,
+                 replan_on_signs: bool = True):
+        super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
+        self._init_args.update(window=window, max_candidates=max_candidates, max_signs=max_signs,
+                               replan_on_signs=replan_on_signs)
+        if not 1 <= max_candidates <= 254:
+            raise ValueError("max_candidates must lie in 1..254")
+        self.R, self.K, self.S = int(window), int(max_candidates), int(max_signs)
+        self.replan_on_signs = bool(replan_on_signs)
+        sc, w = self.task.sc, self.task.world
+        self.step_m = sc.robot.step
+        self.sweep_action = self.K
+        n = 2 * self.R + 1
+        grid = gym.spaces.Box(0, 2, (n, n), np.uint8)
+        spaces = {"occupancy": grid, "explored": gym.spaces.Box(0, 1, (n, n), np.uint8),
+                  "signs": box([0, 0, -1, -BIG, -BIG, -np.pi], [1, 1, BIG, BIG, BIG, np.pi], (self.S, 6)),
+                  "goal": box([-1, 0], [BIG, 1]),
+                  "pose": box([-BIG, -BIG, -np.pi], [BIG, BIG, np.pi])}
+        if action_mode == "macro":
+            spaces["candidates"] = gym.spaces.Box(0, self.K, (n, n), np.uint8)
+            spaces["targets"] = box([0, -BIG, -BIG, -np.pi], [1, BIG, BIG, np.pi], (self.K, 4))
+            self.action_space = gym.spaces.Discrete(self.K + 1)
+        else:
+            self.action_space = gym.spaces.Discrete(10)
+        self.observation_space = gym.spaces.Dict(spaces) if observation_mode == "dict" else text_space()
+        self._buf = {k: np.zeros(s.shape, s.dtype) for k, s in spaces.items()}
+        self._cspace = w.cspace
+        self.decision = None  # (PlanContext, Candidates) while the agent is to choose (macro)
+
+    # ---- episode ----------------------------------------------------------------------
+    def _begin(self) -> None:
+        t, ep = self.task, self.episode
+        self.state = st = t.start_state(ep, self.rng)
+        st.belief = t.new_belief()
+        self.search = DoorSearch(t, _Agent(self.replan_on_signs), ep.goal, self.rng, False, None)
+        self.goal_label = parse_label(ep.goal)
+        self.decision = None
+        if self.action_mode == "macro":
+            self.stepper = Stepper(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
+            self.outcome = self._to_decision(self.stepper.advance())
+        else:
+            found, _ = self.search.sense(st)
+            self.search.update(st)
+            self.outcome = "found" if found else None
+
+    def _to_decision(self, out):
+        """Run the loop from a re-plan to the next one the agent makes (candidates to choose from),
+        or to the end; returns the outcome or None."""
+        st, search = self.state, self.search
+        while out is None:
+            prep = search.prepare(st)
+            if isinstance(prep, str):
+                out = self.stepper.follow(prep)
+                continue
+            ctx, cands = prep
+            if len(cands) == 0:
+                out = self.stepper.follow(search.sweep(st, ctx))
+                continue
+            self.decision, self._tries = (ctx, cands), 0
+            return None
+        self.decision = None
+        return out
+
+    def _act(self, action):
+        st = self.state
+        d0 = st.distance
+        a = int(action)
+        if self.action_mode == "primitive":
+            return self._primitive(a), self._primitive_outcome()
+        ctx, cands = self.decision
+        if not 0 <= a < min(len(cands), self.K):
+            out = self.stepper.follow(self.search.sweep(st, ctx))
+        else:
+            p, left = self.search.attempt(st, ctx, cands, Decision(int(cands.rows[a]), int(cands.cols[a])))
+            self._tries += 1
+            if p is not None:
+                out = self.stepper.follow(p)
+            elif left is not None and self._tries < MAX_RETRIES:
+                self.decision = (ctx, left)  # ask again, that candidate removed
+                return 0.0, None
+            else:
+                out = self.stepper.follow(self.search.sweep(st, ctx))
+        out = self._to_decision(out)  # sweeps on the way travel too
+        return st.distance - d0, out
+
+    def _primitive(self, a: int) -> float:
+        st, fr = self.state, self.task.world.frame
+        moved = 0.0
+        if a < 8:
+            ang = a * math.pi / 4
+            x, y = st.x + self.step_m * math.cos(ang), st.y + self.step_m * math.sin(ang)
+            _, _, r, c = fr.point_to_cell(x, y)
+            st.heading = float(wrap_angle(ang))
+            if 0 <= r < fr.height and 0 <= c < fr.width and self._cspace[r, c]:
+                st.x, st.y, moved = x, y, self.step_m
+        else:
+            st.heading = float(wrap_angle(st.heading + (math.pi / 4 if a == 8 else -math.pi / 4)))
+        st.distance += moved
+        st.steps += 1
+        st.trail.append((st.x, st.y))
+        self._found, _ = self.search.sense(st)
+        self.search.update(st)
+        return moved
+
+    def _primitive_outcome(self):
+        st, e = self.state, self.task.sc.experiment
+        if self._found:
+            return "found"
+        if st.distance >= e.max_distance or st.steps >= self.task.max_steps():
+            return "budget"
+        return None
+
+    # ---- what the agent sees ----------------------------------------------------------
+    def action_masks(self) -> np.ndarray:
+        """(action_space.n,) bool: the actions that name something (macro: the filled candidate
+        slots and the sweep; primitive: every action)."""
+        if self.action_mode == "primitive":
+            return np.ones(10, bool)
+        m = np.zeros(self.K + 1, bool)
+        m[self.K] = True
+        if self.decision is not None:
+            m[:min(len(self.decision[1]), self.K)] = True
+        return m
+
+    def _info(self) -> dict:
+        info = super()._info()
+        info["action_mask"] = self.action_masks()
+        info["n_candidates"] = 0 if self.decision is None else len(self.decision[1])
+        return info
+
+    def _signs(self):
+        """(index, label, dx, dy, facing) of the signs read so far, nearest first."""
+        st, sg = self.state, self.task.world.signs
+        out = [(i, lab, float(sg.x[i]) - st.x, float(sg.y[i]) - st.y, float(wrap_angle(sg.facing[i])))
+               for i, lab in st.read_signs.items()]
+        out.sort(key=lambda s: s[2] * s[2] + s[3] * s[3])
+        return out
+
+    def _observe(self):
+        if self.observation_mode == "text":
+            return self._text()
+        st, b, fr, buf = self.state, self.state.belief, self.task.world.frame, self._buf
+        _, _, r, c = fr.point_to_cell(st.x, st.y)
+        occ = buf["occupancy"]
+        occ.fill(0)
+        window(b.seen, r, c, self.R, occ)
+        free = np.zeros_like(occ)
+        window(b.free, r, c, self.R, free)
+        occ[(occ > 0) & (free == 0)] = 2
+        buf["explored"].fill(0)
+        window(b.visited, r, c, self.R, buf["explored"])
+        sg = buf["signs"]
+        sg.fill(0.0)
+        for k, (_, lab, dx, dy, facing) in enumerate(self._signs()[:self.S]):
+            p = parse_label(lab)
+            same = p is not None and self.goal_label is not None and p.prefix == self.goal_label.prefix
+            sg[k] = (1.0, float(same), -1.0 if p is None else min(p.number, BIG), dx, dy, facing)
+        g = self.goal_label
+        buf["goal"][:] = (-1.0, 0.0) if g is None else (min(g.number, BIG), float(bool(g.prefix or g.suffix)))
+        buf["pose"][:] = (st.x, st.y, st.heading)
+        obs = {k: buf[k].copy() for k in ("occupancy", "explored", "signs", "goal", "pose")}
+        if self.action_mode == "macro":
+            cm, tg = buf["candidates"], buf["targets"]
+            cm.fill(0)
+            tg.fill(0.0)
+            if self.decision is not None:
+                cands = self.decision[1]
+                n = min(len(cands), self.K)
+                xs, ys = fr.to_world(cands.rows[:n], cands.cols[:n])
+                tg[:n, 0] = 1.0
+                tg[:n, 1] = xs - st.x
+                tg[:n, 2] = ys - st.y
+                tg[:n, 3] = cands.theta[:n]
+                rr, cc = cands.rows[:n] - r + self.R, cands.cols[:n] - c + self.R
+                ok = (rr >= 0) & (rr < cm.shape[0]) & (cc >= 0) & (cc < cm.shape[1])
+                cm[rr[ok], cc[ok]] = (np.arange(n) + 1)[ok]
+            obs["candidates"], obs["targets"] = cm.copy(), tg.copy()
+        return obs
+
+    def _text(self) -> str:
+        st = self.state
+        lines = [f"Goal: read the door sign {self.episode.goal}.",
+                 f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {math.degrees(st.heading):.0f} deg "
+                 f"(0 east, 90 north); travelled {st.distance:.1f} m."]
+        signs = self._signs()[:self.S]
+        if signs:
+            lines.append("Signs read, nearest first: " + "; ".join(
+                f"{lab} at {math.hypot(dx, dy):.1f} m bearing {math.degrees(math.atan2(dy, dx)):.0f} deg, facing "
+                f"{math.degrees(f):.0f} deg" for _, lab, dx, dy, f in signs) + ".")
+        else:
+            lines.append("No sign read yet.")
+        if self.action_mode == "macro":
+            if self.decision is not None:
+                cands = self.decision[1]
+                n = min(len(cands), self.K)
+                xs, ys = self.task.world.frame.to_world(cands.rows[:n], cands.cols[:n])
+                lines.append("Frontier targets: " + "; ".join(
+                    f"[{k}] {math.hypot(x - st.x, y - st.y):.1f} m bearing {math.degrees(math.atan2(y - st.y, x - st.x)):.0f} deg, "
+                    f"leading {math.degrees(t):.0f} deg" for k, (x, y, t) in enumerate(zip(xs, ys, cands.theta[:n]))) + ".")
+            lines.append(f"Answer with a target's number, or {self.K} to look at the nearest wall not yet read.")
+        else:
+            lines.append("Answer with 0-7 to move 0.1 m " + ", ".join(f"{k} {d}" for k, d in enumerate(DIRECTIONS))
+                         + "; 8 to turn left, 9 to turn right (45 deg).")
+        return clip_text("\n".join(lines))
+
+    def render(self):
+        if self.render_mode != "rgb_array" or self.episode is None:
+            return None
+        st, b, fr = self.state, self.state.belief, self.task.world.frame
+        img = np.full((fr.height, fr.width, 3), 128, np.uint8)
+        img[b.seen & b.free] = (255, 255, 255)
+        img[b.seen & ~b.free] = (0, 0, 0)
+        img[b.visited & b.free] = (200, 225, 255)
+        trail = np.asarray(st.trail)
+        rr, cc = fr.to_index(trail[:, 0], trail[:, 1])
+        pts = np.stack([cc, rr], axis=1).astype(np.int32).reshape(-1, 1, 2)
+        cv2.polylines(img, [pts], False, (220, 40, 40), 1)
+        if self.decision is not None:
+            cands = self.decision[1]
+            for rc, cc_ in zip(cands.rows[:self.K], cands.cols[:self.K]):
+                cv2.circle(img, (int(cc_), int(rc)), 3, (240, 150, 0), -1)
+        sg = self.task.world.signs
+        for i in st.read_signs:
+            r, c = fr.to_index(sg.x[i], sg.y[i])
+            cv2.circle(img, (int(c), int(r)), 2, (0, 160, 0), -1)
+        r, c = fr.to_index(st.x, st.y)
+        cv2.circle(img, (int(c), int(r)), 4, (200, 0, 200), -1)
+        return img

@@ -1,0 +1,211 @@
+"""``semsearch/IndirectSearch-v0``: find the target object (the monitor, A) in a room, helped by
+the secondary objects, within the time limit.
+
+The environment is the batch's indirect search (:class:`~semsearch_cli.tasks.indirect.IndirectSearch`
+in the :class:`~semsearch_cli.tasks.loop.Stepper` loop, one step a camera frame); the agent names
+the poses, as a planner's goals. An episode is a room, a start and a view scale of the scenario.
+
+The robot's map of A is built as the methods of the paper build theirs: ``masks`` ``"soft"``
+(default), ``"hard"`` or None (A's non-detections only), and ``negative`` (default True: the
+secondary objects' non-detections count too), as ISC-PN-SM does.
+
+Action modes
+------------
+``macro`` (default): ``Discrete(N x 8)``: a pose of a lattice every ``lattice`` metres over the
+room (row-major from the room's origin) and one of 8 headings (0, 45, ..., 315 degrees); the robot
+turns, drives at its speed and turns to the heading, sensing every frame, until the next re-plan
+(``indirect.replan_every`` seconds, the pose reached, or a detection). ``info["action_mask"]``
+holds the lattice points the robot can stand on in this room; another is taken as the nearest
+that it can.
+
+``primitive``: ``Discrete(4)``: 0 drive forward one frame at the robot's speed (where the robot fits),
+1 and 2 turn left and right one frame at its turn rate, 3 wait a frame.
+
+Observation (``observation_mode="dict"``)
+-----------------------------------------
+- ``belief``: float32 (H, W), the robot's p(A) on the room's grid (row 0 north);
+- ``secondary``: float32 (n, 3), per secondary class in ``indirect.secondary`` order: [1 if
+  detected so far, dx, dy (m, from the robot)];
+- ``pose``: float32 (3,): x, y (m, room coordinates), heading (rad);
+- ``time``: float32 (2,): seconds elapsed, the view scale (m).
+
+``observation_mode="text"`` renders the same as a short text (the five likeliest cells of A);
+``render_mode="rgb_array"`` draws the belief, the objects detected and the path.
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import gymnasium as gym
+import numpy as np
+
+from ..geometry import wrap_angle
+from ..planners import Goal
+from ..tasks.indirect import IndirectSearch
+from ..tasks.loop import Stepper
+from .base import BIG, SearchEnv, box, clip_text, text_space
+
+HEADINGS = np.radians(np.arange(0, 360, 45))
+
+
+class _Agent:
+    """Stands in the planner's place inside :class:`IndirectSearch`: the map's kind, and the
+    goal the agent chose (through :meth:`IndirectSearchEnv.step`)."""
+
+    name = "agent"
+    uses_map = True
+    replan_on_detection = True
+
+    def __init__(self, masks, negative: bool):
+        self.masks, self.negative = masks, negative
+        self.goal: Goal | None = None
+
+    def plan(self, ctx) -> Goal:
+        return self.goal
+
+
+class IndirectSearchEnv(SearchEnv):
+    """Indirect search over an indirect scenario (see the module docstring for the spaces)."""
+
+    kind = "indirect"
+
+    def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
+                 success_bonus: float = 100.0, masks: str | None = "soft", negative: bool = True, lattice: float = 0.5):
+        super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
+        if masks not in ("soft", "hard", None):
+            raise ValueError(f"masks must be 'soft', 'hard' or None, not {masks!r}")
+        if not 0.05 <= lattice <= 5.0:
+            raise ValueError("lattice must lie in 0.05..5 m")
+        self._init_args.update(masks=masks, negative=negative, lattice=lattice)
+        t = self.task
+        self.masks, self.negative = masks, bool(negative) and masks is not None
+        self.secondary = list(t.spec.secondary)
+        w, h = t.grids[0].room.size
+        self.lx = np.arange(lattice / 2, w, lattice)
+        self.ly = np.arange(lattice / 2, h, lattice)
+        self.N = len(self.lx) * len(self.ly)
+        H, W = t.grids[0].stand.shape
+        spaces = {"belief": gym.spaces.Box(0.0, 1.0, (H, W), np.float32),
+                  "secondary": box([0, -BIG, -BIG], [1, BIG, BIG], (len(self.secondary), 3)),
+                  "pose": box([-BIG, -BIG, -np.pi], [BIG, BIG, np.pi]),
+                  "time": box([0.0, 0.0], [BIG, BIG])}
+        self.action_space = gym.spaces.Discrete(self.N * 8 if action_mode == "macro" else 4)
+        self.observation_space = gym.spaces.Dict(spaces) if observation_mode == "dict" else text_space()
+
+    def _begin(self) -> None:
+        t, ep = self.task, self.episode
+        self.grid = t.grids[ep.room]
+        self.agent = _Agent(self.masks, self.negative)
+        self.search = IndirectSearch(t, self.grid, self.agent, float(ep.goal), self.rng, False)
+        self.state = st = t.start_state(ep, self.rng)
+        st.belief = self.search.new_belief()
+        self.max_steps = int(round(t.spec.time_limit * t.spec.camera.fps))
+        gx, gy = np.meshgrid(self.lx, self.ly)
+        r, c = self.grid.frame.to_index(gx.ravel(), gy.ravel())
+        H, W = self.grid.stand.shape
+        ok = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+        self.standable = np.zeros(self.N, bool)
+        self.standable[ok] = self.grid.stand[r[ok], c[ok]]
+        self.points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        if self.action_mode == "macro":
+            self.stepper = Stepper(self.search, st, 0.0, math.inf, self.max_steps, move=self.search.move)
+            self.outcome = self.stepper.advance()
+        else:
+            found, _ = self.search.sense(st)
+            self.search.update(st)
+            self.outcome = "found" if found else None
+
+    def _act(self, action):
+        st = self.state
+        d0 = st.distance
+        a = int(action)
+        if self.action_mode == "primitive":
+            spec = self.task.spec
+            dt = 1.0 / spec.camera.fps
+            if a == 0:
+                x, y = st.x + spec.robot.speed * dt * math.cos(st.heading), st.y + spec.robot.speed * dt * math.sin(st.heading)
+                r, c = self.grid.frame.to_index(x, y)
+                H, W = self.grid.stand.shape
+                if 0 <= r < H and 0 <= c < W and self.grid.stand[r, c]:
+                    st.distance += math.hypot(x - st.x, y - st.y)
+                    st.x, st.y = float(x), float(y)
+            elif a in (1, 2):
+                st.heading = float(wrap_angle(st.heading + (1 if a == 1 else -1) * math.radians(spec.robot.turn_rate) * dt))
+            st.steps += 1
+            st.trail.append((st.x, st.y))
+            found, _ = self.search.sense(st)
+            self.search.update(st)
+            return st.distance - d0, "found" if found else "budget" if st.steps >= self.max_steps else None
+        k, h = divmod(a, 8)
+        if not self.standable[k]:  # the nearest lattice point the robot can stand on
+            d = np.hypot(*(self.points - self.points[k]).T)
+            d[~self.standable] = np.inf
+            k = int(np.argmin(d))
+        self.agent.goal = Goal(float(self.points[k, 0]), float(self.points[k, 1]), float(HEADINGS[h]), {"action": a})
+        out = self.stepper.follow(self.search.plan(st))
+        return st.distance - d0, out
+
+    def action_masks(self) -> np.ndarray:
+        if self.action_mode == "primitive":
+            return np.ones(4, bool)
+        return np.repeat(self.standable, 8)
+
+    def _info(self) -> dict:
+        return {**super()._info(), "action_mask": self.action_masks(), "room": self.grid.room.name}
+
+    def _belief(self) -> np.ndarray:
+        b = self.state.belief
+        b.flush()
+        return (b.p / max(float(b.p.sum()), 1e-300)).astype(np.float32)
+
+    def _secondary(self) -> np.ndarray:
+        st = self.state
+        out = np.zeros((len(self.secondary), 3), np.float32)
+        for k, cls in enumerate(self.secondary):
+            if cls in self.search.seen:
+                x, y = self.search.seen[cls]
+                out[k] = (1.0, x - st.x, y - st.y)
+        return out
+
+    def _observe(self):
+        st = self.state
+        t_s = st.steps / self.task.spec.camera.fps
+        if self.observation_mode == "text":
+            p = self._belief()
+            top = np.argsort(p.ravel())[::-1][:5]
+            xs, ys = self.grid.frame.to_world(*np.unravel_index(top, p.shape))
+            sec = self._secondary()
+            lines = [f"Find the {self.task.spec.target} (view scale {float(self.episode.goal):g} m) in room "
+                     f"{self.grid.room.name}; {t_s:.1f} s of {self.task.spec.time_limit:g} s used.",
+                     f"You are at x {st.x:.2f} m, y {st.y:.2f} m, heading {math.degrees(st.heading):.0f} deg.",
+                     "Seen: " + ("; ".join(f"{cls} at dx {s[1]:.2f} m, dy {s[2]:.2f} m" for cls, s in zip(self.secondary, sec) if s[0])
+                                 or "nothing yet") + ".",
+                     "Likeliest cells: " + "; ".join(f"({x:.2f}, {y:.2f}) m p {p.ravel()[i]:.4f}" for x, y, i in zip(xs, ys, top)) + "."]
+            lines.append(f"Answer with 8 k + h: lattice point k of {self.N} (every {self.lx[0] * 2:g} m, row-major) and "
+                         "heading h x 45 deg." if self.action_mode == "macro" else
+                         "Answer 0 to drive forward, 1 to turn left, 2 to turn right, 3 to wait (one frame).")
+            return clip_text("\n".join(lines))
+        return {"belief": self._belief(), "secondary": self._secondary(),
+                "pose": np.array([st.x, st.y, st.heading], np.float32),
+                "time": np.array([t_s, float(self.episode.goal)], np.float32)}
+
+    def render(self):
+        if self.render_mode != "rgb_array" or self.episode is None:
+            return None
+        p = self._belief()
+        g = (255 * (1.0 - p / max(float(p.max()), 1e-12))).astype(np.uint8)
+        img = np.stack([g, g, np.full_like(g, 255)], axis=2)
+        img[self.grid.blocked] = 0
+        img = cv2.resize(img, None, fx=4, fy=4, interpolation=cv2.INTER_NEAREST)
+        fr, st = self.grid.frame, self.state
+        trail = np.asarray(st.trail)
+        rr, cc = fr.to_index(trail[:, 0], trail[:, 1])
+        cv2.polylines(img, [(np.stack([cc, rr], axis=1) * 4 + 2).astype(np.int32).reshape(-1, 1, 2)], False, (220, 40, 40), 1)
+        for cls, (x, y) in self.search.seen.items():
+            r, c = fr.to_index(x, y)
+            cv2.circle(img, (int(c) * 4 + 2, int(r) * 4 + 2), 5, (0, 160, 0), -1)
+        r, c = fr.to_index(st.x, st.y)
+        cv2.circle(img, (int(c) * 4 + 2, int(r) * 4 + 2), 6, (200, 0, 200), -1)
+        return img

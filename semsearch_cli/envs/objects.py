@@ -1,0 +1,187 @@
+"""``semsearch/ObjectSearch-v0``: answer an object request (a class at an hour) on the recorded map.
+
+The environment is the batch's object search (:class:`~semsearch_cli.tasks.objects.ObjectSearch`
+in the :class:`~semsearch_cli.tasks.loop.Stepper` loop); the agent names the places to visit, as
+an object planner does. An episode is one request of the scenario (``goal``: ``Static.mug@12``).
+
+Action modes
+------------
+``macro`` (default): ``Discrete(P)``, one action per place of ``objects.places`` (in the
+scenario's order): drive there on the recorded map, sensing at every step, and look around on
+arrival (three quarter turns), as the object planners' targets are driven. Every place is valid
+(``info["action_mask"]``).
+
+``primitive``: ``Discrete(10)``: 0-7 move ``robot.step`` m towards east, north-east, ..., south-east
+(a move into a cell the robot's disk does not fit in leaves it where it is), 8 and 9 turn 45 degrees;
+the object camera senses after every action.
+
+Observation (``observation_mode="dict"``)
+-----------------------------------------
+- ``places``: float32 (P, 5), per place: [dx, dy (m, from the robot), 1 if the camera has had it in
+  view in this search, detections of the requested class there in the recorded log, those within
+  an hour of the request's hour];
+- ``hour``: float32 (1,), the request's hour;
+- ``pose``: float32 (3,): x, y (m), heading (rad).
+
+``observation_mode="text"`` renders the same as a short text; ``render_mode="rgb_array"`` draws the
+map, the places (seen ones green) and the path.
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import gymnasium as gym
+import numpy as np
+
+from ..geometry import wrap_angle
+from ..planners import ObjectContext
+from ..sensors import PlaceCamera
+from ..tasks.loop import Stepper
+from ..tasks.objects import ObjectSearch
+from .base import BIG, SearchEnv, box, clip_text, text_space
+
+DIRECTIONS = ("east", "north-east", "north", "north-west", "west", "south-west", "south", "south-east")
+
+
+class _Feed:
+    """The targets iterator of :class:`ObjectSearch`: the place the agent chose, once."""
+
+    def __init__(self):
+        self.next = None
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        t, self.next = self.next, None
+        if t is None:
+            raise StopIteration
+        return t
+
+
+class ObjectSearchEnv(SearchEnv):
+    """Object search over an object scenario (see the module docstring for the spaces)."""
+
+    kind = "objects"
+
+    def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
+                 success_bonus: float = 100.0):
+        super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
+        t = self.task
+        self.names = list(t.places)
+        self.P = len(self.names)
+        self.step_m = t.sc.robot.step
+        spaces = {"places": box([-BIG, -BIG, 0, 0, 0], [BIG, BIG, 1, BIG, BIG], (self.P, 5)),
+                  "hour": box([0.0], [24.0]),
+                  "pose": box([-BIG, -BIG, -np.pi], [BIG, BIG, np.pi])}
+        self.action_space = gym.spaces.Discrete(self.P if action_mode == "macro" else 10)
+        self.observation_space = gym.spaces.Dict(spaces) if observation_mode == "dict" else text_space()
+        self._cspace = t.world.cspace
+
+    def _begin(self) -> None:
+        t, ep = self.task, self.episode
+        req = t.request(ep.goal)
+        self.request = req
+        self.state = st = t.start_state(ep, self.rng)
+        instances = t.request_instances(req)
+        camera = PlaceCamera(t.world, t.spec.camera, t.places, t.facing, instances)
+        log = t.logs[req.case]
+        self.ctx = ObjectContext(t.world.frame, t.known, t.places, list(t.route), t.world.start_xy, req.cls, req.hour, log, self.rng)
+        self.feed = _Feed()
+        self.search = ObjectSearch(t, self.feed, req.cls, instances, camera, self.ctx, self.rng)
+        self.search.planner_name = "agent"
+        cls_log = log[log["class"] == req.cls]
+        near = cls_log[np.abs(((cls_log["hour"] - req.hour + 12.0) % 24.0) - 12.0) <= 1.0]
+        self.history = np.array([[float((cls_log["place"] == n).sum()), float((near["place"] == n).sum())] for n in self.names],
+                                np.float32).reshape(self.P, 2)
+        if self.action_mode == "macro":
+            self.stepper = Stepper(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
+            self.outcome = self.stepper.advance()
+        else:
+            self.outcome = "found" if self.search.sense(st)[0] else None
+
+    def _act(self, action):
+        st = self.state
+        d0 = st.distance
+        a = int(action)
+        if self.action_mode == "primitive":
+            moved = 0.0
+            fr = self.task.world.frame
+            if a < 8:
+                ang = a * math.pi / 4
+                x, y = st.x + self.step_m * math.cos(ang), st.y + self.step_m * math.sin(ang)
+                _, _, r, c = fr.point_to_cell(x, y)
+                st.heading = float(wrap_angle(ang))
+                if 0 <= r < fr.height and 0 <= c < fr.width and self._cspace[r, c]:
+                    st.x, st.y, moved = x, y, self.step_m
+            else:
+                st.heading = float(wrap_angle(st.heading + (math.pi / 4 if a == 8 else -math.pi / 4)))
+            st.distance += moved
+            st.steps += 1
+            st.trail.append((st.x, st.y))
+            found = self.search.sense(st)[0]
+            e = self.task.sc.experiment
+            budget = st.distance >= e.max_distance or st.steps >= self.task.max_steps()
+            return moved, "found" if found else "budget" if budget else None
+        if self.search.look:  # on arriving at the last place: look around before going on
+            self.search.look = False
+            if self.search._look_around(st):
+                return 0.0, "found"
+        x, y = self.task.places[self.names[a]]
+        self.feed.next = (x, y, {"place": self.names[a]})
+        p = self.search.plan(st)
+        if p == "not_found":  # no path to that place on the recorded map: nothing travelled, choose again
+            return 0.0, None
+        out = self.stepper.follow(p)
+        return st.distance - d0, out
+
+    def action_masks(self) -> np.ndarray:
+        return np.ones(self.action_space.n, bool)
+
+    def _info(self) -> dict:
+        return {**super()._info(), "action_mask": self.action_masks()}
+
+    def _places(self) -> np.ndarray:
+        st = self.state
+        out = np.zeros((self.P, 5), np.float32)
+        for k, n in enumerate(self.names):
+            x, y = self.task.places[n]
+            out[k, :3] = (x - st.x, y - st.y, float(n in self.ctx.seen_places))
+        out[:, 3:] = self.history
+        return out
+
+    def _observe(self):
+        st = self.state
+        if self.observation_mode == "text":
+            pl = self._places()
+            lines = [f"Find a {self.request.cls} (request at {self.request.hour:g} h).",
+                     f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {math.degrees(st.heading):.0f} deg; "
+                     f"travelled {st.distance:.1f} m.",
+                     "Places: " + "; ".join(
+                         f"[{k}] {n} at {math.hypot(p[0], p[1]):.1f} m bearing {math.degrees(math.atan2(p[1], p[0])):.0f} deg, "
+                         f"{'seen' if p[2] else 'not seen'}, {p[3]:.0f} past detections ({p[4]:.0f} within an hour of now)"
+                         for k, (n, p) in enumerate(zip(self.names, pl))) + "."]
+            lines.append("Answer with a place's number." if self.action_mode == "macro" else
+                         "Answer with 0-7 to move " + ", ".join(f"{k} {d}" for k, d in enumerate(DIRECTIONS))
+                         + "; 8 to turn left, 9 to turn right (45 deg).")
+            return clip_text("\n".join(lines))
+        return {"places": self._places(), "hour": np.array([self.request.hour], np.float32),
+                "pose": np.array([st.x, st.y, st.heading], np.float32)}
+
+    def render(self):
+        if self.render_mode != "rgb_array" or self.episode is None:
+            return None
+        st, w = self.state, self.task.world
+        fr = w.frame
+        img = np.where(w.free[..., None], np.uint8(255), np.uint8(0)).repeat(3, axis=2)
+        trail = np.asarray(st.trail)
+        rr, cc = fr.to_index(trail[:, 0], trail[:, 1])
+        cv2.polylines(img, [np.stack([cc, rr], axis=1).astype(np.int32).reshape(-1, 1, 2)], False, (220, 40, 40), 1)
+        for n, (x, y) in self.task.places.items():
+            r, c = fr.to_index(x, y)
+            cv2.circle(img, (int(c), int(r)), 4, (0, 160, 0) if n in self.ctx.seen_places else (240, 150, 0), -1)
+        r, c = fr.to_index(st.x, st.y)
+        cv2.circle(img, (int(c), int(r)), 5, (200, 0, 200), -1)
+        return img

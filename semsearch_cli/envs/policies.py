@@ -1,0 +1,48 @@
+"""The built-in door planners as policies of the macro environment.
+
+    env = gymnasium.make("semsearch/DoorSearch-v0", scenario="configs/hotel.yaml", **policy.env_kwargs)
+    policy = PlannerPolicy("nsos", alpha=0.9)
+    obs, info = env.reset(options={"episode": 3, "repeat": 0}); policy.reset()
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(env)); done = terminated or truncated
+
+The planner sees what it sees in the batch (the belief, the pose, the candidates) and its choice
+becomes the candidate's slot, so the run is the one ``semsearch run`` records for that episode and
+seed (tests/test_envs.py checks it run for run).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import PlannerError
+from ..planners import Variant
+
+
+class PlannerPolicy:
+    """A registered door planner with fixed parameters, answering the macro environment."""
+
+    def __init__(self, name: str, **params):
+        self.variant = Variant(name, tuple(sorted(params.items())))
+        self.planner = self.variant.build()
+
+    @property
+    def env_kwargs(self) -> dict:
+        """The environment arguments that give the batch's re-plan cadence for this planner."""
+        return {"replan_on_signs": bool(getattr(self.planner, "replan_on_signs", False))}
+
+    def reset(self) -> None:
+        """A fresh planner for a new episode (the batch builds one per run)."""
+        self.planner = self.variant.build()
+
+    def __call__(self, env) -> int:
+        u = env.unwrapped
+        ctx, cands = u.decision
+        dec = self.planner.choose(ctx, cands)
+        if dec is None:
+            return u.sweep_action
+        k = np.flatnonzero((cands.rows == dec.row) & (cands.cols == dec.col))
+        if k.size == 0 or k[0] >= u.K:
+            where = "is not a candidate" if k.size == 0 else f"is candidate {k[0]}, beyond max_candidates={u.K}"
+            raise PlannerError(f"planner {self.variant.label!r} chose the cell ({dec.row}, {dec.col}), which {where}")
+        return int(k[0])
