@@ -1,7 +1,8 @@
 """Door-search benchmark on the authors' Hotel map (read from ../shared, never copied).
 
 Measures (medians of repeated runs, with ratios against baselines timed in the same process):
-  1. one run each of greedy and nsos (alpha 0.9), Hotel goal 148, seed 0: wall time and seconds
+  1. one run each of greedy and nsos (alpha 0.9), Hotel goal 148, seed 0, under each re-planning
+     policy (``--replan periodic,events``, navigation.replan): wall time and seconds
      per 300 m travelled; the baseline is the sensing-only loop (laser + HIMM + door cameras +
      visited kernel) over the same poses, i.e. the floor any planner pays;
   2. whole Hotel tables with 2 workers: 4 goals x greedy and bvp x 10 seeds, and 4 goals x
@@ -13,7 +14,7 @@ Measures (medians of repeated runs, with ratios against baselines timed in the s
      seeds = 520 runs), 2 workers, rows kept in a temporary folder (``--keep DIR`` to compare them
      with benchmarks/compare_rows.py). This part does not need ../shared.
 
-Usage: python benchmarks/bench_door_search.py [--repeat 5] [--tables bvp,nsos,thesis] [--keep DIR] [--out FILE.md]
+Usage: python benchmarks/bench_door_search.py [--repeat 5] [--replan periodic,events] [--tables bvp,nsos,thesis] [--keep DIR] [--out FILE.md]
 """
 
 from __future__ import annotations
@@ -109,6 +110,7 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--pairs", type=int, default=40)
+    ap.add_argument("--replan", default="periodic,events", help="re-planning policies to time in part 1 (navigation.replan)")
     ap.add_argument("--tables", default="bvp,nsos", help="which whole tables to time: bvp, nsos, thesis, several or none")
     ap.add_argument("--keep", type=Path, help="folder for the thesis tables' rows (default: a temporary one)")
     ap.add_argument("--out", type=Path)
@@ -129,20 +131,23 @@ def main() -> int:
     L = Loaded.load(p)
     say(f"# semsearch door-search benchmark ({time.strftime('%Y-%m-%d %H:%M')}, {sys.platform}, python {sys.version.split()[0]})")
     say()
-    # 1. one run per planner
-    for variant in (Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),))):
-        L.task.run(variant, 148, 0)  # warm-up (numba cache, imports)
-        walls, base = [], []
-        for _ in range(a.repeat):
-            res = L.task.run(variant, 148, 0)
-            walls.append(res.wall_s)
-            base.append(sensing_only(L, res.path.astype(float)))
-        med, bmed = statistics.median(walls), statistics.median(base)
-        say(f"## 1. {variant.label}, Hotel goal 148, seed 0 ({a.repeat} repeats)")
-        say(f"distance {res.distance_m:.1f} m, {res.steps} steps, {res.decisions} decisions, outcome {res.outcome}")
-        say(f"median wall {med:.3f} s (min {min(walls):.3f}, max {max(walls):.3f}) = {med / res.distance_m * 300:.2f} s per 300 m (target <= 1.5)")
-        say(f"sensing-only baseline over the same poses: median {bmed:.3f} s; run / baseline = {med / bmed:.2f}")
-        say()
+    # 1. one run per planner, under each re-planning policy
+    for replan in a.replan.split(","):
+        sc_r = L.sc.model_copy(update={"navigation": L.sc.navigation.model_copy(update={"replan": replan})})
+        task = build_task(sc_r, L.world, L.path)
+        for variant in (Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),))):
+            task.run(variant, 148, 0)  # warm-up (numba cache, imports)
+            walls, base = [], []
+            for _ in range(a.repeat):
+                res = task.run(variant, 148, 0)
+                walls.append(res.wall_s)
+                base.append(sensing_only(L, res.path.astype(float)))
+            med, bmed = statistics.median(walls), statistics.median(base)
+            say(f"## 1. {variant.label}, Hotel goal 148, seed 0, navigation.replan: {replan} ({a.repeat} repeats)")
+            say(f"distance {res.distance_m:.1f} m, {res.steps} steps, {res.decisions} decisions, outcome {res.outcome}")
+            say(f"median wall {med:.3f} s (min {min(walls):.3f}, max {max(walls):.3f}) = {med / res.distance_m * 300:.2f} s per 300 m (target <= 1.5)")
+            say(f"sensing-only baseline over the same poses: median {bmed:.3f} s; run / baseline = {med / bmed:.2f} (target <= 1.5)")
+            say()
     # 2. navigators
     b = known_belief(L)
     rng = np.random.default_rng(7)

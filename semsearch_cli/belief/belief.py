@@ -141,6 +141,7 @@ class Belief:
         self.cost = lazy_zeros((H, W), np.float32)  # read only where passable, which refresh_derived writes with it
         self.search_state = GridSearch((H, W))
         self.version = 0  # bumped whenever passable/cost change
+        self.lost = 0  # cells that were free and are no longer (a wall seen where the map had free space)
         self._search_key = None
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
@@ -167,7 +168,7 @@ class Belief:
         n = himm_update(self.cv, self.seen, v, u, thetas, dist, hit, sp.himm_inc, sp.himm_dec, sp.himm_max, self.free,
                         sp.occupied_threshold, self._touched)
         if n <= self._touched.shape[0]:
-            fold_free(self.free, self.seen, self.cv, sp.occupied_threshold, self._touched, n, self.dirty)
+            self.lost += fold_free(self.free, self.seen, self.cv, sp.occupied_threshold, self._touched, n, self.dirty)
             return
         # more changes than the buffer holds (the first scans, or a long-range laser in the open):
         # refresh over the scan's whole box, which holds every cell a beam touched, and make room
@@ -188,6 +189,7 @@ class Belief:
         changed = new != self.free[r0:r1, c0:c1]
         if not changed.any():
             return
+        self.lost += int((changed & ~new).sum())
         self.free[r0:r1, c0:c1] = new
         rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
         _grow(self.dirty, (r0 + int(rows[0]), r0 + int(rows[-1]), c0 + int(cols[0]), c0 + int(cols[-1])))

@@ -119,6 +119,9 @@ class BeliefSpec(Strict):
 class NavigationSpec(Strict):
     navigator: Literal["geodesic", "harmonic"] = "geodesic"
     replan_every: float = Field(1.0, gt=0.0, le=MAX_COORD, description="m travelled between periodic re-plans")
+    replan: Literal["periodic", "events"] = Field(
+        "periodic", description="door search: periodic re-plans every replan_every m (the thesis' tables), or only on "
+        "what changes the decision (the path used up, a free cell of the map lost, the target visited, a sign read)")
 
 
 class EpisodeSpec(Strict):

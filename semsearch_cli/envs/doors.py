@@ -34,7 +34,8 @@ Observation (``observation_mode="dict"``)
 - ``pose``: float32 (3,): x, y (m), heading (rad).
 
 ``observation_mode="text"`` renders the same as a short text (a ``Text`` space) for language-model
-agents. ``render_mode="rgb_array"`` draws the belief and the path (north up).
+agents. ``render_mode="rgb_array"`` draws the belief and the path (north up). ``max_distance``
+(m) replaces the scenario's budget, e.g. for shorter training episodes.
 """
 
 from __future__ import annotations
@@ -75,10 +76,13 @@ class DoorSearchEnv(SearchEnv):
 
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
                  success_bonus: float = 100.0, window: int = 32, max_candidates: int = 32, max_signs: int = 32,
-                 replan_on_signs: bool = True):
+                 replan_on_signs: bool = True, max_distance: float | None = None):
         super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
         self._init_args.update(window=window, max_candidates=max_candidates, max_signs=max_signs,
-                               replan_on_signs=replan_on_signs)
+                               replan_on_signs=replan_on_signs, max_distance=max_distance)
+        if max_distance is not None and not max_distance > 0:
+            raise ValueError("max_distance must be positive (m)")
+        self.max_distance = max_distance
         if not 1 <= max_candidates <= 254:
             raise ValueError("max_candidates must lie in 1..254")
         self.R, self.K, self.S = int(window), int(max_candidates), int(max_signs)
@@ -103,6 +107,11 @@ class DoorSearchEnv(SearchEnv):
         self._cspace = w.cspace
         self.decision = None  # (PlanContext, Candidates) while the agent is to choose (macro)
 
+    @property
+    def budget(self) -> float:
+        """m: ``max_distance`` when given, else the scenario's ``experiment.max_distance``."""
+        return self.max_distance if self.max_distance is not None else self.task.sc.experiment.max_distance
+
     # ---- episode ----------------------------------------------------------------------
     def _begin(self) -> None:
         t, ep = self.task, self.episode
@@ -112,7 +121,7 @@ class DoorSearchEnv(SearchEnv):
         self.goal_label = parse_label(ep.goal)
         self.decision = None
         if self.action_mode == "macro":
-            self.stepper = Stepper(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
+            self.stepper = Stepper(self.search, st, self.step_m, self.budget, t.max_steps())
             self.outcome = self._to_decision(self.stepper.advance())
         else:
             found, _ = self.search.sense(st)
@@ -179,10 +188,10 @@ class DoorSearchEnv(SearchEnv):
         return moved
 
     def _primitive_outcome(self):
-        st, e = self.state, self.task.sc.experiment
+        st = self.state
         if self._found:
             return "found"
-        if st.distance >= e.max_distance or st.steps >= self.task.max_steps():
+        if st.distance >= self.budget or st.steps >= self.task.max_steps():
             return "budget"
         return None
 

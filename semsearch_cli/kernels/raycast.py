@@ -170,15 +170,18 @@ def himm_update(cv, seen, v0, u0, thetas, dist, hit, inc, dec, cv_max, free, occ
 @njit(cache=True)
 def fold_free(free, seen, cv, occupied, cells, n, dirty):
     """Re-derive ``free = seen & (cv < occupied)`` at the first ``n`` flat indices of ``cells``
-    and grow ``dirty`` ``[rmin, rmax, cmin, cmax]`` (in place) by the cells whose state changed."""
+    and grow ``dirty`` ``[rmin, rmax, cmin, cmax]`` (in place) by the cells whose state changed.
+    Returns how many cells stopped being free."""
     W = free.shape[1]
     ff = free.ravel()
     sf = seen.ravel()
     cf = cv.ravel()
+    lost = 0
     for k in range(n):
         q = cells[k]
         new = sf[q] and cf[q] < occupied
         if new != ff[q]:
+            lost += ff[q]
             ff[q] = new
             r = q // W
             c = q - r * W
@@ -190,6 +193,7 @@ def fold_free(free, seen, cv, occupied, cells, n, dirty):
                 dirty[2] = c
             if c > dirty[3]:
                 dirty[3] = c
+    return lost
 
 
 @njit(cache=True)

@@ -78,6 +78,9 @@ class DoorSearch(DoorSensing):
         self.navigator = NAVIGATORS[task.sc.navigation.navigator]()
         self.uses_signs = getattr(planner, "replan_on_signs", False)
         self.replan_every = task.sc.navigation.replan_every
+        self.periodic = task.sc.navigation.replan == "periodic"
+        self._belief = None
+        self._lost_at_plan = 0
         self.looked_around = False
         self.decisions = 0
         self.target: tuple[int, int] | None = None  # the cell the robot is heading for
@@ -92,7 +95,18 @@ class DoorSearch(DoorSensing):
         self.sweep_target: tuple[int, int] | None = None
 
     def replan_due(self, path_done, since_plan, event):
-        return path_done or since_plan >= self.replan_every or (event and self.uses_signs)
+        if path_done or (event and self.uses_signs):
+            return True
+        if self.periodic:
+            return since_plan >= self.replan_every
+        # events: the path may no longer be free (a cell of the map stopped being free: paths keep
+        # the robot's clearance from unknown space too, so a newly seen wall cannot come closer
+        # than that otherwise)
+        return self._belief.lost != self._lost_at_plan
+
+    def update(self, st) -> None:
+        super().update(st)
+        self._belief = st.belief
 
     def turn(self, st, turns: int, angle: float, frames: int = 1) -> bool:
         """Turn on the spot ``turns`` times by ``angle`` radians, sensing ``frames`` times after
@@ -205,6 +219,7 @@ class DoorSearch(DoorSensing):
         if p is not None and len(p[0]) >= 2:
             self.looked_around = False
             self.target = (dec.row, dec.col)
+            self._lost_at_plan = b.lost
             return fr.to_world(p[0], p[1])
         return None
 
