@@ -206,3 +206,22 @@ def test_fold_scan_with_a_full_change_buffer_matches_a_roomy_one():
     assert np.array_equal(small.free, roomy.free) and np.array_equal(small.cv, roomy.cv)
     assert small.dirty.tolist() == roomy.dirty.tolist()
     assert small._touched.shape[0] > 500  # room for as many changes next time
+
+
+@pytest.mark.parametrize("buffer", [1, 100_000])
+def test_lost_counts_the_free_cells_a_scan_turns_to_walls(buffer):
+    # an open room scanned, then a wall appearing across free space (a door closed): the cells it
+    # covers stop being free, and Belief.lost (the events re-planning policy's trigger) counts
+    # them, through the kernel and through the refresh of a whole box alike
+    occ = np.zeros((80, 90), bool)
+    occ[:, 85:] = True
+    thetas = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    b = Belief(GridFrame(0.1, 0.0, 0.0, 80, 90), BeliefSpec(), robot_radius=0.05)
+    b.fold_scan(40.5, 30.5, thetas, *cast_rays(occ, 40.5, 30.5, thetas, 50.0))
+    assert b.lost == 0 and b.free[40, 60]
+    occ[:, 60] = True
+    b._touched = np.empty(buffer, np.int64)
+    for _ in range(10):  # HIMM needs several hits before a cell counts as occupied
+        b.fold_scan(40.5, 30.5, thetas, *cast_rays(occ, 40.5, 30.5, thetas, 50.0))
+    lost = int((~b.free[:, 60] & b.seen[:, 60]).sum())
+    assert not b.free[40, 60] and lost > 10 and b.lost == lost

@@ -93,12 +93,15 @@ def test_vector_envs_of_four(vector):
     vec = gym.vector.SyncVectorEnv(fns) if vector == "sync" else gym.vector.AsyncVectorEnv(fns)
     try:
         obs, infos = vec.reset(seed=[0, 1, 2, 3])
-        assert obs["occupancy"].shape == (4, 65, 65)
+        assert obs["occupancy"].shape == (4, 65, 65) and len(set(infos["repeat"])) == 4
         total = np.zeros(4)
         for _ in range(20):
             obs, rew, term, trunc, infos = vec.step(vec.action_space.sample())
             total += rew
-        assert (total <= 0.1 * 20 * 100).all() and obs["pose"].shape == (4, 3)
+            assert not (term | trunc).any()  # 2 m at most from the starts: no episode ends
+        # each copy's return is minus the metres it travelled, and they went their own ways
+        np.testing.assert_allclose(total, -infos["distance_m"], atol=1e-9)
+        assert infos["steps"].tolist() == [20] * 4 and len(set(np.round(obs["pose"][:, 0], 6))) > 1
     finally:
         vec.close()
 
@@ -151,3 +154,17 @@ def test_the_planners_as_policies_travel_what_the_batch_records(batch_rows, scen
         assert info["outcome"] == row["outcome"]
         assert info["distance_m"] == pytest.approx(row["distance_m"], abs=1e-3)
         assert ret == pytest.approx(-row["distance_m"] + (100.0 if row["outcome"] == "found" else 0.0), abs=1e-3)
+
+
+def test_an_object_agent_cannot_look_again_for_free_at_the_place_it_stands():
+    env = make("semsearch/ObjectSearch-Office-v0").unwrapped
+    for a in range(env.P):  # a place away from the start, where the request's object is not
+        env.reset(seed=1, options={"episode": 0})
+        _, r, term, trunc, info = env.step(a)
+        if not (term or trunc):
+            break
+    assert r < 0 and not info["action_mask"][a] and info["action_mask"].sum() == env.P - 1
+    steps, seen = info["steps"], set(env.ctx.seen_places)
+    _, r, term, trunc, info = env.step(a)  # the masked place again: nothing travelled, nothing sensed
+    assert (r, term, info["steps"], set(env.ctx.seen_places)) == (0.0, False, steps, seen)
+

@@ -27,6 +27,22 @@ def test_every_planner_finds_the_goal_on_the_demo(demo_loaded, name):
         assert res.decisions >= 1
 
 
+@pytest.mark.parametrize("name", ["greedy", "nsos"])
+def test_the_events_replanning_policy_finds_every_goal_on_its_own_paths(demo_loaded, name):
+    """navigation.replan: events re-plans only on the path used up, a sign read or a lost free
+    cell: every run still finds its goal, never below the optimum, and the policy shows in the paths."""
+    L = demo_loaded
+    sc = L.sc.model_copy(update={"navigation": L.sc.navigation.model_copy(update={"replan": "events"})})
+    events = build_task(sc, L.world, L.path)
+    differ = 0
+    for goal in L.sc.goals:
+        for seed in range(3):
+            a, b = L.task.run(Variant(name, ()), goal, seed), events.run(Variant(name, ()), goal, seed)
+            assert b.outcome == "found" and b.distance_m >= L.shortest[goal] - 0.5
+            differ += a.path.shape != b.path.shape or not (a.path == b.path).all()
+    assert differ >= 1
+
+
 def test_same_seed_same_run(demo_loaded):
     L = demo_loaded
     a = L.task.run(Variant("greedy", ()), 452, 1)

@@ -6,9 +6,11 @@ array too big for memory or a loop that never ends."""
 
 from __future__ import annotations
 
+import re
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+import numpy as np
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 # upper bounds shared by the sections (m): far beyond any building, short of an array that fills memory
 MAX_RANGE = 50.0  # a sensor's range
@@ -20,20 +22,25 @@ Coord = Annotated[float, Field(ge=-MAX_COORD, le=MAX_COORD)]
 Angle = Annotated[float, Field(ge=-3600.0, le=3600.0, description="degrees")]
 
 
+_WHOLE = re.compile(r"-?[0-9]+")
+
+
 def sign_label(value):
     """A sign's label in its one canonical form, wherever it was written: a whole number (``148``,
-    ``"148"`` in YAML or a CSV, ``148`` from a spreadsheet column of numbers) is an int, anything else
-    (``K202``, ``24D``, ``2.14``) stripped text. A goal is then matched to its sign however either
-    was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV."""
+    ``"148"`` in YAML or a CSV, ``148.0`` from a spreadsheet column of numbers) is an int, anything
+    else (``K202``, ``24D``, ``2.14``) stripped text. A goal is then matched to its sign however
+    either was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV."""
     if isinstance(value, bool):
-        return str(value)
-    if isinstance(value, int):
+        return str(value).lower()
+    if isinstance(value, (int, np.integer)):
         return int(value)
+    if isinstance(value, (float, np.floating)):
+        return int(value) if float(value).is_integer() else repr(float(value))
     text = str(value).strip()
-    return int(text) if text.lstrip("-").isdigit() else text
+    return int(text) if _WHOLE.fullmatch(text) else text
 
 
-Label = Annotated[Union[int, str], AfterValidator(sign_label)]
+Label = Annotated[Union[int, str], BeforeValidator(sign_label)]
 
 
 class Strict(BaseModel):
@@ -128,7 +135,7 @@ class EpisodeSpec(Strict):
     """One start/goal problem given by hand: the goal (a door number, a request label, a chain's
     name; for indirect search, the room's name, the view scales being the goals) and the start."""
 
-    goal: Union[int, str]
+    goal: Label
     x: Coord
     y: Coord
     heading: Union[Angle, Literal["random"]] = Field("random", description="degrees, or random (drawn per repeat)")

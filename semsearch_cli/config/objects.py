@@ -7,7 +7,7 @@ from typing import Annotated, Union
 
 from pydantic import ConfigDict, Field, model_validator
 
-from .base import MAX_RANGE, Angle, Coord, Strict
+from .base import Label, MAX_RANGE, Angle, Coord, Strict
 
 NAME = r"^[A-Za-z0-9_\-]+$"
 Hour = Annotated[float, Field(ge=0.0, lt=24.0, description="hour of the day, 0 <= h < 24")]
@@ -18,7 +18,7 @@ class PlaceSpec(Strict):
     x: Coord
     y: Coord
     facing: Angle = Field(0.0, description="degrees, the direction the objects there face (for angle tables)")
-    room: Union[int, str, None] = Field(None, description="number of the door sign of the room holding the place (chains)")
+    room: Label | None = Field(None, description="number of the door sign of the room holding the place (chains)")
 
 
 class DetectTable(Strict):

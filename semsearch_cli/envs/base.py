@@ -91,6 +91,9 @@ def text_space() -> gym.spaces.Text:
 
 
 def clip_text(text: str) -> str:
+    """``text`` inside the Text space: characters outside its charset (a label's accents, a tab)
+    as ``?``, at most ``TEXT_LENGTH`` characters."""
+    text = "".join(ch if ch in TEXT_CHARSET else "?" for ch in text) or "?"
     return text if len(text) <= TEXT_LENGTH else text[:TEXT_LENGTH - 4] + "\n..."
 
 
@@ -139,6 +142,9 @@ class SearchEnv(gym.Env):
         self._idle = 0
         self.rng = np.random.default_rng(episode_seed(self.episode, self.repeat, self.task.sc.experiment.base_seed))
         self._begin()
+        # what the robot travelled inside reset() (a sweep before the first choice) is charged to
+        # the first step, so that the return is always minus the distance (plus the bonus)
+        self._unpaid = float(self.state.distance)
         # an episode that ends at its start (the goal read from the first pose) ends at the first
         # step, which travels nothing: gymnasium has no way to end an episode in reset()
         self._ended_at_reset, self.outcome = self.outcome, None
@@ -155,6 +161,7 @@ class SearchEnv(gym.Env):
             moved, outcome = 0.0, self._ended_at_reset
         else:
             moved, outcome = self._act(action)
+        moved, self._unpaid = moved + self._unpaid, 0.0
         self._idle = self._idle + 1 if self.state.steps == s0 and outcome is None else 0
         if self._idle >= IDLE_ACTIONS:
             outcome = "stuck"
@@ -166,13 +173,16 @@ class SearchEnv(gym.Env):
 
     def _info(self) -> dict:
         st = self.state
-        return {"episode": self.episode.index, "repeat": self.repeat, "goal": str(self.episode.goal),
+        # "episode_index", not "episode": Gymnasium's RecordEpisodeStatistics and Stable-Baselines3
+        # keep their episode statistics (a dict) under info["episode"]
+        return {"episode_index": self.episode.index, "repeat": self.repeat, "goal": str(self.episode.goal),
                 "distance_m": float(st.distance), "steps": int(st.steps), "outcome": self.outcome or "",
                 "shortest_m": float(self.episode.shortest_m)}
 
     # ---- pickling: the arguments, the generator and the actions since the reset ----------
     def __getstate__(self):
         return {"args": self._init_args, "np_random": getattr(self, "_np_random", None),
+                "np_random_seed": getattr(self, "_np_random_seed", None),
                 "reset": getattr(self, "_reset_options", None), "actions": list(self._actions)}
 
     def __setstate__(self, state):
@@ -181,7 +191,7 @@ class SearchEnv(gym.Env):
             self.reset(options=state["reset"])
             for a in state["actions"]:
                 self.step(a)
-        self._np_random = state["np_random"]
+        self._np_random, self._np_random_seed = state["np_random"], state["np_random_seed"]
 
     # ---- the kind's ---------------------------------------------------------------------
     def _begin(self) -> None:  # pragma: no cover

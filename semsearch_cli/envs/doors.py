@@ -8,6 +8,7 @@ Action modes
 ``macro`` (default): ``Discrete(K + 1)``. At each re-plan of the batch (the path used up, every
 ``navigation.replan_every`` metres, and, with ``replan_on_signs``, when a sign reaches
 ``belief.min_reads``) the agent chooses one of the belief's frontier candidates, slots ``0..K-1``
+holding the K nearest (straight-line) nearest first
 (``info["action_mask"]``, also :meth:`action_masks` for sb3-contrib's MaskablePPO); the navigator
 drives there until the next re-plan. Action ``K`` looks at the nearest wall face no camera has read
 yet (the batch's completeness sweep, what it does when a planner returns None); an action naming an
@@ -75,7 +76,7 @@ class DoorSearchEnv(SearchEnv):
     kind = "doors"
 
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
-                 success_bonus: float = 100.0, window: int = 32, max_candidates: int = 32, max_signs: int = 32,
+                 success_bonus: float = 100.0, window: int = 32, max_candidates: int = 64, max_signs: int = 32,
                  replan_on_signs: bool = True, max_distance: float | None = None):
         super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
         self._init_args.update(window=window, max_candidates=max_candidates, max_signs=max_signs,
@@ -112,6 +113,12 @@ class DoorSearchEnv(SearchEnv):
         """m: ``max_distance`` when given, else the scenario's ``experiment.max_distance``."""
         return self.max_distance if self.max_distance is not None else self.task.sc.experiment.max_distance
 
+    @property
+    def step_limit(self) -> int:
+        """Steps: the scenario's ``experiment.max_steps``, else 1.5 times the steps the budget takes."""
+        e = self.task.sc.experiment
+        return e.max_steps or int(np.ceil(self.budget / self.step_m * 1.5)) + 100
+
     # ---- episode ----------------------------------------------------------------------
     def _begin(self) -> None:
         t, ep = self.task, self.episode
@@ -121,7 +128,7 @@ class DoorSearchEnv(SearchEnv):
         self.goal_label = parse_label(ep.goal)
         self.decision = None
         if self.action_mode == "macro":
-            self.stepper = Stepper(self.search, st, self.step_m, self.budget, t.max_steps())
+            self.stepper = Stepper(self.search, st, self.step_m, self.budget, self.step_limit)
             self.outcome = self._to_decision(self.stepper.advance())
         else:
             found, _ = self.search.sense(st)
@@ -141,10 +148,18 @@ class DoorSearchEnv(SearchEnv):
             if len(cands) == 0:
                 out = self.stepper.follow(search.sweep(st, ctx))
                 continue
-            self.decision, self._tries = (ctx, cands), 0
+            self._set_decision(ctx, cands)
+            self._tries = 0
             return None
         self.decision = None
         return out
+
+    def _set_decision(self, ctx, cands) -> None:
+        """The agent's choice: ``slots[k]`` is the candidate (its index in ``cands``) in action
+        slot k, the K nearest to the robot (straight-line), nearest first."""
+        xs, ys = self.task.world.frame.to_world(cands.rows, cands.cols)
+        d = np.hypot(xs - self.state.x, ys - self.state.y)
+        self.decision, self.slots = (ctx, cands), np.argsort(d, kind="stable")[:self.K]
 
     def _act(self, action):
         st = self.state
@@ -153,15 +168,16 @@ class DoorSearchEnv(SearchEnv):
         if self.action_mode == "primitive":
             return self._primitive(a), self._primitive_outcome()
         ctx, cands = self.decision
-        if not 0 <= a < min(len(cands), self.K):
+        if not 0 <= a < len(self.slots):
             out = self.stepper.follow(self.search.sweep(st, ctx))
         else:
-            p, left = self.search.attempt(st, ctx, cands, Decision(int(cands.rows[a]), int(cands.cols[a])))
+            j = int(self.slots[a])
+            p, left = self.search.attempt(st, ctx, cands, Decision(int(cands.rows[j]), int(cands.cols[j])))
             self._tries += 1
             if p is not None:
                 out = self.stepper.follow(p)
             elif left is not None and self._tries < MAX_RETRIES:
-                self.decision = (ctx, left)  # ask again, that candidate removed
+                self._set_decision(ctx, left)  # ask again, that candidate removed
                 return 0.0, None
             else:
                 out = self.stepper.follow(self.search.sweep(st, ctx))
@@ -191,7 +207,7 @@ class DoorSearchEnv(SearchEnv):
         st = self.state
         if self._found:
             return "found"
-        if st.distance >= self.budget or st.steps >= self.task.max_steps():
+        if st.distance >= self.budget or st.steps >= self.step_limit:
             return "budget"
         return None
 
@@ -204,7 +220,7 @@ class DoorSearchEnv(SearchEnv):
         m = np.zeros(self.K + 1, bool)
         m[self.K] = True
         if self.decision is not None:
-            m[:min(len(self.decision[1]), self.K)] = True
+            m[:len(self.slots)] = True
         return m
 
     def _info(self) -> dict:
@@ -242,21 +258,21 @@ class DoorSearchEnv(SearchEnv):
             sg[k] = (1.0, float(same), -1.0 if p is None else min(p.number, BIG), dx, dy, facing)
         g = self.goal_label
         buf["goal"][:] = (-1.0, 0.0) if g is None else (min(g.number, BIG), float(bool(g.prefix or g.suffix)))
-        buf["pose"][:] = (st.x, st.y, st.heading)
+        buf["pose"][:] = (st.x, st.y, wrap_angle(st.heading))
         obs = {k: buf[k].copy() for k in ("occupancy", "explored", "signs", "goal", "pose")}
         if self.action_mode == "macro":
             cm, tg = buf["candidates"], buf["targets"]
             cm.fill(0)
             tg.fill(0.0)
             if self.decision is not None:
-                cands = self.decision[1]
-                n = min(len(cands), self.K)
-                xs, ys = fr.to_world(cands.rows[:n], cands.cols[:n])
+                cands = self.decision[1].take(self.slots)
+                n = len(cands)
+                xs, ys = fr.to_world(cands.rows, cands.cols)
                 tg[:n, 0] = 1.0
                 tg[:n, 1] = xs - st.x
                 tg[:n, 2] = ys - st.y
-                tg[:n, 3] = cands.theta[:n]
-                rr, cc = cands.rows[:n] - r + self.R, cands.cols[:n] - c + self.R
+                tg[:n, 3] = cands.theta
+                rr, cc = cands.rows - r + self.R, cands.cols - c + self.R
                 ok = (rr >= 0) & (rr < cm.shape[0]) & (cc >= 0) & (cc < cm.shape[1])
                 cm[rr[ok], cc[ok]] = (np.arange(n) + 1)[ok]
             obs["candidates"], obs["targets"] = cm.copy(), tg.copy()
@@ -276,12 +292,11 @@ class DoorSearchEnv(SearchEnv):
             lines.append("No sign read yet.")
         if self.action_mode == "macro":
             if self.decision is not None:
-                cands = self.decision[1]
-                n = min(len(cands), self.K)
-                xs, ys = self.task.world.frame.to_world(cands.rows[:n], cands.cols[:n])
-                lines.append("Frontier targets: " + "; ".join(
+                cands = self.decision[1].take(self.slots)
+                xs, ys = self.task.world.frame.to_world(cands.rows, cands.cols)
+                lines.append("Frontier targets, nearest first: " + "; ".join(
                     f"[{k}] {math.hypot(x - st.x, y - st.y):.1f} m bearing {math.degrees(math.atan2(y - st.y, x - st.x)):.0f} deg, "
-                    f"leading {math.degrees(t):.0f} deg" for k, (x, y, t) in enumerate(zip(xs, ys, cands.theta[:n]))) + ".")
+                    f"leading {math.degrees(t):.0f} deg" for k, (x, y, t) in enumerate(zip(xs, ys, cands.theta))) + ".")
             lines.append(f"Answer with a target's number, or {self.K} to look at the nearest wall not yet read.")
         else:
             lines.append("Answer with 0-7 to move 0.1 m " + ", ".join(f"{k} {d}" for k, d in enumerate(DIRECTIONS))
@@ -301,8 +316,8 @@ class DoorSearchEnv(SearchEnv):
         pts = np.stack([cc, rr], axis=1).astype(np.int32).reshape(-1, 1, 2)
         cv2.polylines(img, [pts], False, (220, 40, 40), 1)
         if self.decision is not None:
-            cands = self.decision[1]
-            for rc, cc_ in zip(cands.rows[:self.K], cands.cols[:self.K]):
+            cands = self.decision[1].take(self.slots)
+            for rc, cc_ in zip(cands.rows, cands.cols):
                 cv2.circle(img, (int(cc_), int(rc)), 3, (240, 150, 0), -1)
         sg = self.task.world.signs
         for i in st.read_signs:

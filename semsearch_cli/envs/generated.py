@@ -9,6 +9,8 @@ random heading. Training on one range of seeds and evaluating on another holds b
 
 from __future__ import annotations
 
+import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -27,10 +29,16 @@ def building(layout: str, numbering: str, seed: int, spacing: float) -> Path:
     if _FOLDER is None:
         _FOLDER = tempfile.TemporaryDirectory(prefix="semsearch-buildings-")
     out = Path(_FOLDER.name) / f"{layout}-{numbering}-{seed}-{spacing:g}"
-    path = out / "scenario.yaml"
-    if not path.is_file():
-        generate_building(layout, numbering, seed, out, spacing=spacing)
-    return path
+    if not (out / "scenario.yaml").is_file():
+        # written aside and renamed into place: processes forked from one parent share the
+        # folder, and one must never read a building another is still writing
+        tmp = out.with_name(f"{out.name}.{os.getpid()}")
+        generate_building(layout, numbering, seed, tmp, spacing=spacing)
+        try:
+            os.rename(tmp, out)
+        except OSError:  # another process put it there first: the same building
+            shutil.rmtree(tmp, ignore_errors=True)
+    return out / "scenario.yaml"
 
 
 class GeneratedDoorSearchEnv(DoorSearchEnv):

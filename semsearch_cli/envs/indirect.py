@@ -188,7 +188,7 @@ class IndirectSearchEnv(SearchEnv):
                          "Answer 0 to drive forward, 1 to turn left, 2 to turn right, 3 to wait (one frame).")
             return clip_text("\n".join(lines))
         return {"belief": self._belief(), "secondary": self._secondary(),
-                "pose": np.array([st.x, st.y, st.heading], np.float32),
+                "pose": np.array([st.x, st.y, wrap_angle(st.heading)], np.float32),
                 "time": np.array([t_s, float(self.episode.goal)], np.float32)}
 
     def render(self):

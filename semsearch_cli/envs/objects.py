@@ -8,8 +8,9 @@ Action modes
 ------------
 ``macro`` (default): ``Discrete(P)``, one action per place of ``objects.places`` (in the
 scenario's order): drive there on the recorded map, sensing at every step, and look around on
-arrival (three quarter turns), as the object planners' targets are driven. Every place is valid
-(``info["action_mask"]``).
+arrival (three quarter turns), as the object planners' targets are driven. ``info["action_mask"]``
+holds every place but the one the robot has just looked around at; choosing that one, or a place
+with no path, travels nothing and the agent chooses again.
 
 ``primitive``: ``Discrete(10)``: 0-7 move ``robot.step`` m towards east, north-east, ..., south-east
 (a move into a cell the robot's disk does not fit in leaves it where it is), 8 and 9 turn 45 degrees;
@@ -90,6 +91,7 @@ class ObjectSearchEnv(SearchEnv):
         log = t.logs[req.case]
         self.ctx = ObjectContext(t.world.frame, t.known, t.places, list(t.route), t.world.start_xy, req.cls, req.hour, log, self.rng)
         self.feed = _Feed()
+        self.here = None  # the place the robot arrived at and looked around
         self.search = ObjectSearch(t, self.feed, req.cls, instances, camera, self.ctx, self.rng)
         self.search.planner_name = "agent"
         cls_log = log[log["class"] == req.cls]
@@ -125,20 +127,27 @@ class ObjectSearchEnv(SearchEnv):
             e = self.task.sc.experiment
             budget = st.distance >= e.max_distance or st.steps >= self.task.max_steps()
             return moved, "found" if found else "budget" if budget else None
-        if self.search.look:  # on arriving at the last place: look around before going on
-            self.search.look = False
-            if self.search._look_around(st):
-                return 0.0, "found"
         x, y = self.task.places[self.names[a]]
         self.feed.next = (x, y, {"place": self.names[a]})
         p = self.search.plan(st)
-        if p == "not_found":  # no path to that place on the recorded map: nothing travelled, choose again
+        if p == "not_found":  # no path to that place (or the robot stands there): nothing travelled, choose again
             return 0.0, None
+        self.here = None
         out = self.stepper.follow(p)
+        if out is None:  # arrived (the path used up): look around there now, as the batch does next
+            self.here = a
+            self.search.look = False
+            if self.search._look_around(st):
+                out = self.stepper.follow("found")
         return st.distance - d0, out
 
     def action_masks(self) -> np.ndarray:
-        return np.ones(self.action_space.n, bool)
+        """Macro: every place but the one the robot has just looked around at (choosing it again
+        would travel nothing and see nothing new); primitive: every action."""
+        m = np.ones(self.action_space.n, bool)
+        if self.action_mode == "macro" and self.here is not None:
+            m[self.here] = False
+        return m
 
     def _info(self) -> dict:
         return {**super()._info(), "action_mask": self.action_masks()}
@@ -168,7 +177,7 @@ class ObjectSearchEnv(SearchEnv):
                          + "; 8 to turn left, 9 to turn right (45 deg).")
             return clip_text("\n".join(lines))
         return {"places": self._places(), "hour": np.array([self.request.hour], np.float32),
-                "pose": np.array([st.x, st.y, st.heading], np.float32)}
+                "pose": np.array([st.x, st.y, wrap_angle(st.heading)], np.float32)}
 
     def render(self):
         if self.render_mode != "rgb_array" or self.episode is None:

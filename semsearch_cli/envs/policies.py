@@ -6,8 +6,9 @@
     while not done:
         obs, reward, terminated, truncated, info = env.step(policy(env)); done = terminated or truncated
 
-The planner sees what it sees in the batch (the belief, the pose, the candidates) and its choice
-becomes the candidate's slot, so the run is the one ``semsearch run`` records for that episode and
+The planner sees what it sees in the batch (the belief, the pose, every candidate) and its choice
+becomes the candidate's slot (planners that choose among the frontier candidates: greedy, nsos,
+geometric, draft; bvp picks cells of its own and cannot), so the run is the one ``semsearch run`` records for that episode and
 seed (tests/test_envs.py checks it run for run).
 """
 
@@ -41,8 +42,11 @@ class PlannerPolicy:
         dec = self.planner.choose(ctx, cands)
         if dec is None:
             return u.sweep_action
-        k = np.flatnonzero((cands.rows == dec.row) & (cands.cols == dec.col))
-        if k.size == 0 or k[0] >= u.K:
-            where = "is not a candidate" if k.size == 0 else f"is candidate {k[0]}, beyond max_candidates={u.K}"
+        k = np.flatnonzero((cands.rows[u.slots] == dec.row) & (cands.cols[u.slots] == dec.col))
+        if k.size == 0:
+            inside = ((cands.rows == dec.row) & (cands.cols == dec.col)).any()
+            where = (f"is not among the {u.K} nearest candidates the environment shows (max_candidates)" if inside
+                     else "is not a frontier candidate (a planner that picks cells of its own, as bvp does, cannot run "
+                          "as a policy of the macro environment)")
             raise PlannerError(f"planner {self.variant.label!r} chose the cell ({dec.row}, {dec.col}), which {where}")
         return int(k[0])
