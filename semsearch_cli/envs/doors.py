@@ -258,7 +258,7 @@ class DoorSearchEnv(SearchEnv):
             sg[k] = (1.0, float(same), -1.0 if p is None else min(p.number, BIG), dx, dy, facing)
         g = self.goal_label
         buf["goal"][:] = (-1.0, 0.0) if g is None else (min(g.number, BIG), float(bool(g.prefix or g.suffix)))
-        buf["pose"][:] = (st.x, st.y, wrap_angle(st.heading))
+        buf["pose"][:] = (st.x, st.y, (st.heading + math.pi) % (2 * math.pi) - math.pi)
         obs = {k: buf[k].copy() for k in ("occupancy", "explored", "signs", "goal", "pose")}
         if self.action_mode == "macro":
             cm, tg = buf["candidates"], buf["targets"]
