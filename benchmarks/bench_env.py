@@ -2,7 +2,7 @@
 beside them in the same run.
 
     pip install 'semsearch[gym]' minigrid     # irsim-x too, for its column
-    python benchmarks/bench_env.py [--steps 20000] [--repeat 5] [--out FILE.md]
+    python benchmarks/bench_env.py [--steps 20000] [--repeat 5] [--md FILE]
 
 One process, random actions (``action_space.sample()``; macro actions drawn among the valid ones
 of ``info["action_mask"]``), no rendering, environments made with ``gymnasium.make`` as a user would
@@ -31,6 +31,8 @@ from pathlib import Path
 import cv2
 import gymnasium as gym
 import numpy as np
+
+from output import emit
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -102,7 +104,7 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--macro-steps", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--md", type=Path, default=None, help="also write the table as Markdown")
     a = ap.parse_args()
     hotel = str(ROOT / "configs/hotel.yaml")
     cases = {"semsearch primitive (hotel)": (lambda: gym.make("semsearch/DoorSearch-v0", scenario=hotel, action_mode="primitive"), a.steps, False),
@@ -130,11 +132,7 @@ def main() -> int:
         med = statistics.median(v)
         ratio = f"{med / base:.2f}" if base else ""
         lines.append(f"| {k} | {med:,.0f} | {min(v):,.0f} | {max(v):,.0f} | {ratio} |")
-    text = "\n".join(lines)
-    print(text)
-    if a.out:
-        a.out.write_text(text + "\n")
-    return 0
+    return emit("\n".join(lines), a.md)
 
 
 if __name__ == "__main__":

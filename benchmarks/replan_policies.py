@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import yaml
+from output import emit
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -95,10 +96,7 @@ def main() -> int:
     verdict = ok and still
     text.append(f"events as the default: {'yes' if verdict else 'no'} (every interval inside +-5%: {'yes' if ok else 'no'}; "
                 f"nsos against greedy keeps its sign: {'yes' if still else 'no'})")
-    print("\n".join(text))
-    if a.md:
-        a.md.write_text("\n".join(text) + "\n")
-    return 0
+    return emit("\n".join(text), a.md)
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@ import cv2
 import numpy as np
 import pandas as pd
 import yaml
+from output import emit
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -104,10 +105,7 @@ def main() -> int:
                      "found": f"{(g['outcome_raw'] == 'found').mean():.0%}, {(g['outcome_clean'] == 'found').mean():.0%}"})
     text = [f"SLAM-like demo map: {int(added.sum())} ray cells added through the walls", *notes, "",
             markdown_table(pd.DataFrame(rows))]
-    print("\n".join(text))
-    if a.md:
-        a.md.write_text("\n".join(text) + "\n")
-    return 0
+    return emit("\n".join(text), a.md)
 
 
 if __name__ == "__main__":

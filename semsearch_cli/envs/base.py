@@ -16,6 +16,7 @@ no step of the loop); ``truncated`` at the scenario's budget
 
 from __future__ import annotations
 
+import math
 import string
 from pathlib import Path
 
@@ -76,6 +77,31 @@ def window(a: np.ndarray, r: int, c: int, radius: int, out: np.ndarray) -> np.nd
     if a0 < a1 and b0 < b1:
         out[a0 - r0:a1 - r0, b0 - c0:b1 - c0] = a[a0:a1, b0:b1]
     return out
+
+
+COMPASS = ("east", "north-east", "north", "north-west", "west", "south-west", "south", "south-east")
+TWO_PI = 2.0 * math.pi
+
+
+def compass_step(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
+    """The primitive actions of a robot on a grid, applied to ``st`` (a RobotState): 0-7 move
+    ``step`` m towards ``COMPASS[a]``, the heading turning to it (a move into a cell where the
+    robot's disk does not fit, ``cspace`` False, leaves it where it is); 8 and 9 turn 45 degrees
+    left and right. Counts the step and the trail; returns the metres moved."""
+    moved = 0.0
+    if a < 8:
+        ang = a * math.pi / 4
+        x, y = st.x + step * math.cos(ang), st.y + step * math.sin(ang)
+        _, _, r, c = frame.point_to_cell(x, y)
+        st.heading = (ang + math.pi) % TWO_PI - math.pi
+        if 0 <= r < frame.height and 0 <= c < frame.width and cspace[r, c]:
+            st.x, st.y, moved = x, y, step
+    else:
+        st.heading = (st.heading + (math.pi / 4 if a == 8 else -math.pi / 4) + math.pi) % TWO_PI - math.pi
+    st.distance += moved
+    st.steps += 1
+    st.trail.append((st.x, st.y))
+    return moved
 
 
 def box(low, high, shape=None) -> gym.spaces.Box:

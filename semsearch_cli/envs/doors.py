@@ -52,9 +52,7 @@ from ..planners import Decision
 from ..tasks.doors import MAX_RETRIES, DoorSearch
 from ..tasks.loop import Stepper
 from ..world.labels import parse_label
-from .base import BIG, SearchEnv, box, clip_text, text_space, window
-
-DIRECTIONS = ("east", "north-east", "north", "north-west", "west", "south-west", "south", "south-east")
+from .base import BIG, COMPASS, SearchEnv, box, clip_text, compass_step, text_space, window
 
 
 class _Agent:
@@ -185,20 +183,8 @@ class DoorSearchEnv(SearchEnv):
         return st.distance - d0, out
 
     def _primitive(self, a: int) -> float:
-        st, fr = self.state, self.task.world.frame
-        moved = 0.0
-        if a < 8:
-            ang = a * math.pi / 4
-            x, y = st.x + self.step_m * math.cos(ang), st.y + self.step_m * math.sin(ang)
-            _, _, r, c = fr.point_to_cell(x, y)
-            st.heading = float(wrap_angle(ang))
-            if 0 <= r < fr.height and 0 <= c < fr.width and self._cspace[r, c]:
-                st.x, st.y, moved = x, y, self.step_m
-        else:
-            st.heading = float(wrap_angle(st.heading + (math.pi / 4 if a == 8 else -math.pi / 4)))
-        st.distance += moved
-        st.steps += 1
-        st.trail.append((st.x, st.y))
+        st = self.state
+        moved = compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
         self._found, _ = self.search.sense(st)
         self.search.update(st)
         return moved
@@ -299,7 +285,7 @@ class DoorSearchEnv(SearchEnv):
                     f"leading {math.degrees(t):.0f} deg" for k, (x, y, t) in enumerate(zip(xs, ys, cands.theta))) + ".")
             lines.append(f"Answer with a target's number, or {self.K} to look at the nearest wall not yet read.")
         else:
-            lines.append("Answer with 0-7 to move 0.1 m " + ", ".join(f"{k} {d}" for k, d in enumerate(DIRECTIONS))
+            lines.append("Answer with 0-7 to move 0.1 m " + ", ".join(f"{k} {d}" for k, d in enumerate(COMPASS))
                          + "; 8 to turn left, 9 to turn right (45 deg).")
         return clip_text("\n".join(lines))
 

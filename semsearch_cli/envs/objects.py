@@ -41,9 +41,7 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..tasks.loop import Stepper
 from ..tasks.objects import ObjectSearch
-from .base import BIG, SearchEnv, box, clip_text, text_space
-
-DIRECTIONS = ("east", "north-east", "north", "north-west", "west", "south-west", "south", "south-east")
+from .base import BIG, COMPASS, SearchEnv, box, clip_text, compass_step, text_space
 
 
 class _Feed:
@@ -109,20 +107,7 @@ class ObjectSearchEnv(SearchEnv):
         d0 = st.distance
         a = int(action)
         if self.action_mode == "primitive":
-            moved = 0.0
-            fr = self.task.world.frame
-            if a < 8:
-                ang = a * math.pi / 4
-                x, y = st.x + self.step_m * math.cos(ang), st.y + self.step_m * math.sin(ang)
-                _, _, r, c = fr.point_to_cell(x, y)
-                st.heading = float(wrap_angle(ang))
-                if 0 <= r < fr.height and 0 <= c < fr.width and self._cspace[r, c]:
-                    st.x, st.y, moved = x, y, self.step_m
-            else:
-                st.heading = float(wrap_angle(st.heading + (math.pi / 4 if a == 8 else -math.pi / 4)))
-            st.distance += moved
-            st.steps += 1
-            st.trail.append((st.x, st.y))
+            moved = compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
             found = self.search.sense(st)[0]
             e = self.task.sc.experiment
             budget = st.distance >= e.max_distance or st.steps >= self.task.max_steps()
@@ -173,7 +158,7 @@ class ObjectSearchEnv(SearchEnv):
                          f"{'seen' if p[2] else 'not seen'}, {p[3]:.0f} past detections ({p[4]:.0f} within an hour of now)"
                          for k, (n, p) in enumerate(zip(self.names, pl))) + "."]
             lines.append("Answer with a place's number." if self.action_mode == "macro" else
-                         "Answer with 0-7 to move " + ", ".join(f"{k} {d}" for k, d in enumerate(DIRECTIONS))
+                         "Answer with 0-7 to move " + ", ".join(f"{k} {d}" for k, d in enumerate(COMPASS))
                          + "; 8 to turn left, 9 to turn right (45 deg).")
             return clip_text("\n".join(lines))
         return {"places": self._places(), "hour": np.array([self.request.hour], np.float32),
