@@ -128,7 +128,7 @@ class NavigationSpec(Strict):
     replan_every: float = Field(1.0, gt=0.0, le=MAX_COORD, description="m travelled between periodic re-plans")
     replan: Literal["periodic", "events"] = Field(
         "periodic", description="door search: periodic re-plans every replan_every m (the thesis' tables), or only on "
-        "what changes the decision (the path used up, a free cell of the map lost, the target visited, a sign read)")
+        "what changes the decision or the path (the path used up, a sign read, a free cell of the map lost)")
 
 
 class EpisodeSpec(Strict):

@@ -86,8 +86,6 @@ class DoorSearchEnv(SearchEnv):
             raise ValueError("max_candidates must lie in 1..254")
         self.R, self.K, self.S = int(window), int(max_candidates), int(max_signs)
         self.replan_on_signs = bool(replan_on_signs)
-        sc, w = self.task.sc, self.task.world
-        self.step_m = sc.robot.step
         self.sweep_action = self.K
         n = 2 * self.R + 1
         grid = gym.spaces.Box(0, 2, (n, n), np.uint8)
@@ -103,8 +101,14 @@ class DoorSearchEnv(SearchEnv):
             self.action_space = gym.spaces.Discrete(10)
         self.observation_space = gym.spaces.Dict(spaces) if observation_mode == "dict" else text_space()
         self._buf = {k: np.zeros(s.shape, s.dtype) for k, s in spaces.items()}
-        self._cspace = w.cspace
+        self._free = np.zeros((n, n), np.uint8)
+        self.bind(self.task)
         self.decision = None  # (PlanContext, Candidates) while the agent is to choose (macro)
+
+    def bind(self, task) -> None:
+        """Run ``task`` from the next reset on, with what the steps read of it."""
+        self.task, self.step_m, self._cspace = task, task.sc.robot.step, task.world.cspace
+        self._facing = wrap_angle(task.world.signs.facing)  # the signs' facings in [-pi, pi), for the observation
 
     @property
     def budget(self) -> float:
@@ -113,9 +117,7 @@ class DoorSearchEnv(SearchEnv):
 
     @property
     def step_limit(self) -> int:
-        """Steps: the scenario's ``experiment.max_steps``, else 1.5 times the steps the budget takes."""
-        e = self.task.sc.experiment
-        return e.max_steps or int(np.ceil(self.budget / self.step_m * 1.5)) + 100
+        return self.task.max_steps(self.budget)
 
     # ---- episode ----------------------------------------------------------------------
     def _begin(self) -> None:
@@ -218,8 +220,8 @@ class DoorSearchEnv(SearchEnv):
     def _signs(self):
         """(index, label, dx, dy, facing) of the signs read so far, nearest first."""
         st, sg = self.state, self.task.world.signs
-        out = [(i, lab, float(sg.x[i]) - st.x, float(sg.y[i]) - st.y, float(wrap_angle(sg.facing[i])))
-               for i, lab in st.read_signs.items()]
+        facing = self._facing
+        out = [(i, lab, float(sg.x[i]) - st.x, float(sg.y[i]) - st.y, float(facing[i])) for i, lab in st.read_signs.items()]
         out.sort(key=lambda s: s[2] * s[2] + s[3] * s[3])
         return out
 
@@ -231,7 +233,8 @@ class DoorSearchEnv(SearchEnv):
         occ = buf["occupancy"]
         occ.fill(0)
         window(b.seen, r, c, self.R, occ)
-        free = np.zeros_like(occ)
+        free = self._free
+        free.fill(0)
         window(b.free, r, c, self.R, free)
         occ[(occ > 0) & (free == 0)] = 2
         buf["explored"].fill(0)

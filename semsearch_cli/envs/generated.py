@@ -66,9 +66,7 @@ class GeneratedDoorSearchEnv(DoorSearchEnv):
         options = dict(options or {})
         b = options.pop("building", None)
         self.building_seed = self.first + int(self.np_random.integers(self.buildings)) if b is None else int(b)
-        self.task = load_task(building(self.layout, self.numbering, self.building_seed, self.spacing), self.kind)
-        self._cspace = self.task.world.cspace
-        self.step_m = self.task.sc.robot.step
+        self.bind(load_task(building(self.layout, self.numbering, self.building_seed, self.spacing), self.kind))
         obs, info = super().reset(options=options)
         self._reset_options = {**self._reset_options, "building": self.building_seed}
         return obs, info

@@ -45,7 +45,7 @@ from ..geometry import wrap_angle
 from ..planners import Goal
 from ..tasks.indirect import IndirectSearch
 from ..tasks.loop import Stepper
-from .base import BIG, SearchEnv, box, clip_text, text_space
+from .base import BIG, TWO_PI, SearchEnv, box, clip_text, text_space
 
 HEADINGS = np.radians(np.arange(0, 360, 45))
 
@@ -126,13 +126,14 @@ class IndirectSearchEnv(SearchEnv):
             dt = 1.0 / spec.camera.fps
             if a == 0:
                 x, y = st.x + spec.robot.speed * dt * math.cos(st.heading), st.y + spec.robot.speed * dt * math.sin(st.heading)
-                r, c = self.grid.frame.to_index(x, y)
+                _, _, r, c = self.grid.frame.point_to_cell(x, y)
                 H, W = self.grid.stand.shape
                 if 0 <= r < H and 0 <= c < W and self.grid.stand[r, c]:
                     st.distance += math.hypot(x - st.x, y - st.y)
                     st.x, st.y = float(x), float(y)
             elif a in (1, 2):
-                st.heading = float(wrap_angle(st.heading + (1 if a == 1 else -1) * math.radians(spec.robot.turn_rate) * dt))
+                turn = (1 if a == 1 else -1) * math.radians(spec.robot.turn_rate) * dt
+                st.heading = (st.heading + turn + math.pi) % TWO_PI - math.pi
             st.steps += 1
             st.trail.append((st.x, st.y))
             found, _ = self.search.sense(st)

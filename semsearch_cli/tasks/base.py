@@ -331,9 +331,12 @@ class Task:
         """The room an episode searches (indirect search), else empty."""
         return ""
 
-    def max_steps(self) -> int:
+    def max_steps(self, max_distance: float | None = None) -> int:
+        """The step limit: ``experiment.max_steps``, else 1.5 times the steps that
+        ``max_distance`` (default: ``experiment.max_distance``) takes, and 100 more."""
         e = self.sc.experiment
-        return e.max_steps or int(np.ceil(e.max_distance / self.sc.robot.step * 1.5)) + 100
+        budget = e.max_distance if max_distance is None else max_distance
+        return e.max_steps or int(np.ceil(budget / self.sc.robot.step * 1.5)) + 100
 
     # ---- beside the runs --------------------------------------------------------------
     def write_inputs(self, out: Path) -> None:

@@ -79,7 +79,7 @@ class DoorSearch(DoorSensing):
         self.uses_signs = getattr(planner, "replan_on_signs", False)
         self.replan_every = task.sc.navigation.replan_every
         self.periodic = task.sc.navigation.replan == "periodic"
-        self._belief = None
+        self._belief = None  # the belief and its lost-cell count when the path was planned (events)
         self._lost_at_plan = 0
         self.looked_around = False
         self.decisions = 0
@@ -103,10 +103,6 @@ class DoorSearch(DoorSensing):
         # the robot's clearance from unknown space too, so a newly seen wall cannot come closer
         # than that otherwise)
         return self._belief.lost != self._lost_at_plan
-
-    def update(self, st) -> None:
-        super().update(st)
-        self._belief = st.belief
 
     def turn(self, st, turns: int, angle: float, frames: int = 1) -> bool:
         """Turn on the spot ``turns`` times by ``angle`` radians, sensing ``frames`` times after
@@ -219,7 +215,7 @@ class DoorSearch(DoorSensing):
         if p is not None and len(p[0]) >= 2:
             self.looked_around = False
             self.target = (dec.row, dec.col)
-            self._lost_at_plan = b.lost
+            self._belief, self._lost_at_plan = b, b.lost
             return fr.to_world(p[0], p[1])
         return None
 
