@@ -11,7 +11,7 @@ interval as a share of the periodic mean, the Wilcoxon p, and the wall time of e
 per policy, nsos against greedy on the same goals and seeds (per-run differences, 95% bootstrap
 interval over the runs, Wilcoxon p).
 The events policy may become the default only if every planner's interval lies inside +-5% of its
-mean and nsos still beats greedy (issue 27's rule); the script says whether it does.
+mean and nsos still beats greedy (the rule for making it the default); the script says whether it does.
 """
 
 from __future__ import annotations

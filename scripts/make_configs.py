@@ -20,6 +20,7 @@ from semsearch_cli.world.office import office_image, office_scenario
 
 PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
 
+SCHEMA_LINE = "# yaml-language-server: $schema=scenario.schema.json\n"  # editors' completion and checking (semsearch schema)
 # name: (layout, numbering, seed, spacing m, signs, goals, floor digit, density delta m^2, description)
 LIBRARY = {
     "normal": ("grid", "corridor-parity", 3, 2.7, 113, [54, 55, 111, 124], 2, 4.5,
@@ -48,7 +49,7 @@ def main() -> None:
         p.unlink()
         scen["map"]["image"] = f"../maps/{name}/map.png"
         scen["doors"] = f"../maps/{name}/doors.csv"
-        header = (f"# {name}: {signs} signs, goals {', '.join(map(str, goals))} (as the thesis' Table 4.1); {what}.\n"
+        header = (SCHEMA_LINE + f"# {name}: {signs} signs, goals {', '.join(map(str, goals))} (as the thesis' Table 4.1); {what}.\n"
                   f"# Our own building: semsearch generate building --layout {lay} --numbering {scheme} --seed {seed} "
                   f"--spacing {spacing} --signs {signs} (floor digit {floor}); regenerate with scripts/make_configs.py.\n")
         if name in EPISODES:
@@ -67,7 +68,7 @@ def main() -> None:
         print(f"configs/{name}.yaml")
     (root / "maps" / "office").mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(root / "maps" / "office" / "map.png"), office_image())
-    header = ("# office: object search over time (thesis 5.3): 20.5 m x 14.5 m, seven rooms, places A-J,\n"
+    header = (SCHEMA_LINE + "# office: object search over time (thesis 5.3): 20.5 m x 14.5 m, seven rooms, places A-J,\n"
               "# the mug patterns of Table 5.1, requests at 12:00 and 00:00 (ground truth of Table 5.2),\n"
               "# the combined-patterns run and the moved-mug run. Regenerate with scripts/make_configs.py.\n")
     scen = office_scenario(image="../maps/office/map.png")
@@ -77,7 +78,7 @@ def main() -> None:
     folder.mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(folder / "map.png"), hospital_image())
     write_doors(folder / "doors.csv", hospital_signs())
-    header = ("# hospital: chained searches (thesis ch. 6): twenty numbered rooms off two crossing corridors,\n"
+    header = (SCHEMA_LINE + "# hospital: chained searches (thesis ch. 6): twenty numbered rooms off two crossing corridors,\n"
               "# objects with timelines in rooms 12 and 15, chains of 3-5 stages (door signs, then objects in\n"
               "# the room behind a door). Regenerate with scripts/make_configs.py.\n")
     scen = hospital_scenario(image="../maps/hospital/map.png", doors="../maps/hospital/doors.csv")

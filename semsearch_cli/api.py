@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from contextlib import nullcontext
@@ -11,7 +12,7 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from .config import PlannerSpec, load_scenario, read_yaml, with_param
+from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .errors import ScenarioError
 from .planners import PLANNERS, expand_variants, load_entry_points
 from .report import build as report_build
@@ -19,6 +20,7 @@ from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Loaded, check_folder, check_kind, expand, folder_lock, make_executor, run_batch, run_rows
+from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import inside, output_file, output_folder, temp_path
@@ -130,12 +132,21 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
 def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
                 goals=None, out: str | Path | None = None, progress=None, trace: bool = False, force: bool = False,
                 oversubscribe: bool = False, executor: str = "processes", scheduler: str | None = None) -> RunOutput:
-    """nsos at each alpha with greedy beside it: the rows and summary of :func:`run`, plus
-    ``plots/alpha_sweep.png``. Other nsos parameters come from the scenario's first nsos entry."""
+    """The planner that sweeps alpha (:attr:`Planner.swept`: nsos) at each alpha with the baseline
+    planner (:attr:`Planner.baseline`: greedy) beside it: the rows and summary of :func:`run`, plus
+    ``plots/alpha_sweep.png``. The swept planner is the scenario's first entry of one that sweeps
+    alpha (its other parameters kept), else the built-in one of the scenario's kind."""
     sc = load_scenario(scenario)
-    base = next((p.params() for p in sc.planners if p.name == "nsos"), {})
+    answers = TASKS[sc.kind].planner_kind
+    sweeping = {n: c for n, c in PLANNERS.items() if c.swept == "alpha" and c.task == answers}
+    baseline = next((n for n, c in PLANNERS.items() if c.baseline and c.task == answers), None)
+    if not sweeping or baseline is None:
+        raise ScenarioError(str(scenario), "kind", f"no planner of a {sc.kind} scenario sweeps alpha against a baseline")
+    entry = next((p for p in sc.planners if p.name in sweeping), None)
+    name = entry.name if entry is not None else next(iter(sweeping))
+    base = entry.params() if entry is not None else {}
     base.pop("alpha", None)
-    specs = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[float(a) for a in alphas], **base)]
+    specs = [PlannerSpec(name=baseline), PlannerSpec(name=name, alpha=[float(a) for a in alphas], **base)]
     res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs, force=force,
               oversubscribe=oversubscribe, executor=executor, scheduler=scheduler)
     labels = {v.label for v in expand_variants(specs, str(scenario))}
@@ -279,6 +290,22 @@ def imported(importer, out: str | Path, *args, **kwargs) -> tuple[Path, list[str
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return out / path.name, notes
+
+
+def schema_text() -> str:
+    """The scenario JSON Schema (every kind's model), as ``semsearch schema`` writes it."""
+    return json.dumps(scenario_schema(), indent=2) + "\n"
+
+
+def schema(out: str | Path | None = None) -> Path | None:
+    """Write the scenario JSON Schema to ``out`` (.json, atomically); None: return nothing (the
+    caller prints :func:`schema_text`). Editors read it through the first line of a scenario,
+    ``# yaml-language-server: $schema=PATH``, for completion and checking as you type."""
+    if out is None:
+        return None
+    path = output_file(out, "--out", (".json",))
+    atomic_text(path, schema_text())
+    return path
 
 
 def validate(scenario: str | Path) -> dict:

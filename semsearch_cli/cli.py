@@ -326,6 +326,22 @@ def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
 
 
 @app.command()
+def schema(out_file: Optional[str] = typer.Option(None, "--out", callback=_path, help="JSON file to write (default: print it).")):
+    """The scenario format as a JSON Schema: every field of every kind of search, with its type,
+    default, bounds and description. Point an editor at it with a scenario's first line,
+    `# yaml-language-server: $schema=scenario.schema.json`, for completion and checking."""
+
+    try:
+        path = api.schema(out_file)
+    except ScenarioError as exc:
+        _fail(exc)
+    if path is None:
+        sys.stdout.write(api.schema_text())
+    else:
+        out.print(f"wrote {path}")
+
+
+@app.command()
 def show(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
     out_file: str = typer.Option("map.png", "--out", callback=_path, help="Image to write: .png, .pdf or .svg."),

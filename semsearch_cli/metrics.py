@@ -1,4 +1,4 @@
-"""A finished run -> one flat row (SPEC 9)."""
+"""A finished run -> one flat row."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """A catalogue of hostile inputs: every kind of bad input a user (or a damaged disk) can give the
-command line, each with what must happen. The tests run the cases from issue 14 in-process
+command line, each with what must happen. The tests run the cases that first crashed it in-process
 (``test_hostile.py``); ``benchmarks/hostile.py`` runs every case as a real process, with a time
 limit, and tabulates the outcomes by category.
 
@@ -31,7 +31,7 @@ class Case:
     name: str
     args: list[str]
     expect: str = "refuse"  # refuse | accept | either (no traceback, no hang)
-    issue: bool = False  # a defect listed in issue 14 (the tests run these)
+    issue: bool = False  # a defect found in the first hostile review (the tests run these)
     says: tuple = ()  # text the output must hold (the field or flag blamed, the file named)
     cwd: Path | None = field(default=None, repr=False)
 
@@ -101,7 +101,7 @@ def build_cases(root: Path) -> list[Case]:
     indirect_fields = ["indirect.time_limit", "indirect.resolution", "indirect.replan_every", "indirect.view_scales.0",
                        "indirect.camera.secondary_range", "indirect.camera.fps", "indirect.robot.speed",
                        "indirect.robot.radius", "indirect.rooms.size.0", "indirect.p_outside"]
-    # issue 14: .inf (and 1e9) crashed ranges, radii and the budget; NaN went through headings, facings, places
+    # first found: .inf (and 1e9) crashed ranges, radii and the budget; NaN went through headings, facings, places
     issue_numbers = {f: ("inf", "1e9") for f in ("door_camera.range", "laser.range", "objects.camera.range", "experiment.max_distance",
                                                  "belief.visited_radius", "belief.density_radius")}
     issue_numbers |= {f: ("nan",) for f in ("start.heading", "objects.places.0.facing", "objects.places.0.x")}
@@ -305,7 +305,7 @@ def build_cases(root: Path) -> list[Case]:
                   ["doors"], [{"number": 1, "x": 150.0, "y": 110.05, "facing": -90}, {"number": 2, "x": 180.0, "y": 89.95, "facing": 90}])
     add("resources", "a 2000 x 2000 map validates", ["validate", scen("big2000", _set(bigdoc, ["goals"], [1, 2]))], "accept")
 
-    # -- issue 26: other commands, importers, planners, paths (process faults: tests/test_faults.py)
+    # -- other commands, importers, planners, paths (process faults: tests/test_faults.py)
     counts = root / "counts"
     counts.mkdir(exist_ok=True)
     for name, text in (("negative", "hour,A\n1,-2\n"), ("infinite", "hour,A\n1,inf\n"), ("header only", "hour,A\n"),

@@ -1,4 +1,4 @@
-"""Process faults end cleanly and lose nothing (issue 26, class 1): a parent killed alone takes its
+"""Process faults end cleanly and lose nothing: a parent killed alone takes its
 workers with it and frees its folder; a killed worker, SIGTERM and a full disk end with one
 paragraph, never a traceback; rows are never lost or doubled, and the same command resumes."""
 

@@ -1,4 +1,4 @@
-"""Figures for papers (issue 24, item 5): every image format, the success-vs-budget curve, the
+"""Figures for papers: every image format, the success-vs-budget curve, the
 alpha figure only for two alphas or more, the replay chosen on the command line."""
 
 import json
@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
 from semsearch_cli.report import stats
-from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, nsos_alphas, planner_colors, thin_labels
+from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, swept_values, planner_colors, thin_labels
 from semsearch_cli.report.runfiles import load_paths, median_label, stems
 
 MAGIC = {"png": b"\x89PNG", "pdf": b"%PDF", "svg": b"<?xml"}
@@ -155,7 +155,7 @@ def synthetic_folder(path, alphas):
 @pytest.mark.parametrize("alphas,drawn", [((0.9,), False), ((0.8, 0.9), True)])
 def test_alpha_figure_only_for_two_alphas(tmp_path, alphas, drawn):
     folder = synthetic_folder(tmp_path / "s", alphas)
-    assert nsos_alphas(pd.read_csv(folder / "runs.csv")) == list(alphas)
+    assert swept_values(pd.read_csv(folder / "runs.csv")) == list(alphas)
     res = report(folder, "--format", "png,md", "--no-replay")
     assert res.exit_code == 0, res.output
     assert (folder / "figures" / "alpha_s.png").is_file() == drawn

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.config import Scenario
+from semsearch_cli.config import scenario_schema
 
 from .hostile_inputs import demo_base
 
@@ -29,7 +29,7 @@ settings.register_profile("nightly", max_examples=2000, deadline=None,
                           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 FUZZ = settings(settings.get_profile(os.environ.get("SEMSEARCH_FUZZ", "ci")))
 
-SCHEMA = Scenario.model_json_schema()
+SCHEMA = scenario_schema()
 runner = CliRunner()
 _TMP = tempfile.TemporaryDirectory(prefix="semsearch-fuzz-")
 ROOT = Path(_TMP.name)

@@ -1,4 +1,4 @@
-"""The other commands check what they are given (issue 26, class 5): each bad input below is exit 2
+"""The other commands check what they are given: each bad input below is exit 2
 with one paragraph naming the option, file or field, never a traceback."""
 
 import shutil

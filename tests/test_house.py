@@ -41,24 +41,8 @@ def demo_data(**over) -> dict:
 
 
 def small_scenario(kind: str, planner: str, tmp_path: Path) -> Path:
-    """A small scenario of ``kind`` run by ``planner`` (for the chain: greedy's door stages)."""
-    if kind == "doors":
-        return write_scenario(tmp_path, demo_data(goals=[452], planners=[{"name": planner}], experiment={"seeds": 1, "max_distance": 300}))
-    if kind == "objects":
-        d = yaml.safe_load((CONFIGS / "office.yaml").read_text())
-        d["map"]["image"] = str(ROOT / "maps" / "office" / "map.png")
-        d["objects"]["cases"] = [c for c in d["objects"]["cases"] if c["name"] == "Moved-mug"]
-        d["planners"] = [{"name": planner}]
-        d["experiment"] = {"seeds": 1, "max_distance": 300}
-        return write_scenario(tmp_path, d)
-    if kind == "indirect":
-        return write_scenario(tmp_path, {"name": "rooms", "indirect": {"rooms": {"count": 2, "seed": 1}, "view_scales": [1.5],
-                                                                       "time_limit": 60.0},
-                                         "planners": [{"name": planner}], "experiment": {"seeds": 2}})
-    d = demo_data(planners=[{"name": planner}], experiment={"seeds": 1, "max_distance": 600})
-    del d["goals"]
-    d["chains"] = [{"name": "two", "stages": [{"door": 452}, {"door": 304}, {"door": 452}]}]
-    return write_scenario(tmp_path, d)
+    """The kind's own small example, run by ``planner`` (for the chain: greedy's door stages)."""
+    return TASKS[kind].example(tmp_path / "example", planner)
 
 
 def cases():
@@ -81,6 +65,8 @@ def test_every_task_and_planner(kind, planner, tmp_path):
     a = run_batch(loaded, specs, tmp_path / "w1", workers=1)
     b = run_batch(back, specs, tmp_path / "w2", workers=2)
     assert set(a["kind"]) == {kind}
+    for col in TASKS[kind].records:  # what the kind says it records, it records
+        assert (a[col].astype(str) != "").all() and a[col].notna().all(), col
     assert (a["outcome"].isin(["found", "not_found", "stuck", "budget"])).all()
     assert (a["distance_m"] <= loaded.sc.experiment.max_distance + loaded.sc.robot.step).all()
     key = ["planner", "goal", "episode", "seed", "stage", "map"]

@@ -1,4 +1,4 @@
-"""Room labels with letters and separators are signs like any other (issue 26): parsed into a prefix,
+"""Room labels with letters and separators are signs like any other: parsed into a prefix,
 a number and a suffix; goals are matched on the whole label; nsos and the draft planner reason on
 the numbers of the signs that share the goal's prefix."""
 

@@ -1,4 +1,4 @@
-"""NSOS factors against values computed by hand (thesis 4.3, paper Eq. 16, SPEC 4)."""
+"""NSOS factors against values computed by hand (thesis 4.3, paper Eq. 16)."""
 
 import json
 import math
@@ -196,7 +196,7 @@ def test_rolling_histogram_matches_the_plain_one():
         assert np.allclose(rh.update(items), heading_histogram(items[-50:], 18, fold=False))
 
 
-# ---- the draft paper's planner (SPEC 4: tau + Omega + alpha Gamma) ------------------------------
+# ---- the draft paper's planner (tau + Omega + alpha Gamma) ------------------------------
 def test_draft_parity_attraction_follows_the_authors_code():
     from semsearch_cli.planners.doors.draft import parity_attraction
 

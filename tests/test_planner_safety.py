@@ -1,4 +1,4 @@
-"""A user's planner cannot take the batch down or lie (issue 26, class 2): an exit or exception in
+"""A user's planner cannot take the batch down or lie: an exit or exception in
 ``choose`` is that run's ``error``, one at import is exit 2 naming the file, a planner that hangs is
 ``timeout`` after ``experiment.run_time_limit``, a target off the map or in a wall is ``error``
 naming the planner and the value, and traces are strict JSON whatever ``Decision.info`` holds."""

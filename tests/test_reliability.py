@@ -1,6 +1,6 @@
 """Output folders are safe: one batch per folder, rows of another scenario never reused, a torn
 last line (even inside a quoted field) survives, garbage files are refused cleanly; user text is
-never read as console markup (issue 14)."""
+never read as console markup."""
 
 import fcntl
 import os

@@ -1,4 +1,4 @@
-"""The robot's belief, built from sensing only (SPEC 3): HIMM occupancy, visited region and its
+"""The robot's belief, built from sensing only: HIMM occupancy, visited region and its
 density classes, skeleton, clearance, door reads, frontier candidates.
 
 Per-step updates touch only a window around the robot; the derived maps (clearance, skeleton) are
@@ -29,11 +29,18 @@ MIN_BRANCH_CELLS = 3
 
 @dataclass
 class Candidates:
-    """Frontier candidates C (SPEC 4): one skeleton cell per branch leaving the visited region.
+    """Frontier candidates C: one skeleton cell per branch leaving the visited region, k of them
+    (``len(cands)``), as parallel arrays.
 
-    rows, cols : (k,) int64 cells; theta : (k,) float64, radians, the branch direction theta_f
-    pointing out of the visited region; seg_rows, seg_cols : (k,) int64, a visited cell the
-    candidate touches (its segment S(c) is the segment of that cell).
+    - ``rows``, ``cols``: (k,) int64, the candidate cells (grid indices; ``belief.frame.to_world``
+      gives metres);
+    - ``theta``: (k,) float64, radians counter-clockwise from +x, the branch direction theta_f
+      pointing out of the visited region;
+    - ``seg_rows``, ``seg_cols``: (k,) int64, a visited cell the candidate touches: its segment
+      S(c) is that cell's corridor segment (``belief.segment_door_lists`` gives the signs read
+      there).
+
+    ``take(idx)`` selects candidates; ``concat(other)`` joins two sets.
     """
 
     rows: np.ndarray
@@ -53,7 +60,7 @@ class Candidates:
 
 
 class DoorReads:
-    """Every sign read, kept so door lists can be rebuilt when segments change (SPEC 3).
+    """Every sign read, kept so door lists can be rebuilt when segments change.
 
     Reads are aggregated per (label, robot cell): ``cell``, ``label`` (index into ``labels``),
     ``count``, ``sx``, ``sy`` (sums of robot x, y in m) are arrays of the first ``n`` rows.
@@ -455,7 +462,7 @@ class Belief:
         return gs.path(tr, tc)
 
     def door_lists(self) -> dict:
-        """Door list of each visited segment (thesis 4.2.3, SPEC 3), rebuilt from every read.
+        """Door list of each visited segment (thesis 4.2.3), rebuilt from every read.
 
         Returns ``{segment: {label: (count, x, y)}}``: the signs read at least ``min_reads`` times
         in all, attached to the segment of the robot's cell at each read, with the number of reads

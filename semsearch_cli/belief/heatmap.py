@@ -1,4 +1,4 @@
-"""LSOS heat map and goals (thesis 5.2, Eqs. 5.3-5.6; SPEC 6). Pure functions of arrays.
+"""LSOS heat map and goals (thesis 5.2, Eqs. 5.3-5.6). Pure functions of arrays.
 
 Each recorded detection of the target class adds an inverted kernel (Eq. 5.4)
 ``IK = W(rh, hour) * Q * d / r`` for cells within Manhattan distance ``d <= r`` of the object,

@@ -1,5 +1,4 @@
-"""The probability map of the main object A in indirect search (Loncomilla et al. 2018, Section 3;
-SPEC 7).
+"""The probability map of the main object A in indirect search (Loncomilla et al. 2018, Section 3).
 
 The map holds p(a_ij) over the room's cells and p(a_0), the outside cell (Eqs. 6-9). Every
 observation multiplies it by a likelihood image (and the outside cell by a number) and
@@ -10,7 +9,7 @@ renormalises:
   frame given the frames before missed it); the outside cell 1.
 - B seen at cell c (Eqs. 8-9, 12-13): the likelihood image of B is 1 at c and 0 elsewhere, so the
   cross-likelihood (Eq. 14) is the relation mask centred on c, R_B/A(ij - c) / S(ij), and the
-  outside cell gets the image's mean, 1 / n (Eq. 13 as SPEC reads it).
+  outside cell gets the image's mean, 1 / n (Eq. 13 as we read it).
 - B not seen (Eqs. 8-9, 12-13): the likelihood image is ``1 - D_B`` (D_B as D_A); its convolution with the
   relation is ``1 - (D_B * R_B/A) / S``, done by FFT; the outside cell gets the image's mean.
 
@@ -23,7 +22,7 @@ away from the walls for no reason.
 Relation masks (Eqs. 18-32). A basic mask is a function of the offset between two cells, hard
 (rectangular profile) or soft (trapezoid, the gap delta), over every offset two cells of the map can
 have ((2H - 1) x (2W - 1)), normalised to sum 1 there. A class's mask mixes the four basic masks by
-its co-occurrences (Eq. 28 with SPEC's reading of Eq. 32). The "very far" mask reaches the whole
+its co-occurrences (Eq. 28 with our reading of Eq. 32). The "very far" mask reaches the whole
 map, so a convolution with it would cost a map-sized kernel: we write each mixed mask as a local
 part (within u3 + delta) plus a constant, R = l + kappa, so that D * R = D * l + kappa sum(D), and
 only the local part is convolved.

@@ -1,4 +1,4 @@
-"""Presence estimation from hourly counts per place (thesis 5.3.5, Eq. 5.3; SPEC 6).
+"""Presence estimation from hourly counts per place (thesis 5.3.5, Eq. 5.3).
 
 The score of a place at request hour rh is the sum over hours h of count(h, place) * W(rh, h),
 with W(rh, h) = 1 - dh / 12 and dh the hour difference on the 24-hour clock (23:00 and 01:00 are

@@ -1,5 +1,5 @@
 """The sections every scenario shares: map, start, door signs, planners, robot, sensors, belief,
-navigation, experiment (SPEC 1). Lengths are metres, angles degrees; every model forbids unknown
+navigation, experiment. Lengths are metres, angles degrees; every model forbids unknown
 keys, so a misspelt key is an error naming the field, and refuses NaN and infinity, so a number
 is always a number. Sizes have upper bounds (the Limits table in docs/usage.md) so that no value makes an
 array too big for memory or a loop that never ends."""
@@ -124,7 +124,8 @@ class BeliefSpec(Strict):
 
 
 class NavigationSpec(Strict):
-    navigator: Literal["geodesic", "harmonic"] = "geodesic"
+    navigator: str = Field("geodesic", pattern=r"^[A-Za-z0-9_\-]+$",
+                           description="a registered navigator: geodesic (the cheapest path) or harmonic (the thesis' BVP)")
     replan_every: float = Field(1.0, gt=0.0, le=MAX_COORD, description="m travelled between periodic re-plans")
     replan: Literal["periodic", "events"] = Field(
         "periodic", description="door search: periodic re-plans every replan_every m (the thesis' tables), or only on "

@@ -1,4 +1,4 @@
-"""The ``chains`` section: chained searches (thesis ch. 6, SPEC 8). A chain is an ordered list of
+"""The ``chains`` section: chained searches (thesis ch. 6). A chain is an ordered list of
 stages; each stage finds a door sign and, when it names an object class and an hour, then finds
 that object in the room behind the door."""
 
@@ -9,6 +9,8 @@ from typing import Literal, Union
 from pydantic import Field, model_validator
 
 from .base import Label, Strict
+from .objects import ObjectsSpec
+from .scenario import OnMap, register_kind
 
 NAME = r"^[A-Za-z0-9_\-]+$"
 
@@ -31,4 +33,17 @@ class ChainSpec(Strict):
     record: Union[str, list[str], None] = Field(None, description="timelines recorded for the object stages' log "
                                                                   "(one day each), or a detection-log CSV")
     truth: str | None = Field(None, description="timeline giving where the objects are at the stages' hours")
-    object_planner: Literal["lsos", "brute_force"] = Field("lsos", description="how an object stage searches its room")
+    object_planner: str = Field("lsos", pattern=NAME, description="how an object stage searches its room: a registered "
+                                "object-search planner (lsos, brute_force, last_seen)")
+
+
+@register_kind("chain")
+class ChainScenario(OnMap):
+    """Chained searches (thesis ch. 6): door signs, then objects in the rooms behind them."""
+
+    section = "chains"
+    needs = "a chains section"
+
+    kind: Literal["chain"] = "chain"
+    chains: list[ChainSpec] = Field(min_length=1, description="chained searches (thesis ch. 6)")
+    objects: ObjectsSpec | None = Field(None, description="the places and timelines of the object stages")

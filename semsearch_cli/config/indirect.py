@@ -1,4 +1,4 @@
-"""The ``indirect`` section: indirect search with secondary objects (Loncomilla et al. 2018, SPEC 7).
+"""The ``indirect`` section: indirect search with secondary objects (Loncomilla et al. 2018).
 
 A robot looks for the main object (the monitor, A) in a room, helped by what it sees of secondary
 objects (keyboard, system unit, router) that stand at typical distances from it. Lengths are
@@ -14,6 +14,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from .base import MAX_RANGE, Strict
+from .scenario import Scenario, register_kind
 
 Length = Annotated[float, Field(gt=0.0, le=MAX_RANGE)]
 
@@ -29,7 +30,7 @@ LUT_YAWS = (0, 45, 90, 135, 180, 225, 270, 315)  # degrees, the object's yaw see
 
 # Table 1 (detection rates by distance and yaw) is lost in our copy but for one line, which keeps
 # these values per yaw row with their columns (class and distance) lost, and two of the twenty
-# header labels lost too (SPEC 7):
+# header labels lost too:
 TABLE1_SURVIVING = {0: (81, 76, 33, 40), 45: (12, 38), 90: (12, 35, 36, 80), 135: (), 180: (88, 94, 41, 43),
                     225: (11, 39), 270: (68, 78), 315: (20, 32, 10, 56)}
 
@@ -250,3 +251,15 @@ class IndirectSpec(Strict):
             return dict(self.relations)
         names = list(self.relations)
         return {c: self.relations[names[(k + 1) % len(names)]] for k, c in enumerate(names)}
+
+
+@register_kind("indirect")
+class IndirectScenario(Scenario):
+    """Indirect search with secondary objects (Loncomilla et al. 2018). It brings its own rooms,
+    so it takes no ``map`` or ``start``."""
+
+    section = "indirect"
+    needs = "an indirect section"
+
+    kind: Literal["indirect"] = "indirect"
+    indirect: IndirectSpec = Field(description="indirect search with secondary objects (Loncomilla et al. 2018)")

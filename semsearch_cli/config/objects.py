@@ -1,13 +1,14 @@
 """The ``objects`` section: places, timelines, cases and requests of object search over time
-(thesis ch. 5, SPEC 6), and the object camera."""
+(thesis ch. 5), and the object camera."""
 
 from __future__ import annotations
 
-from typing import Annotated, Union
+from typing import Annotated, Literal, Union
 
 from pydantic import ConfigDict, Field, model_validator
 
 from .base import Label, MAX_RANGE, Angle, Coord, Strict
+from .scenario import OnMap, register_kind
 
 NAME = r"^[A-Za-z0-9_\-]+$"
 Hour = Annotated[float, Field(ge=0.0, lt=24.0, description="hour of the day, 0 <= h < 24")]
@@ -54,7 +55,7 @@ class ClassCameraSpec(Strict):
 
 
 class ObjectCameraSpec(Strict):
-    """Forward object camera (SPEC 2): field of view and range, detection probability constant or
+    """Forward object camera: field of view and range, detection probability constant or
     a :class:`DetectTable`, with per-class overrides under ``classes``."""
 
     fov: float = Field(60.0, gt=0.0, le=360.0, description="degrees, centred on the heading")
@@ -99,7 +100,7 @@ Timeline = dict[str, dict[Hour, Union[str, list[str], None]]]
 
 
 class ObjectsSpec(Strict):
-    """Object search over time (thesis ch. 5, SPEC 6)."""
+    """Object search over time (thesis ch. 5)."""
 
     places: list[PlaceSpec] = Field(min_length=1)
     fixed: dict[str, Union[str, list[str]]] = Field(default_factory=dict, description="place -> class(es) standing there all day")
@@ -112,3 +113,15 @@ class ObjectsSpec(Strict):
     camera: ObjectCameraSpec = ObjectCameraSpec()
 
 
+
+
+@register_kind("objects")
+class ObjectScenario(OnMap):
+    """An object-search scenario: places on a map, where objects stand over the day, and the
+    requests (a class at an hour) to answer."""
+
+    section = "objects"
+    needs = "an objects section"
+
+    kind: Literal["objects"] = "objects"
+    objects: ObjectsSpec = Field(description="places, timelines, requests and the object camera")

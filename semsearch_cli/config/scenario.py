@@ -1,50 +1,40 @@
-"""The scenario file: one model over the shared sections and each kind's own, YAML loading, and
-errors that name the file and the field (SPEC 1). Checks that need the map (start in a wall, goals
-reachable) belong to the world and the tasks.
+"""The scenario file: the sections every kind of search shares, the registry of kinds, YAML
+loading, and errors that name the file and the field. Checks that need the map (start in a wall,
+goals reachable) belong to the world and the tasks.
 
-The kind of search is ``kind:`` when given, else the section present: ``objects`` (object search),
-``chains`` (chained searches), ``indirect`` (indirect search in rooms), otherwise ``goals`` (door
-search). Indirect search brings its own rooms, so it takes no ``map`` or ``start``; the others
-need both.
+Each kind of search declares its scenario model in its own module of this package, a subclass of
+:class:`Scenario` (or :class:`OnMap`) registered with :func:`register_kind`, which names the
+section that makes a document that kind. A document is of the kind ``kind:`` names, else of the
+kind whose section it has (a kind whose model also takes the other sections present wins, as
+chains do with ``objects``), else of the default kind. The scenario format is the union of the
+registered models, discriminated on ``kind`` (:func:`scenario_schema`).
 """
 
 from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal, Union
 
 import yaml
-from pydantic import Field, ValidationError, field_validator, model_validator
+from pydantic import Field, Tag, TypeAdapter, ValidationError, field_validator
 
 from ..errors import ScenarioError
 from ..files import read_user_text
-from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, Label, LaserSpec, MapSpec, NavigationSpec,
+from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
-from .chain import ChainSpec
-from .indirect import IndirectSpec
-from .objects import ObjectsSpec, DetectTable  # noqa: F401  (DetectTable names a union branch in errors)
-
-KINDS = ("doors", "objects", "chain", "indirect")
-# the section each kind needs: (field, what to write when it is missing)
-NEEDS = {"doors": ("goals", "door numbers under goals"), "objects": ("objects", "an objects section"),
-         "chain": ("chains", "a chains section"), "indirect": ("indirect", "an indirect section")}
-# the sections a kind takes from others
-USES = {"doors": {"goals"}, "objects": {"objects"}, "chain": {"chains", "objects"}, "indirect": {"indirect"}}
-ROOMS_OF_THEIR_OWN = {"indirect"}  # kinds that bring their own rooms instead of map and start
-
 
 class Scenario(Strict):
+    """The sections every kind of search shares. A kind's model adds its own section (named by
+    ``section``) and sets ``kind`` to a one-value Literal with that value as its default."""
+
+    section: ClassVar[str] = ""  # the field whose presence makes a document this kind
+    needs: ClassVar[str] = ""  # what to write when that section is missing, e.g. "door numbers under goals"
+
+    kind: str
     name: str = Field(pattern=r"^[A-Za-z0-9_\-][A-Za-z0-9_.\-]*$", max_length=200,
                       description="letters, digits, _ - . (not first): it names the output folder")
-    map: MapSpec | None = None
-    start: StartSpec | None = None
-    doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
-    goals: list[Label] = Field(default_factory=list)
-    objects: ObjectsSpec | None = None
-    chains: list[ChainSpec] | None = Field(None, description="chained searches (thesis ch. 6)")
-    indirect: IndirectSpec | None = Field(None, description="indirect search with secondary objects (Loncomilla et al. 2018)")
-    kind: Literal["doors", "objects", "chain", "indirect"] | None = Field(None, description="default: from the sections given")
+    doors: Union[str, list[DoorSpec]] = Field(default_factory=list, description="the door signs: a CSV file (number, x, y, facing) or a list")
     duplicates: Literal["error", "keep-first", "any"] = Field(
         "error", description="signs sharing a number: refuse them, keep the first of each, or accept any as the goal")
     planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
@@ -56,41 +46,79 @@ class Scenario(Strict):
     belief: BeliefSpec = BeliefSpec()
     navigation: NavigationSpec = NavigationSpec()
 
-    @field_validator("goals")
-    @classmethod
-    def _unique_goals(cls, v):
-        if len(set(map(str, v))) != len(v):
-            raise ValueError("goals must not repeat")
-        return v
 
-    @model_validator(mode="after")
-    def _task(self):
-        kind = self.search_kind
-        field, what = NEEDS[kind]
-        if not getattr(self, field):
-            raise ValueError(f"give {what} (door search: goals; object search: objects; chains: chains; "
-                             "indirect search: indirect)")
-        extra = [f for f in ("goals", "objects", "chains", "indirect") if getattr(self, f) and f not in USES[kind]]
-        if kind in ROOMS_OF_THEIR_OWN:
-            extra += [f for f in ("map", "start") if getattr(self, f) is not None]
-        else:
-            missing = [f for f in ("map", "start") if getattr(self, f) is None]
-            if missing:
-                raise ValueError(f"a {kind} scenario needs {' and '.join(missing)}")
-        if extra:
-            raise ValueError(f"a {kind} scenario does not take {' or '.join(extra)}; remove it")
-        return self
+class OnMap(Scenario):
+    """A kind searched on a map of the scenario's own, from a start pose."""
 
-    @property
-    def search_kind(self) -> str:
-        """doors, objects or chain: ``kind`` when given, else the section present."""
-        if self.kind is not None:
-            return self.kind
-        if self.chains:
-            return "chain"
-        if self.indirect is not None:
-            return "indirect"
-        return "objects" if self.objects is not None else "doors"
+    map: MapSpec = Field(description="the occupancy map: an image with its resolution and origin, or a ROS map_server YAML")
+    start: StartSpec = Field(description="where the robot starts (m, degrees)")
+
+
+KINDS: dict[str, type[Scenario]] = {}  # kind -> its scenario model, in registration order
+_DEFAULT: list[str] = []
+
+
+def register_kind(kind: str, default: bool = False):
+    """Class decorator: ``cls`` (a :class:`Scenario` subclass whose ``kind`` is ``Literal[kind]``)
+    is the scenario model of ``kind``; with ``default``, documents that name no kind and have no
+    kind's section are of this kind. A kind is registered once."""
+
+    def deco(cls):
+        if not (isinstance(cls, type) and issubclass(cls, Scenario)):
+            raise TypeError(f"scenario kind {kind!r}: {cls!r} is not a Scenario subclass")
+        if kind in KINDS:
+            raise ValueError(f"scenario kind {kind!r} is already registered (by {KINDS[kind].__module__})")
+        if not cls.section or cls.section not in cls.model_fields:
+            raise TypeError(f"scenario kind {kind!r}: {cls.__name__}.section must name one of its fields")
+        KINDS[kind] = cls
+        if default:
+            _DEFAULT[:] = [kind]
+        global _ADAPTER
+        _ADAPTER = None
+        return cls
+
+    return deco
+
+
+def _sections() -> dict[str, str]:
+    return {cls.section: kind for kind, cls in KINDS.items()}
+
+
+def kind_of(data: dict) -> str | None:
+    """The kind a scenario document is of (see the module's docstring); None for ``kind:`` naming
+    no registered kind."""
+    given = data.get("kind")
+    if given is not None:
+        return given if isinstance(given, str) and given in KINDS else None
+    present = [k for s, k in _sections().items() if data.get(s) not in (None, [], {})]
+    if not present:
+        return _DEFAULT[0] if _DEFAULT else next(iter(KINDS))
+    taken = [k for k in present if all(KINDS[o].section in KINDS[k].model_fields for o in present)]
+    return (taken or present)[0]
+
+
+def model_of(kind: str) -> type[Scenario]:
+    return KINDS[kind]
+
+
+def all_fields() -> set[str]:
+    """Every top-level field of every kind's model."""
+    return {f for cls in KINDS.values() for f in cls.model_fields}
+
+
+_ADAPTER: TypeAdapter | None = None
+
+
+def scenario_schema() -> dict:
+    """The JSON Schema of a scenario file: one branch per kind, each with ``kind`` a constant."""
+    global _ADAPTER
+    if _ADAPTER is None:
+        union = Union[tuple(Annotated[cls, Tag(k)] for k, cls in KINDS.items())]  # noqa: UP007
+        _ADAPTER = TypeAdapter(union)
+    schema = _ADAPTER.json_schema()
+    return {"$schema": "https://json-schema.org/draft/2020-12/schema", "title": "semsearch scenario",
+            "description": "A scenario file: one kind of search (" + ", ".join(KINDS) + "), named by kind or by its section.",
+            **schema}
 
 
 _TYPE_PART = re.compile(r"^(int|str|float|bool|none|constrained-\w+|list\[.*\]|dict\[.*\]|literal\[.*\]|function-.*|[A-Z]\w*Spec|DetectTable)$")
@@ -113,8 +141,12 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
     """Validate a parsed YAML document; raise :class:`ScenarioError` on the first problem."""
     if not isinstance(data, dict):
         raise ScenarioError(str(file), "", "expected a YAML mapping (key: value) at the top level")
+    kind = kind_of(data)
+    if kind is None:
+        raise ScenarioError(str(file), "kind", f"unknown kind {data.get('kind')!r}; known: {', '.join(KINDS)}")
+    model = KINDS[kind]
     try:
-        return Scenario.model_validate(data)
+        return model.model_validate(data)
     except ValidationError as exc:
         errs = exc.errors()
         err = errs[0]
@@ -124,8 +156,13 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
         err = max(same, key=lambda e: (len(e["loc"]), not e["type"].endswith("_type")))
         field = _loc(err["loc"])
         msg = err["msg"]
+        if err["type"] == "extra_forbidden" and len(err["loc"]) == 1 and field in all_fields():
+            raise ScenarioError(str(file), field, f"a {kind} scenario does not take {field}; remove it") from None
+        if err["type"] == "missing" and field == model.section:
+            raise ScenarioError(str(file), field, f"give {model.needs} ("
+                                + "; ".join(f"{k}: {c.section}" for k, c in KINDS.items()) + ")") from None
         if err["type"] == "extra_forbidden":
-            msg = "unknown key (check its spelling; `semsearch validate --help` lists the scenario format)"
+            msg = "unknown key (check its spelling; `semsearch schema` writes the scenario format)"
         elif err["type"] == "missing":
             msg = "required field is missing"
         got = err.get("input")
@@ -174,10 +211,11 @@ def with_param(data: dict, param: str, value: Any, file: str | Path) -> dict:
         for p in planners:
             _set(p, keys[1:], value)
         return out
-    if keys[0] not in Scenario.model_fields or keys[0] in ("name", "planners"):
+    fields = KINDS[kind_of(out) or next(iter(KINDS))].model_fields
+    if keys[0] not in fields or keys[0] in ("name", "planners", "kind"):
         names = sorted({p.get("name") for p in out.get("planners") or [] if isinstance(p, dict)} - {None})
         raise ScenarioError("<command line>", "--param", f"{keys[0]!r} is neither a section of {file} nor one of its planners "
-                            f"({', '.join(names)}); sections: {', '.join(k for k in Scenario.model_fields if k not in ('name', 'planners'))}")
+                            f"({', '.join(names)}); sections: {', '.join(k for k in fields if k not in ('name', 'planners', 'kind'))}")
     _set(out, keys, value)
     return out
 

@@ -1,4 +1,4 @@
-"""Motion (SPEC 2): perfect odometry; the robot advances a fixed step along its path."""
+"""Motion: perfect odometry; the robot advances a fixed step along its path."""
 
 from __future__ import annotations
 

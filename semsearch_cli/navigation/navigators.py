@@ -1,4 +1,4 @@
-"""Navigators (SPEC 5): from the robot cell to a chosen target cell, a path of cells.
+"""Navigators: from the robot cell to a chosen target cell, a path of cells.
 
 ``geodesic`` (default): the cheapest path under the belief's skeleton-following cost.
 ``harmonic``: gradient ascent of the harmonic attraction (the thesis' BVP) solved in a window around
@@ -12,6 +12,8 @@ geodesic path and counts a fallback.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from ..kernels.harmonic import ascend, harmonic_field
@@ -20,16 +22,43 @@ HARMONIC_MARGIN_M = 3.0
 LOOKAHEAD_M = 8.0
 
 
-class GeodesicNavigator:
-    name = "geodesic"
+class Navigator:
+    """Base class: :meth:`plan` drives from the robot cell to a target cell."""
 
+    name: ClassVar[str] = ""
+
+    def plan(self, belief, r: int, c: int, tr: int, tc: int):  # pragma: no cover
+        """Cells (rows, cols) from (r, c) to (tr, tc), or None when unreachable."""
+        raise NotImplementedError
+
+
+NAVIGATORS: dict[str, type[Navigator]] = {}
+
+
+def register_navigator(name: str):
+    """Class decorator adding a :class:`Navigator` subclass under ``name`` (once per name)."""
+
+    def deco(cls):
+        if not (isinstance(cls, type) and issubclass(cls, Navigator)):
+            raise TypeError(f"navigator {name!r}: {cls!r} is not a Navigator subclass")
+        if name in NAVIGATORS:
+            raise ValueError(f"navigator {name!r} is already registered (by {NAVIGATORS[name].__module__})")
+        cls.name = name
+        NAVIGATORS[name] = cls
+        return cls
+
+    return deco
+
+
+@register_navigator("geodesic")
+class GeodesicNavigator(Navigator):
     def plan(self, belief, r: int, c: int, tr: int, tc: int):
         """Cells (rows, cols) from (r, c) to (tr, tc), or None when unreachable."""
         return belief.path(r, c, tr, tc)
 
 
-class HarmonicNavigator:
-    name = "harmonic"
+@register_navigator("harmonic")
+class HarmonicNavigator(Navigator):
 
     def __init__(self):
         self.fallbacks = 0
@@ -57,6 +86,3 @@ class HarmonicNavigator:
             self.fallbacks += 1
             return geo
         return rows + r0, cols + c0
-
-
-NAVIGATORS = {"geodesic": GeodesicNavigator, "harmonic": HarmonicNavigator}

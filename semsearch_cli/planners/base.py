@@ -1,4 +1,4 @@
-"""The planner interface and registry (SPEC 4).
+"""The planner interface and registry.
 
 A planner picks the next target from the belief. It sees a :class:`PlanContext` and the frontier
 :class:`~semsearch_cli.belief.Candidates`, and returns a :class:`Decision` (a target cell and the
@@ -20,6 +20,7 @@ import importlib.util
 import inspect
 import itertools
 import math
+import re
 import sys
 import traceback
 from dataclasses import dataclass, field
@@ -43,10 +44,27 @@ class NoParams(BaseModel):
 
 @dataclass
 class PlanContext:
-    """What a planner may look at: the belief, the robot pose and history, the goal, the run's RNG.
+    """What a door planner may look at at a re-plan: the belief, the robot's pose and history,
+    the goal and the run's random generator.
 
-    ``explain``: whether the caller keeps the numbers behind each choice (``Decision.info``, for
-    traces and recordings); planners may skip tabulating them when it is False.
+    Cells are (row, col) indices of the belief's grid: row 0 is the map's top, so row grows as y
+    falls; ``belief.frame`` converts (``to_world(row, col)`` -> (x, y) m of the cell centre,
+    ``to_index(x, y)`` -> cell, ``res`` m per cell).
+
+    - ``belief``: the map built so far (:class:`~semsearch_cli.belief.Belief`): ``free``,
+      ``seen``, ``visited``, ``passable`` (free and the robot fits), ``skeleton`` and
+      ``clearance`` (m) as (H, W) arrays; ``search(row, col, rows, cols, n)`` skeleton distances
+      (cells) to target cells; ``reads`` every sign read (``reads.total``: label -> count) and
+      ``segment_door_lists`` the signs read per corridor segment.
+    - ``row``, ``col``: the robot's cell; ``x``, ``y``: its position (m); ``heading``: radians,
+      counter-clockwise from +x.
+    - ``goal``: the label to find as written in the scenario (an int such as 148, or text such as
+      ``K202``).
+    - ``rng``: the run's NumPy generator: draw from it (never from a global one), so that a run
+      repeats exactly.
+    - ``headings``: the robot's heading (radians) at every pose so far.
+    - ``explain``: whether the caller keeps the numbers behind each choice (``Decision.info``,
+      for traces and recordings); a planner may skip tabulating them when it is False.
     """
 
     belief: Belief
@@ -63,17 +81,33 @@ class PlanContext:
 
 @dataclass
 class Decision:
+    """A door planner's choice: the target cell (``row``, ``col``, a free cell of the belief's
+    grid) and ``info``, the numbers behind it for traces (any JSON-able values; ``"kept": True``
+    marks a re-plan that keeps the previous target, which is not counted as a decision)."""
+
     row: int
     col: int
     info: dict = field(default_factory=dict)
 
 
 class Planner:
-    """Base class: ``choose`` returns a :class:`Decision` or None when there is nowhere to go."""
+    """A door-search planner (and the base of every kind's planner protocol): ``choose(ctx,
+    cands)`` gets a :class:`PlanContext` and the frontier
+    :class:`~semsearch_cli.belief.Candidates` and returns a :class:`Decision`, or None when there
+    is nowhere to go. Object planners subclass :class:`~semsearch_cli.planners.ObjectPlanner`,
+    indirect ones :class:`~semsearch_cli.planners.IndirectPlanner`.
+
+    Class attributes: ``Params`` (a pydantic model of the planner's parameters, checked when the
+    scenario is loaded), ``task`` (the kind of search it answers), ``rank``, ``baseline`` and
+    ``swept`` (how reports order and compare it; see the attributes below).
+    """
 
     name: ClassVar[str] = ""
     task: ClassVar[str] = "doors"  # or "objects": which kind of scenario the planner answers
     Params: ClassVar[type[BaseModel]] = NoParams
+    rank: ClassVar[int] = 100  # where reports list it among its kind's planners (lower first; then by name)
+    baseline: ClassVar[bool] = False  # reports compare the other planners with this one, paired
+    swept: ClassVar[str | None] = None  # the parameter `semsearch sweep-alpha` sweeps (and reports plot against)
 
     def __init__(self, params: BaseModel):
         self.params = params
@@ -89,6 +123,8 @@ def register_planner(name: str):
     """Class decorator adding a planner to the registry under ``name`` (must be new)."""
 
     def deco(cls):
+        if not (isinstance(cls, type) and issubclass(cls, Planner)):
+            raise TypeError(f"planner {name!r}: {cls!r} is not a subclass of Planner (or ObjectPlanner, IndirectPlanner)")
         if name in PLANNERS:
             raise ValueError(f"planner {name!r} is already registered (by {PLANNERS[name].__module__}); choose another name")
         cls.name = name
@@ -168,6 +204,41 @@ class Variant:
     def build(self) -> Planner:
         cls = planner_class(self)
         return cls(cls.Params(**dict(self.params)))
+
+
+def planner_named(label: str) -> type[Planner] | None:
+    """The registered class of a row's planner label (``nsos[alpha=0.9]`` -> nsos), or None when
+    this process has not registered it (a user's planner, outside its run)."""
+    return PLANNERS.get(str(label).split("[", 1)[0])
+
+
+def swept_value(label: str) -> float | None:
+    """The value of its planner's swept parameter in a row's planner label (``nsos[alpha=0.8]``
+    -> 0.8), the parameter's default when the label does not set it; None without one."""
+    cls = planner_named(label)
+    if cls is None or cls.swept is None:
+        return None
+    m = re.search(rf"[\[,]{re.escape(cls.swept)}=([-+0-9.eE]+)", str(label))
+    return float(m.group(1)) if m else float(cls.Params.model_fields[cls.swept].default)
+
+
+def planner_order(labels) -> list[str]:
+    """Row planner labels in report order: by :attr:`Planner.rank`, name, then the swept
+    parameter's value (unknown planners last, by name)."""
+
+    def key(lab):
+        cls = planner_named(lab)
+        v = swept_value(lab)
+        return (cls.rank if cls is not None else Planner.rank, str(lab).split("[", 1)[0], v if v is not None else 0.0, lab)
+
+    return sorted(set(labels), key=key)
+
+
+def baseline_of(labels) -> str:
+    """The label the others are compared with: a baseline planner's (the first in report order),
+    else the first label in report order."""
+    order = planner_order(labels)
+    return next((lab for lab in order if (c := planner_named(lab)) is not None and c.baseline), order[0])
 
 
 def expand_variants(specs, file: str = "<scenario>", task: str | None = None, base: Path | None = None) -> list[Variant]:

@@ -1,4 +1,4 @@
-"""Indirect-search planners (Loncomilla et al. 2018, Sections 3.3 and 4.5; SPEC 7): the paper's
+"""Indirect-search planners (Loncomilla et al. 2018, Sections 3.3 and 4.5): the paper's
 eleven methods, each registered under the paper's name, so rows read ``UIS``, ``ISCG-PN-SM``, ...
 
 - ``UIS``: local search (Eqs. 33-34) on the map of A's non-detections alone.
@@ -252,17 +252,18 @@ class GlobalSearch(IndirectPlanner):
                                                        "dist_m": round(float(dist[j]), 2), "eu": round(float(eu[j]), 5)})
 
 
-def _register(name: str, base: type, masks: str | None, negative: bool) -> type:
-    cls = type(name.replace("-", "_"), (base,), {"masks": masks, "negative": negative,
+def _register(name: str, base: type, masks: str | None, negative: bool, rank: int) -> type:
+    cls = type(name.replace("-", "_"), (base,), {"masks": masks, "negative": negative, "rank": rank,
                                                  "__doc__": f"{name} (Loncomilla et al. 2018, Section 4.5)"})
     return register_planner(name)(cls)
 
 
-_register("UIS", LocalSearch, None, False)
-for _search, _base in (("ISC", LocalSearch), ("ISCG", GlobalSearch)):
-    for _info in ("PN", "OP"):
-        for _m, _kind in (("HM", "hard"), ("SM", "soft")):
-            _register(f"{_search}-{_info}-{_m}", _base, _kind, _info == "PN")
+# ranks: the order of the paper's Table 3 (UIS, ISUP, AOSEOOR, then ISC and ISCG, hard masks first)
+_register("UIS", LocalSearch, None, False, 0)
+for _s, (_search, _base) in enumerate((("ISC", LocalSearch), ("ISCG", GlobalSearch))):
+    for _i, _info in enumerate(("PN", "OP")):
+        for _k, (_m, _kind) in enumerate((("HM", "hard"), ("SM", "soft"))):
+            _register(f"{_search}-{_info}-{_m}", _base, _kind, _info == "PN", 3 + 4 * _s + 2 * _k + _i)
 
 
 class IsupParams(BaseModel):
@@ -275,6 +276,8 @@ class IsupParams(BaseModel):
 @register_planner("ISUP")
 class Isup(IndirectPlanner):
     """Aydemir et al.: particles around a secondary object seen in the current frame."""
+
+    rank = 1
 
     Params = IsupParams
     masks = None  # the map holds A's non-detections only; the particles come from the soft relation
@@ -315,6 +318,8 @@ class AoseoorParams(BaseModel):
 @register_planner("AOSEOOR")
 class Aoseoor(IndirectPlanner):
     """Elfring et al., Algorithm 3 with Eq. 36: go to the most promising secondary object seen."""
+
+    rank = 2
 
     Params = AoseoorParams
     masks = None

@@ -1,4 +1,4 @@
-"""Object-search planners (thesis 5.2-5.3, SPEC 6): each yields target points, in order, for the
+"""Object-search planners (thesis 5.2-5.3): each yields target points, in order, for the
 robot to drive to until the object camera detects an instance of the requested class.
 
 - ``lsos``: heat map of the log (Eqs. 5.3-5.4, class filter, sector toward the robot pose of each
@@ -84,6 +84,8 @@ def lsos_goals(frame: GridFrame, known: np.ndarray, log: pd.DataFrame, cls: str,
 
 @register_planner("lsos")
 class Lsos(ObjectPlanner):
+    rank = 2
+
     Params = LsosParams
 
     def targets(self, ctx):
@@ -97,6 +99,8 @@ class Lsos(ObjectPlanner):
 
 @register_planner("brute_force")
 class BruteForce(ObjectPlanner):
+    rank = 0
+
     Params = NoParams
 
     def targets(self, ctx):
@@ -107,6 +111,8 @@ class BruteForce(ObjectPlanner):
 
 @register_planner("last_seen")
 class LastSeen(ObjectPlanner):
+    rank = 1
+
     Params = NoParams
 
     def targets(self, ctx):

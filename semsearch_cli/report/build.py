@@ -25,14 +25,12 @@ from ..planners import code_of
 from ..files import read_user_text
 from ..runner import Loaded, read_runs, run_rows
 from ..tasks.episodes import set_hash
-from . import chain, doors, indirect, objects
+from .sections import SECTIONS, replaying
 from .stats import episodes
 from .tables import goal_key, planner_order
 from .document import Code, Document, atomic_text
 
 ALL_FORMATS = ("md", "csv", "png", "pdf", "svg", "html")  # png, pdf, svg: every figure (GIF replays stay GIF)
-SECTIONS = {"doors": doors, "objects": objects, "chain": chain, "indirect": indirect}  # kind -> its report section
-REPLAYS = ("doors", "indirect")  # the kinds whose section re-simulates a run
 
 
 @dataclass(frozen=True)
@@ -67,7 +65,7 @@ def _same_goal(a, b) -> bool:
 def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
     """A :class:`ScenarioError` naming ``--replay`` and listing the runs there are, unless some
     folder of a kind with a replay holds the chosen run."""
-    rows = [run_rows(p.runs) for k in REPLAYS for p in parts_by_kind.get(k, [])]
+    rows = [run_rows(p.runs) for k in replaying() for p in parts_by_kind.get(k, [])]
     rows = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["planner", "goal", "seed"])
     ep = episodes(rows)
     hit = (rows["planner"].astype(str) == choice.planner) & rows["goal"].map(lambda g: _same_goal(g, choice.goal)) \
@@ -76,7 +74,7 @@ def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
         return
     if not len(rows):
         raise ScenarioError("<command line>", "--replay", f"these folders hold no runs of a kind with a replay "
-                            f"({', '.join(REPLAYS)}); leave --replay out")
+                            f"({', '.join(replaying())}); leave --replay out")
 
     def span(v):
         v = sorted(set(int(x) for x in v))

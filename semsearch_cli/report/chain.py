@@ -1,4 +1,4 @@
-"""The chain section of a report (thesis ch. 6, SPEC 8): per chain and planner the distance of
+"""The chain section of a report (thesis ch. 6): per chain and planner the distance of
 each stage with the map kept against the same stage from scratch, the saving, and whether later
 stages get cheaper as the robot knows more."""
 
@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import tables as T
+from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import image_formats, planner_colors, plot_chain_stages, plot_path_panels, plot_scenario
 from .runfiles import load_paths, median_label, safe_name, start_points
@@ -153,3 +154,6 @@ def show(loaded, out: Path) -> None:
     doors = list(dict.fromkeys(s.door for st in t.stages.values() for s in st))
     plot_scenario(w, doors, f"{loaded.sc.name}: {len(w.signs)} signs; chains: "
                   + "; ".join(f"{n}: {' > '.join(s.label for s in st)}" for n, st in t.stages.items()), out)
+
+
+register_section(Section("chain", section, console, show, replays=False))

@@ -11,8 +11,9 @@ import pandas as pd
 from ..runner import run_rows
 from . import stats as S
 from . import tables as T
+from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import (animate_run, budget_curve, episode_mean, image_formats, nsos_alphas, plot_alpha_sweep, plot_boxes, plot_budget,
+from .plots import (animate_run, budget_curve, episode_mean, image_formats, swept_values, plot_alpha_sweep, plot_boxes, plot_budget,
                     plot_path_panels, plot_scenario, planner_colors)
 from .runfiles import load_paths, median_label, safe_name, start_points, stems
 from .tables import goal_key
@@ -96,7 +97,7 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
                       "shortest paths differ), a column per planner; the share of runs that found the goal within b "
                       f"metres, with its 95% interval over {unit} (clustered Wilson), the other planners in grey; "
                       "dotted: the shortest path (mean over the episodes)")
-        if len(nsos_alphas(sub)) >= 2:
+        if len(swept_values(sub)) >= 2:
             f = fdir / f"alpha_{scen}.png"
             plot_alpha_sweep(sub, f, formats=img, colors=colors)
             doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}, with 95% intervals over {unit}; "
@@ -206,3 +207,6 @@ def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
 def show(loaded, out: Path) -> None:
     w, sc = loaded.world, loaded.sc
     plot_scenario(w, sc.goals, f"{sc.name}: {len(w.signs)} signs, goals {', '.join(map(str, sc.goals))}", out)
+
+
+register_section(Section("doors", section, console, show, replays=True))

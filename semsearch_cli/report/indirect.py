@@ -12,6 +12,7 @@ import pandas as pd
 from ..runner import run_rows
 from . import stats as S
 from . import tables as T
+from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import animate_probability, image_formats, plot_rooms, plot_success_by_scale
 from .runfiles import stems
@@ -31,21 +32,10 @@ PAPER_TABLE3 = {
     "ISCG-PN-SM": (79, 74, 86, 87, 88, 94, 95),
     "ISCG-OP-SM": (74, 76, 82, 82, 87, 88, 91),
 }
-ORDER = list(PAPER_TABLE3)
-
-
-def method_order(labels) -> list[str]:
-    """The paper's order, then any other planner."""
-    def key(lab):
-        name = lab.split("[", 1)[0]
-        return (ORDER.index(name) if name in ORDER else len(ORDER), lab)
-    return sorted(set(labels), key=key)
-
-
 def success_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Per scenario x method x view scale: n, found, success rate with its 95% interval clustered
     on rooms (:func:`.stats.rate_ci`: Wilson at the effective sample size n / deff, Kish's design
-    effect of the searches in one room layout, which are not independent; SPEC 7), mean time to
+    effect of the searches in one room layout, which are not independent), mean time to
     find (s, over the searches that found A), mean distance, mean SPL, and the ``unit`` of the
     interval with their number ``n_units``: ``rooms``, or for rows without a room (older folders)
     the episodes, or the repeats of one episode (then it is the plain Wilson interval)."""
@@ -63,7 +53,7 @@ def success_table(runs: pd.DataFrame) -> pd.DataFrame:
     out = pd.DataFrame(rows)
     if out.empty:
         return out
-    order = method_order(out["planner"])
+    order = T.planner_order(out["planner"])
     out["_p"] = out["planner"].map(order.index)
     return out.sort_values(["scenario", "_p", "view_scale"]).drop(columns="_p").round(4).reset_index(drop=True)
 
@@ -99,7 +89,7 @@ def time_spl(table: pd.DataFrame) -> pd.DataFrame:
 
 def _pivot(t: pd.DataFrame) -> pd.DataFrame:
     w = t.pivot_table(index="planner", columns="view_scale", values="cell", aggfunc="first", sort=False)
-    w = w.loc[[m for m in method_order(t["planner"]) if m in w.index]]
+    w = w.loc[[m for m in T.planner_order(t["planner"]) if m in w.index]]
     w.columns = [f"{c:g} m" for c in w.columns]
     w.index.name = "method"
     return w
@@ -193,7 +183,7 @@ def claims_table(runs: pd.DataFrame) -> pd.DataFrame:
                      "hi": 100 * hi, "paper": paper, "verdict": _verdict(paper, lo, hi)})
     if len(scales) >= 2:
         s0, s1 = scales[0], scales[-1]
-        for method in method_order(runs["method"]):
+        for method in T.planner_order(runs["method"]):
             g = runs[runs["method"] == method]
             m, lo, hi, n = paired_success(g[g["scale"] == s1], g[g["scale"] == s0], PAIR_KEYS)
             ref = PAPER_TABLE3.get(method)
@@ -237,7 +227,7 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     img = image_formats(formats)
     if img:
         f = out / "figures" / "indirect_success.png"
-        plot_success_by_scale(table, method_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f, img)
+        plot_success_by_scale(table, T.planner_order(table["planner"]), PAPER_TABLE3, PAPER_SCALES, f, img)
         doc.figure(f, "Success rate against the view scale, one panel per method: ours with the "
                       f"{interval_text(table)}, beside the paper's Table 3 (grey, dashed); n: searches per view scale")
         if replay:
@@ -264,7 +254,7 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
     ep = S.episodes(runs)
     scales = runs["goal"].astype(float)
     if choice is True:
-        order = method_order(runs["planner"])
+        order = T.planner_order(runs["planner"])
         label = "ISCG-PN-SM" if "ISCG-PN-SM" in order else order[-1]
         sub = runs[(runs["planner"] == label) & (scales == scales.min())]
     else:
@@ -307,3 +297,6 @@ def show(loaded, out: Path) -> None:
     plot_rooms([g.room for g in t.grids[:shown]], f"{loaded.sc.name}: {len(t.grids)} rooms"
                f"{f' (the first {shown})' if shown < len(t.grids) else ''}; A ({t.spec.target}) vermillion, secondary "
                "objects coloured (tick: facing), start square (arrow: heading)", out)
+
+
+register_section(Section("indirect", section, console, show, replays=True))

@@ -15,16 +15,10 @@ from ..planners import LsosParams, lsos_goals
 from ..runner import run_rows
 from ..tasks.objects import parse_label, read_log
 from . import tables as T
+from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import image_formats, planner_colors, plot_heat, plot_heat_steps, plot_object_bars, plot_path_panels
 from .runfiles import load_paths, median_label, start_points
-
-ORDER = {"brute_force": 0, "last_seen": 1, "lsos": 2}
-
-
-def planner_order(labels) -> list[str]:
-    return sorted(set(labels), key=lambda lab: (ORDER.get(lab.split("[", 1)[0], 3), lab))
-
 
 def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Per case x class x request hour x planner: n, found, success rate, mean, std (ddof 1),
@@ -44,7 +38,7 @@ def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     case_order = list(dict.fromkeys(df["case"]))
     out["_c"] = out["case"].map(case_order.index)
     out["_h"] = out["hour"].map(lambda h: (h == 0, h))
-    out["_p"] = out["planner"].map(lambda p: planner_order(df["planner"]).index(p))
+    out["_p"] = out["planner"].map(lambda p: T.planner_order(df["planner"]).index(p))
     return out.sort_values(["_c", "class", "_h", "_p"]).drop(columns=["_c", "_h", "_p"]).round(3).reset_index(drop=True)
 
 
@@ -55,7 +49,7 @@ def figure_table(table: pd.DataFrame) -> pd.DataFrame:
     t["cell"] = [f"{m:.1f} ± {0.0 if np.isnan(s) else s:.1f} ({f}/{n})" for m, s, f, n in
                  zip(t["mean"], t["std"], t["found"], t["n"])]
     wide = t.pivot_table(index=["case", "request"], columns="planner", values="cell", aggfunc="first", sort=False)
-    wide = wide[[p for p in planner_order(t["planner"]) if p in wide.columns]]
+    wide = wide[[p for p in T.planner_order(t["planner"]) if p in wide.columns]]
     wide["shortest (m)"] = t.groupby(["case", "request"], sort=False)["shortest_m"].first().map(lambda v: f"{v:.1f}")
     wide.columns.name = None
     return wide
@@ -81,7 +75,7 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
         doc.heading(3, "Figures")
         fdir = out / "figures"
         f = fdir / "objects_by_case.png"
-        order = planner_order(runs["planner"])
+        order = T.planner_order(runs["planner"])
         plot_object_bars(table, order, f, img, planner_colors(order))
         doc.figure(f, "Distance until the object is seen per case, request hour and planner (the thesis' Figure 5.12): "
                       f"the mean with its 95% interval ({T.interval_caption(table)}); hatched bars: some runs did not find "
@@ -104,7 +98,7 @@ def show(loaded, out: Path) -> None:
 
 
 def _figures(doc, runs, part, fdir: Path, notes: list, img=("png",), colors: dict | None = None) -> None:
-    order = planner_order(runs["planner"])
+    order = T.planner_order(runs["planner"])
     colors = colors or planner_colors(order)
     folder = part.folder
     loaded = part.loaded(notes, "Heat maps and paths")
@@ -167,3 +161,6 @@ def _log(folder: Path, loaded, case: str) -> pd.DataFrame:
     """The detection log the runs used (``logs/<case>.csv`` beside runs.csv), else the scenario's."""
     f = folder / "logs" / f"{case}.csv"
     return read_log(f) if f.is_file() else loaded.task.logs[case]
+
+
+register_section(Section("objects", section, console, show, replays=False))

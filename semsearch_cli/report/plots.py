@@ -22,6 +22,7 @@ import pandas as pd
 
 from ..files import temp_path
 from . import stats
+from ..planners.base import baseline_of, planner_named
 from .tables import goal_key, planner_order
 
 import cv2
@@ -354,10 +355,24 @@ def plot_scenario(world, goals, title: str, out: Path, formats=("png",)) -> list
 
 
 # ---- statistics over runs -----------------------------------------------------------------------
-def nsos_alphas(runs: pd.DataFrame) -> list[float]:
-    """The distinct alphas of the nsos variants in ``runs`` (an nsos without one has 0.9)."""
-    nsos = runs[runs["planner"].astype(str).str.startswith("nsos")]
-    return sorted({float(json.loads(p or "{}").get("alpha", 0.9)) for p in nsos["params"].fillna("{}")})
+def swept_rows(runs: pd.DataFrame) -> tuple[str | None, pd.DataFrame]:
+    """(the swept parameter, the rows of the planners that sweep it, with its value in column
+    ``swept``): the first swept planner in report order (:attr:`Planner.swept`; nsos and alpha),
+    its value read from each row's params, the parameter's default where a row does not set it."""
+    for lab in planner_order(runs["planner"].astype(str)):
+        cls = planner_named(lab)
+        if cls is not None and cls.swept is not None:
+            name, param = cls.name, cls.swept
+            default = float(cls.Params.model_fields[param].default)
+            rows = runs[runs["planner"].astype(str).map(lambda x: x.split("[", 1)[0] == name)].copy()
+            rows["swept"] = rows["params"].fillna("{}").map(lambda p: float(json.loads(p or "{}").get(param, default)))
+            return param, rows
+    return None, runs.iloc[:0].assign(swept=pd.Series(dtype=float))
+
+
+def swept_values(runs: pd.DataFrame) -> list[float]:
+    """The distinct values of the swept parameter in ``runs`` (see :func:`swept_rows`)."""
+    return sorted(set(swept_rows(runs)[1]["swept"]))
 
 
 def budget_curve(runs: pd.DataFrame, budgets=None, confidence: float = 0.95) -> pd.DataFrame:
@@ -497,13 +512,20 @@ def plot_boxes(runs, scenario: str, order: list, out: Path, formats=("png",), co
 
 
 @_paper
-def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy", formats=("png",), colors: dict | None = None) -> list[Path]:
-    """Mean ratio to the shortest path against alpha, one panel per goal: nsos at each alpha
-    (points in each variant's colour, 95% CI over units), the baseline planner (greedy) as a
-    dashed line with its 95% CI shaded."""
+def plot_alpha_sweep(runs, out: Path, baseline: str | None = None, formats=("png",), colors: dict | None = None) -> list[Path]:
+    """Mean ratio to the shortest path against the swept parameter (nsos' alpha, see
+    :func:`swept_rows`), one panel per goal: the swept planner at each value (points in each
+    variant's colour, 95% CI over units), the baseline planner (default: greedy, see
+    :func:`~semsearch_cli.planners.base.baseline_of`) as a dashed line with its 95% CI shaded."""
     colors = colors or planner_colors(planner_order(runs["planner"]))
-    nsos = runs[runs["planner"].astype(str).str.startswith("nsos")].copy()
-    nsos["alpha"] = nsos["params"].fillna("{}").map(lambda p: float(json.loads(p or "{}").get("alpha", 0.9)))
+    param, nsos = swept_rows(runs)
+    nsos = nsos.rename(columns={"swept": "alpha"})
+    swept_name = nsos["planner"].astype(str).iloc[0].split("[", 1)[0] if len(nsos) else ""
+    what = planner_named(swept_name).Params.model_fields[param].description if len(nsos) else None
+    xlabel = f"{param} ({what.split(',')[0]})" if what else str(param)
+    if baseline is None:
+        rest = [lab for lab in runs["planner"].astype(str).unique() if lab.split("[", 1)[0] != swept_name]
+        baseline = baseline_of(rest) if rest else ""
     goals = sorted(runs["goal"].unique(), key=goal_key)
     fig, axes = _grid(len(goals), 2.0)
     n_alpha = nsos.groupby(["goal", "alpha"]).size()
@@ -533,13 +555,13 @@ def plot_alpha_sweep(runs, out: Path, baseline: str = "greedy", formats=("png",)
         ax.set_xticks(sorted(nsos["alpha"].unique()))
         ax.set_ylim(bottom=0)
         if ax.get_subplotspec().is_last_row() or len(goals) - goals.index(g) <= 2:
-            ax.set_xlabel("alpha (weight of the semantic factor)")
+            ax.set_xlabel(xlabel)
         if ax.get_subplotspec().is_first_col():
             ax.set_ylabel("distance / shortest path")
     n_a = sorted(set(n_alpha.tolist()))
     n_b = sorted(set(n_base.tolist()))
     handles = [Line2D([], [], c="0.3", marker="o", mfc="0.6", mec="black", ms=4,
-                      label=f"nsos (n={'/'.join(map(str, n_a))} per alpha)")]
+                      label=f"{swept_name} (n={'/'.join(map(str, n_a))} per {param})")]
     if len(n_b):
         handles.append(Line2D([], [], c=colors.get(baseline, "black"), ls="--", label=f"{baseline} (n={'/'.join(map(str, n_b))})"))
     handles.append(Patch(color="0.6", alpha=0.4, label=f"95% CI over {stats.unit_kind(runs)}"))

@@ -1,10 +1,10 @@
-"""Statistics at the level of the episode (SPEC 9, issue 24 item 4).
+"""Statistics at the level of the episode .
 
 Runs of one episode (one start pose and goal) repeated over seeds are not independent: they share
 the start, the map and the goal, and differ only in the random stream. The unit of every interval
 and test here is therefore the *episode*, or, when a goal has a single episode (the thesis'
 configurations: one fixed start per goal), the repeat of that episode; then an interval speaks for
-that start only. Indirect search clusters on the room layout instead (SPEC 7: trials in one room
+that start only. Indirect search clusters on the room layout instead (trials in one room
 are not independent).
 
 Failures count in the mean distance at the distance they travelled before the search ended

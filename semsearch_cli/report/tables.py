@@ -1,4 +1,4 @@
-"""Tables rebuilt from rows alone (SPEC 9)."""
+"""Tables rebuilt from rows alone."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ..metrics import CAUSES as OUTCOME_CAUSES
+from ..planners.base import baseline_of, planner_order  # noqa: F401  (planner_order: the report order, used across report/)
 from . import stats as S
 
 KEYS = ["scenario", "goal", "planner"]
@@ -106,18 +107,6 @@ def goal_key(g):
     return (0, int(s), "") if s.lstrip("-").isdigit() else (1, 0, s)
 
 
-def planner_order(labels) -> list[str]:
-    """greedy, bvp, geometric, other planners, then nsos variants by alpha."""
-
-    def key(lab):
-        name = lab.split("[", 1)[0]
-        rank = {"greedy": 0, "bvp": 1, "geometric": 2, "nsos": 4}.get(name, 3)
-        m = re.search(r"alpha=([0-9.]+)", lab)
-        return (rank, name, float(m.group(1)) if m else 0.0, lab)
-
-    return sorted(set(labels), key=key)
-
-
 def five_statistics(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:
     """Tables 4.2-4.5: rows (scenario, goal, statistic) for the five statistics of distance_m,
     one column per planner variant (``summary``: :func:`summarise` of ``runs``, if at hand)."""
@@ -210,8 +199,9 @@ def _trials(d: pd.DataFrame) -> set:
 def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "distance_m") -> pd.DataFrame:
     """Per goal, each planner variant against a baseline on ``value`` (m).
 
-    The baseline is ``baseline`` when given and present, else greedy when present, else the first
-    planner of :func:`planner_order`. When the variant and the baseline ran the same set of
+    The baseline is ``baseline`` when given and present, else the first planner whose class says
+    it is one (:attr:`~semsearch_cli.planners.Planner.baseline`, greedy), else the first planner of
+    :func:`planner_order`. When the variant and the baseline ran the same set of
     (episode, seed) for the goal (they share episodes and random streams), the comparison is
     paired (:func:`.stats.paired`): per-unit differences, the Wilcoxon signed-rank test and the
     matched-pairs rank-biserial r. Otherwise it falls back to the unpaired Mann-Whitney U test over
@@ -222,7 +212,7 @@ def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "
     rows = []
     for (scen, goal), g in runs.groupby(["scenario", "goal"]):
         order = planner_order(g["planner"])
-        base = baseline if baseline in order else "greedy" if "greedy" in order else order[0]
+        base = baseline if baseline in order else baseline_of(order)
         b = g[g["planner"] == base]
         for lab in order:
             if lab == base:

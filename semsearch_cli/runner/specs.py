@@ -1,4 +1,4 @@
-"""A loaded scenario and its runs: goals x planner variants x seeds (SPEC 9).
+"""A loaded scenario and its runs: goals x planner variants x seeds.
 
 A run's randomness comes only from its episode and repeat (:func:`semsearch_cli.tasks.episode_seed`), so rows
 do not depend on the number of workers or the executor.
@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..config import Scenario, load_scenario, parse_scenario
+from ..config import Scenario, all_fields, load_scenario, parse_scenario
 from ..files import safe_chars
 from ..planners import Variant
 from ..tasks import Task, build_task
@@ -90,7 +90,11 @@ class Loaded:
         logs, ...) standing for its bytes, not its path (a scenario moved with its files keeps
         its fingerprint). Rows carry it, and a batch resumes only rows that match."""
         if self._fingerprint is None:
-            d = self.sc.model_dump(mode="json")
+            # one canonical form whatever the kind's model: every kind's sections (null where this
+            # kind has none), and ``kind`` only as written (null when the sections said it)
+            d = dict.fromkeys(all_fields()) | self.sc.model_dump(mode="json")
+            if "kind" not in self.sc.model_fields_set:
+                d["kind"] = None
             for key in ("planners", "goals"):  # the name stays: rows of a renamed copy are not resumed under the old name
                 d.pop(key, None)
             for key in ("seeds", "out", "run_time_limit"):

@@ -1,5 +1,5 @@
 """The row store: runs.csv, appended one row at a time as runs finish, read back for resume and
-reports; and each run's path (and trace) beside it (SPEC 9)."""
+reports; and each run's path (and trace) beside it."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Sensors over the ground-truth world: laser, door cameras, object camera (SPEC 2)."""
+"""Sensors over the ground-truth world: laser, door cameras, object camera."""
 
 from .devices import DoorCamera, Laser
 from .objects import ObjectCamera, PlaceCamera, detect_probability

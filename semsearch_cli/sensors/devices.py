@@ -1,4 +1,4 @@
-"""Laser and door cameras (SPEC 2) over the ground-truth world; the kernels are in raycast.py."""
+"""Laser and door cameras over the ground-truth world; the kernels are in raycast.py."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The object camera (SPEC 2): a forward camera with a field of view and range per object class,
+"""The object camera: a forward camera with a field of view and range per object class,
 line of sight against walls, and a detection probability per frame that is a constant or a table
 by distance and view angle (Loncomilla et al. 2018, Table 1)."""
 

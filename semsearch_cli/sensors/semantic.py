@@ -1,4 +1,4 @@
-"""The semantic camera of indirect search (Loncomilla et al. 2018, Section 4.2-4.3; SPEC 7).
+"""The semantic camera of indirect search (Loncomilla et al. 2018, Section 4.2-4.3).
 
 Ground truth (:meth:`SemanticCamera.frame`): an object's centre is taken into the camera frame by
 Eq. 37 (robot yaw, then the camera's pitch; ours: ``pitch`` degrees down, since the paper gives

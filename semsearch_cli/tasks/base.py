@@ -23,6 +23,7 @@ from ..config import Scenario
 from ..kernels.grid import dijkstra
 from ..errors import PlannerError, ScenarioError
 from ..metrics import run_row
+from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
 from ..world.scenario import World
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words, region_mask
@@ -120,7 +121,13 @@ TASKS: dict[str, type["Task"]] = {}
 
 
 def register_task(cls):
-    """Class decorator: the task answers scenarios of kind ``cls.kind``."""
+    """Class decorator: the task answers scenarios of kind ``cls.kind`` (a :class:`Task` subclass,
+    one per kind)."""
+    if not (isinstance(cls, type) and issubclass(cls, Task)):
+        raise TypeError(f"{cls!r} is not a Task subclass")
+    if not cls.kind or cls.kind in TASKS:
+        raise ValueError(f"task kind {cls.kind!r} is empty or already registered"
+                         + (f" (by {TASKS[cls.kind].__module__})" if cls.kind in TASKS else ""))
     TASKS[cls.kind] = cls
     return cls
 
@@ -131,6 +138,14 @@ class Task:
 
     kind: ClassVar[str] = ""
     planner_kind: ClassVar[str] = "doors"
+    noun: ClassVar[str] = ""  # what the kind searches for, in a sentence ("door signs")
+    records: ClassVar[tuple[str, ...]] = ()  # the row columns this kind fills beyond every kind's own
+
+    @classmethod
+    def example(cls, folder: Path, planner: str) -> Path:
+        """Write a small scenario of this kind run by ``planner`` (with the files it names) into
+        ``folder`` and return its YAML file: seconds to run, for the tests every kind shares."""
+        raise NotImplementedError
 
     def __init__(self, sc: Scenario, world: World, path: Path):
         self.sc, self.world, self.path = sc, world, Path(path)
@@ -351,9 +366,12 @@ class Task:
 
 def build_task(sc: Scenario, world: World, path: Path) -> Task:
     """The task of a scenario's kind, built and checked."""
-    kind = sc.search_kind
+    kind = sc.kind
     if kind not in TASKS:
         raise ScenarioError(str(path), "kind", f"no task of kind {kind!r}; known: {', '.join(sorted(TASKS))}")
+    if sc.navigation.navigator not in NAVIGATORS:
+        raise ScenarioError(str(path), "navigation.navigator", f"unknown navigator {sc.navigation.navigator!r}; valid: "
+                            f"{', '.join(NAVIGATORS)}")
     task = TASKS[kind].build(sc, world, path)
     task.episodes  # built and checked now: a bad episode is an error of the scenario's
     return task

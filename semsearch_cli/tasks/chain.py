@@ -1,4 +1,4 @@
-"""Chained searches (thesis ch. 6, SPEC 8): "disinfect room 12, then room 15"; "the computer in
+"""Chained searches (thesis ch. 6): "disinfect room 12, then room 15"; "the computer in
 room 12 at 11:00".
 
 A chain is a list of stages. A stage finds a door sign (door search with the scenario's door
@@ -29,10 +29,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from ..errors import ScenarioError
 from ..metrics import CAUSES, spl
-from ..planners import Variant
+from ..planners import PLANNERS, Variant
+from ..world.demo import write_demo
 from .base import RobotState, RunResult, Task, register_task
 from .episodes import Episode, episode_seed
 from .doors import DoorTask
@@ -54,6 +56,20 @@ class Stage:
 class ChainTask(Task):
     kind = "chain"
     planner_kind = "doors"
+    noun = "door signs one after another, and objects in the rooms behind them, from one robot state"
+    records = ("map",)
+
+    @classmethod
+    def example(cls, folder, planner):
+        """The demo building: doors 452, 304 and 452 again (the last one read on the map built so
+        far), one seed, a 600 m budget."""
+        path = write_demo(folder, planners=[{"name": planner}], seeds=1)
+        d = yaml.safe_load(path.read_text())
+        del d["goals"]
+        d["chains"] = [{"name": "two", "stages": [{"door": 452}, {"door": 304}, {"door": 452}]}]
+        d["experiment"]["max_distance"] = 600.0
+        path.write_text(yaml.safe_dump(d, sort_keys=False))
+        return path
 
     def __init__(self, sc, world, path):
         super().__init__(sc, world, path)
@@ -77,6 +93,10 @@ class ChainTask(Task):
             task.doors.check_goals([s.door for s in stages], f"{field}.stages")
             if any(s.cls is not None for s in stages):
                 task._check_object_stages(ch, stages, field)
+                answers = sorted(n for n, c in PLANNERS.items() if c.task == ObjectTask.planner_kind)
+                if ch.object_planner not in answers:
+                    raise ScenarioError(task.file, f"{field}.object_planner", f"unknown object-search planner "
+                                        f"{ch.object_planner!r}; valid: {', '.join(answers)}")
             task.stages[ch.name] = stages
             legs = task._shortest_legs(ch, stages, field, world.start_cell)
             task.legs[(ch.name, *world.start_xy)] = legs

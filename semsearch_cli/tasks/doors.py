@@ -1,4 +1,4 @@
-"""Door search (thesis ch. 4, SPEC 2-5): find the door sign with a given number on a map the
+"""Door search (thesis ch. 4): find the door sign with a given number on a map the
 robot builds as it goes.
 
 Sensing is the laser into HIMM and the two door cameras into sign reads; the belief update marks
@@ -14,6 +14,7 @@ reached by path planning on the map built so far, to the mean pose of its reads.
 from __future__ import annotations
 
 import numpy as np
+import yaml
 
 from ..belief import Belief
 from ..errors import ScenarioError
@@ -23,6 +24,7 @@ from ..planners import PlanContext
 from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.scenario import check_goals_reachable
+from ..world.demo import write_demo
 from .base import Outcome, RobotState, Task, checked_cell, register_task
 from .loop import run_loop
 
@@ -273,6 +275,17 @@ class DoorTask(Task):
 
     kind = "doors"
     planner_kind = "doors"
+    noun = "a door sign with a given number, read by cameras on the robot's sides"
+    records = ("soft_spl", "left_m")
+
+    @classmethod
+    def example(cls, folder, planner):
+        """The demo building (30 m x 20 m, 24 signs), goal 452, one seed, a 300 m budget."""
+        path = write_demo(folder, goals=(452,), planners=[{"name": planner}], seeds=1)
+        d = yaml.safe_load(path.read_text())
+        d["experiment"]["max_distance"] = 300.0
+        path.write_text(yaml.safe_dump(d, sort_keys=False))
+        return path
 
     def __init__(self, sc, world, path):
         super().__init__(sc, world, path)

@@ -1,4 +1,4 @@
-"""Indirect search with secondary objects (Loncomilla et al. 2018, SPEC 7): find the main object A
+"""Indirect search with secondary objects (Loncomilla et al. 2018): find the main object A
 in a room, helped by the secondary objects the semantic camera sees.
 
 Goals are view scales (m): how far A can be detected (the secondary objects always at
@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
+import yaml
 
 from ..belief.indirect import IndirectBelief, relation_mask
 from ..config.indirect import CATEGORIES
@@ -310,6 +311,18 @@ class IndirectTask(Task):
 
     kind = "indirect"
     planner_kind = "indirect"
+    noun = "a target object in a room, through the secondary objects that co-occur with it"
+    records = ("room", "time_s", "soft_spl", "left_m")
+
+    @classmethod
+    def example(cls, folder, planner):
+        """Two generated rooms, the target visible from 1.5 m, 60 s per search, two seeds."""
+        folder.mkdir(parents=True, exist_ok=True)
+        d = {"name": "rooms", "indirect": {"rooms": {"count": 2, "seed": 1}, "view_scales": [1.5], "time_limit": 60.0},
+             "planners": [{"name": planner}], "experiment": {"seeds": 2}}
+        path = folder / "scenario.yaml"
+        path.write_text(yaml.safe_dump(d, sort_keys=False))
+        return path
 
     def __init__(self, sc, world, path):
         super().__init__(sc, world, path)

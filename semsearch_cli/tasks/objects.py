@@ -1,4 +1,4 @@
-"""Object search over time (thesis ch. 5, SPEC 6): places, timelines, cases, requests, ground
+"""Object search over time (thesis ch. 5): places, timelines, cases, requests, ground
 truth, the recording mode, and the requesting mode: the robot drives an object planner's targets on
 the recorded map until the object camera detects an instance of the requested class.
 
@@ -39,6 +39,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pandas as pd
+import yaml
 
 from ..config import ObjectsSpec
 from ..errors import ScenarioError
@@ -47,6 +48,7 @@ from ..kernels.grid import dijkstra
 from ..navigation import KnownMap
 from ..planners import ObjectContext
 from ..sensors import PlaceCamera
+from ..world.office import office_image, office_scenario
 from .base import Outcome, RobotState, Task, checked_point, register_task
 from .loop import run_loop
 from ..files import read_user_text, temp_path, user_file
@@ -199,6 +201,21 @@ class ObjectTask(Task):
 
     kind = "objects"
     planner_kind = "objects"
+    noun = "an object of a class at an hour of the day, among places it moves between"
+    records = ("soft_spl", "left_m")
+
+    @classmethod
+    def example(cls, folder, planner):
+        """The office of thesis 5.3 with its moved-mug case alone, one seed, a 300 m budget."""
+        folder.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(folder / "map.png"), office_image())
+        d = office_scenario()
+        d["objects"]["cases"] = [c for c in d["objects"]["cases"] if c["name"] == "Moved-mug"]
+        d["planners"] = [{"name": planner}]
+        d["experiment"] = {"seeds": 1, "max_distance": 300.0}
+        path = folder / "scenario.yaml"
+        path.write_text(yaml.safe_dump(d, sort_keys=False))
+        return path
 
     def __init__(self, sc, world, path):
         super().__init__(sc, world, path)

@@ -1,4 +1,4 @@
-"""Rooms for indirect search (Loncomilla et al. 2018, Section 4.5; SPEC 7).
+"""Rooms for indirect search (Loncomilla et al. 2018, Section 4.5).
 
 A room is a rectangle (6 m x 6 m by default) holding the main object A and the secondary objects,
 each with a position, a height and a yaw (a multiple of 45 degrees), optional box obstacles, and

@@ -1,4 +1,4 @@
-"""The ground-truth world built from a scenario: map grid, door signs, start; checks (SPEC 1, 2).
+"""The ground-truth world built from a scenario: map grid, door signs, start; checks.
 
 Map images: gray value < 100 is wall, >= 200 free, anything between is "outside" (never entered,
 blocks beams like a wall). The world is immutable once built and shared by every run of a batch.
@@ -15,7 +15,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..config import DoorSpec, Scenario, read_yaml
+from ..config import DoorSpec, OnMap, Scenario, read_yaml
 from ..errors import ScenarioError
 from ..files import read_user_text
 from ..geometry import GridFrame
@@ -173,7 +173,7 @@ class World:
         """(H, W) bool: cells of ``within`` (default: reachable) from which sign ``i`` can be read.
 
         A pose reads a sign within camera range, in line of sight, in front of the sign's face
-        (SPEC 2); the side cameras can always be turned onto it, so heading is free.
+       ; the side cameras can always be turned onto it, so heading is free.
         """
         s = self.signs
         return self.sight_mask(s.x[i], s.y[i], self.read_range, 0.75, s.facing[i], within)
@@ -228,7 +228,7 @@ class World:
 def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     """Build and check the world of a scenario (paths relative to ``base``); None for a scenario
     without a map (one that brings rooms of its own)."""
-    if sc.map is None:
+    if not isinstance(sc, OnMap):
         return None
     if sc.map.ros is not None:
         img, res, origin = read_ros_map(base / sc.map.ros, owner=file)

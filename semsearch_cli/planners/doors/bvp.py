@@ -32,6 +32,8 @@ class BVPParams(BaseModel):
 
 @register_planner("bvp")
 class BVP(Planner):
+    rank = 1
+
     Params = BVPParams
 
     def __init__(self, params):

@@ -1,12 +1,12 @@
 """The draft paper's planner (../shared/seeds/draft_semantic_goal_directed_exploration.txt,
-Section III-C; SPEC 4): ``phi(c) = tau(c) + Omega(c) + alpha Gamma(c)``, the robot going to
+Section III-C): ``phi(c) = tau(c) + Omega(c) + alpha Gamma(c)``, the robot going to
 argmax phi over the frontier candidates c.
 
 The draft is unfinished; what it defines, and how each gap is filled here:
 
-- **Parity attraction tau** (the draft's Eqs. 5-8 are cut). From the authors' code as SPEC 4
-  quotes it: the belief in a parity is ``bel = min(1, beta * n)``, n the number of signs of that
-  parity in the candidate's segment N(c) read more than ``parity_reads`` (5) times there;
+- **Parity attraction tau** (the draft's Eqs. 5-8 are cut). From the authors' code:
+  the belief in a parity is ``bel = min(1, beta * n)``, n the number of signs of that parity in
+  the candidate's segment N(c) read more than ``parity_reads`` (5) times there;
   ``diff = min(0, bel_goal - bel_other)``; ``tau = 0.5 + (bel_goal + diff |diff|) / 2``, with
   beta = 0.1. *Gap*: the code names odd and even, not the goal's parity; we read ``bel`` as the
   belief in the goal's parity and ``diff`` as that belief minus the other's, so tau is 1 when the
@@ -23,13 +23,13 @@ The draft is unfinished; what it defines, and how each gap is filled here:
   ``TT' = 1 - 2 TT / pi``. *Gap*: with the goal smaller than every sign the "otherwise" branch of
   Eq. 9 applies (turn away from the increasing direction); a goal equal to SMALLER or BIGGER
   cannot be in N(c) (it would have been read), so it is treated like the otherwise branch too.
-- **Physical distance Gamma** (section 3 is "!!!!" in the draft). SPEC 4 maps it to closeness:
+- **Physical distance Gamma** (section 3 is "!!!!" in the draft). We read it as NSOS's closeness:
   ``Gamma = phi_c = 1 - (1 - D_min / D(c))^4``, D the skeleton distance (NSOS paper Eq. 16).
 - *Gap*: the draft's "door numbers read" per segment uses the same door lists as NSOS (thesis
   4.2.3), with every read counted (``min_reads`` 1) so that the parity threshold above applies to
   the reads made from the segment.
 - *Gap*: its tables show "Ours (10)" and "Ours (20)" without saying what 10 and 20 are; we expose
-  ``w_g`` (PARAM), ``beta``, ``parity_reads`` and ``alpha`` and default to SPEC's w_g = 8 and
+  ``w_g`` (PARAM), ``beta``, ``parity_reads`` and ``alpha`` and default to w_g = 8 and
   alpha = 1.
 - *Gap*: the draft has no rule for ties nor for a robot oscillating between two candidates as
   closeness drifts; the planner keeps NSOS's hysteresis (keep the last target while its phi is
@@ -95,6 +95,8 @@ class DraftParams(BaseModel):
 @register_planner("draft")
 class Draft(KeepTarget):
     """phi = tau + Omega + alpha Gamma (the draft paper's planner), with NSOS's hysteresis."""
+
+    rank = 3
 
     Params = DraftParams
 

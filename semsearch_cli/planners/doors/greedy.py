@@ -22,5 +22,10 @@ def nearest_candidate(ctx, cands) -> Decision | None:
 
 @register_planner("greedy")
 class Greedy(Planner):
+    """The nearest frontier candidate (the thesis' geometric baseline)."""
+
+    rank = 0
+    baseline = True
+
     def choose(self, ctx, cands):
         return nearest_candidate(ctx, cands)

@@ -1,4 +1,4 @@
-"""NSOS semantic planner (thesis 4.3; paper Section 4; SPEC 4) and the ``geometric`` planner.
+"""NSOS semantic planner (thesis 4.3; paper Section 4) and the ``geometric`` planner.
 
 For each frontier candidate c (segment S(c), branch direction theta_f(c)):
 
@@ -216,6 +216,9 @@ class KeepTarget(Planner):
 class NSOS(KeepTarget):
     """The semantic planner (Eqs. 4.5-4.8), with :class:`KeepTarget`'s hysteresis."""
 
+    rank = 4
+    swept = "alpha"
+
     Params = NSOSParams
     use_semantics = True
 
@@ -299,6 +302,9 @@ class GeometricParams(BaseModel):
 @register_planner("geometric")
 class Geometric(NSOS):
     """Eq. 4.6 alone: NSOS with alpha = 0, keeping the two orientation factors."""
+
+    rank = 2
+    swept = None
 
     Params = GeometricParams
     replan_on_signs = False
