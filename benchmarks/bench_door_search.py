@@ -34,8 +34,8 @@ from semsearch_cli.runner import Loaded, expand, run_batch
 from semsearch_cli.tasks import build_task
 from semsearch_cli.navigation import GeodesicNavigator, HarmonicNavigator
 from semsearch_cli.planners import Variant
-from semsearch_cli.sensors.devices import DoorCamera, Laser
-from semsearch_cli.world.mobilesim import import_mobilesim
+from semsearch_cli.sensors.doors import DoorCamera, Laser
+from semsearch_cli.world.importers.mobilesim import import_mobilesim
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 

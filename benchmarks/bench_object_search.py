@@ -23,7 +23,7 @@ from semsearch_cli.config import load_scenario
 from semsearch_cli.runner import Loaded, expand, run_batch
 from semsearch_cli.tasks.objects import ObjectTask
 from semsearch_cli.planners import Variant
-from semsearch_cli.world.scenario import build_world
+from semsearch_cli.world.ground_truth import build_world
 
 OFFICE = Path(__file__).resolve().parents[1] / "configs" / "office.yaml"
 

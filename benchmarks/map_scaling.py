@@ -22,7 +22,7 @@ from output import emit
 
 from semsearch_cli.planners import Variant
 from semsearch_cli.runner import Loaded
-from semsearch_cli.world.generate import generate_building
+from semsearch_cli.world.buildings.numbered import generate_building
 
 VARIANTS = [Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),))]
 

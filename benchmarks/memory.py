@@ -35,7 +35,7 @@ CHILD = r"""
 import json, resource, sys
 stage = sys.argv[1]
 from semsearch_cli.runner import Loaded, expand
-from semsearch_cli.runner.executors import execute
+from semsearch_cli.runner.execution import execute
 out = {"import_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 if stage != "import":
     L = Loaded.load(sys.argv[2])

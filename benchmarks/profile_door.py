@@ -20,7 +20,7 @@ from output import emit
 
 from semsearch_cli.planners import Variant
 from semsearch_cli.runner import Loaded
-from semsearch_cli.world.mobilesim import import_mobilesim
+from semsearch_cli.world.importers.mobilesim import import_mobilesim
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 # (phase, (file, function) whose cumulative time is that phase's)

@@ -24,8 +24,8 @@ from semsearch_cli.runner import Loaded, expand, run_batch  # noqa: E402
 from semsearch_cli.planners import expand_variants  # noqa: E402
 from semsearch_cli.report.build import write_meta  # noqa: E402
 from semsearch_cli.report.tables import summarise  # noqa: E402
-from semsearch_cli.world.mobilesim import import_mobilesim  # noqa: E402
-from semsearch_cli.world.scenario import build_world  # noqa: E402
+from semsearch_cli.world.importers.mobilesim import import_mobilesim  # noqa: E402
+from semsearch_cli.world.ground_truth import build_world  # noqa: E402
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 

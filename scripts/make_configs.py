@@ -13,10 +13,10 @@ import yaml
 
 import cv2
 
-from semsearch_cli.world.files import write_doors
-from semsearch_cli.world.generate import generate_building
-from semsearch_cli.world.hospital import hospital_image, hospital_scenario, hospital_signs
-from semsearch_cli.world.office import office_image, office_scenario
+from semsearch_cli.world.scenario_folder import write_doors
+from semsearch_cli.world.buildings.numbered import generate_building
+from semsearch_cli.world.buildings.hospital import hospital_image, hospital_scenario, hospital_signs
+from semsearch_cli.world.buildings.office import office_image, office_scenario
 
 PLANNERS = [{"name": "greedy"}, {"name": "bvp"}, {"name": "nsos", "alpha": [0.8, 0.9, 1.0]}]
 

@@ -141,7 +141,8 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = N
     sweeping = {n: c for n, c in PLANNERS.items() if c.swept == "alpha" and c.task == answers}
     baseline = next((n for n, c in PLANNERS.items() if c.baseline and c.task == answers), None)
     if not sweeping or baseline is None:
-        raise ScenarioError(str(scenario), "kind", f"no planner of a {sc.kind} scenario sweeps alpha against a baseline")
+        raise ScenarioError(str(scenario), "kind", f"no registered planner for {sc.kind} scenarios sweeps alpha beside a "
+                            "baseline; sweep a planner's own parameter with `semsearch sweep --param PLANNER.PARAM=V1,V2`")
     entry = next((p for p in sc.planners if p.name in sweeping), None)
     name = entry.name if entry is not None else next(iter(sweeping))
     base = entry.params() if entry is not None else {}

@@ -23,15 +23,15 @@ from .config.base import MAX_SEEDS
 from .config.indirect import IndirectSpec
 from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated
 from .report.build import console_tables
-from .world.generate import LAYOUTS, SCHEMES
-from .world.generate import generate_batch as gen_batch
-from .world.generate import generate_building as gen_building
+from .world.buildings.numbered import LAYOUTS, SCHEMES
+from .world.buildings.numbered import generate_batch as gen_batch
+from .world.buildings.numbered import generate_building as gen_building
 from .world.rooms import generate_rooms as gen_rooms
 from .world.rooms import write_rooms
-from .world.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
-from .world.kth import import_kth as imp_kth
-from .world.mobilesim import import_mobilesim as imp_mobilesim
-from .world.ros_import import import_ros as imp_ros
+from .world.importers.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
+from .world.importers.kth import import_kth as imp_kth
+from .world.importers.mobilesim import import_mobilesim as imp_mobilesim
+from .world.importers.ros import import_ros as imp_ros
 from .files import atomic_text, output_file, output_folder
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)

@@ -11,7 +11,7 @@ REF = SHARED / "reference_maps"
 
 @pytest.fixture(scope="session")
 def demo_dir(tmp_path_factory):
-    from semsearch_cli.world.demo import write_demo
+    from semsearch_cli.world.buildings.demo import write_demo
 
     d = tmp_path_factory.mktemp("demo")
     write_demo(d)

@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 import yaml
 
-from semsearch_cli.world.demo import write_demo
+from semsearch_cli.world.buildings.demo import write_demo
 
 REPO = Path(__file__).resolve().parents[1]
 INF, NAN = float("inf"), float("nan")

@@ -110,12 +110,12 @@ def test_a_batch_resumes_across_executors(demo_dir, tmp_path):
 def test_a_sweep_uses_one_cluster_for_all_its_values(demo_dir, tmp_path, monkeypatch):
     started = []
 
-    class Counted(cluster_module.LocalCluster):
+    class Counted(cluster_module.distributed.LocalCluster):
         def __init__(self, *a, **k):
             started.append(1)
             super().__init__(*a, **k)
 
-    monkeypatch.setattr(cluster_module, "LocalCluster", Counted)
+    monkeypatch.setattr(cluster_module.distributed, "LocalCluster", Counted)
     kw = dict(seeds=2, goals=[452], planners=["greedy"], workers=2)
     res = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], out=tmp_path / "dask", executor="dask", **kw)
     assert len(started) == 1  # not one per value

@@ -122,7 +122,7 @@ def test_start_facing_a_dead_end_turns_around(demo_loaded):
     """A start at the end of a wing, facing the end wall: the 180-degree laser sees no way on
     until the robot turns on the spot."""
     from semsearch_cli.config import StartSpec
-    from semsearch_cli.world.scenario import build_world
+    from semsearch_cli.world.ground_truth import build_world
 
     L = demo_loaded
     sc = L.sc.model_copy(update={"start": StartSpec(x=8.0, y=17.3, heading=90.0)})
@@ -137,8 +137,8 @@ def test_goal_behind_a_mid_corridor_start_is_found(tmp_path):
     must come back for the half it has never seen (the classic frontier)."""
     from semsearch_cli.config import StartSpec
     from semsearch_cli.runner import Loaded
-    from semsearch_cli.world.generate import generate_building
-    from semsearch_cli.world.scenario import build_world
+    from semsearch_cli.world.buildings.numbered import generate_building
+    from semsearch_cli.world.ground_truth import build_world
 
     p = generate_building("single", "floor", 0, tmp_path)
     L = Loaded.load(p)
@@ -156,7 +156,7 @@ def dead_end_scenario(tmp_path):
     cameras read it only from a robot turned across the corridor near the end. The old search
     drove to both ends (a U-turn flips the heading in one step) and stopped ``stuck`` after
     29.7 m with greedy, though the sign is readable 10.5 m from the start."""
-    from semsearch_cli.world.files import fill_box, scenario_dict, write_building
+    from semsearch_cli.world.scenario_folder import fill_box, scenario_dict, write_building
 
     img = np.zeros((30, 220), np.uint8)
     fill_box(img, 0.1, 0.2, 21.8, 0.5, 2.5, 255)
@@ -226,7 +226,7 @@ def test_sweep_bad_param_exits_2(demo_dir, tmp_path, param, field):
 def test_a_goal_with_a_slash_writes_its_path_file(tmp_path):
     """KTH second doors are labelled e.g. ``2512/2``: the run's files stay in paths/."""
     from semsearch_cli.runner import Loaded, file_stem
-    from semsearch_cli.world.files import fill_box, scenario_dict, write_building
+    from semsearch_cli.world.scenario_folder import fill_box, scenario_dict, write_building
 
     img = np.zeros((30, 120), np.uint8)
     fill_box(img, 0.1, 0.2, 11.8, 0.5, 2.5, 255)

@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.runner import Loaded
-from semsearch_cli.world.generate import LAYOUTS, SCHEMES, generate_building
+from semsearch_cli.world.buildings.numbered import LAYOUTS, SCHEMES, generate_building
 
 
 def doors(path):

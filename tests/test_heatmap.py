@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from semsearch_cli.geometry import GridFrame
-from semsearch_cli.belief.heatmap import goal_cells, heat_map, inverted_kernel
+from semsearch_cli.belief.objects import goal_cells, heat_map, inverted_kernel
 
 
 def test_inverted_kernel_values_full_disk():

@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.runner import Loaded
-from semsearch_cli.world.ros import read_ros_map
+from semsearch_cli.world.ros_map import read_ros_map
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -97,7 +97,7 @@ def test_import_kth_reference_floor(tmp_path):
         import pytest
 
         pytest.skip(f"the KTH sample floor is not at {f} (../shared absent)")
-    from semsearch_cli.world.kth import import_kth
+    from semsearch_cli.world.importers.kth import import_kth
 
     L = Loaded.load(import_kth(f, tmp_path)[0])
     # one per room-to-circulation portal: 53 into its KORRIDOR spaces, 10 into two untyped halls

@@ -16,7 +16,7 @@ from semsearch_cli.cli import app
 from semsearch_cli.config.indirect import EVERY_YAW_TABLE, SIDE_BLIND_TABLES, TABLE2, MasksSpec, SemanticCameraSpec
 from semsearch_cli.geometry import GridFrame
 from semsearch_cli.runner import Loaded, expand, run_batch
-from semsearch_cli.sensors.semantic import SemanticCamera, YawMemory
+from semsearch_cli.sensors.indirect import SemanticCamera, YawMemory
 from semsearch_cli.tasks.indirect import RoomGrid
 from semsearch_cli.world.rooms import Room, Thing, estimate_relations, generate_rooms, read_rooms, ring, write_rooms
 

@@ -13,7 +13,7 @@ from semsearch_cli.runner import Loaded, execute, expand, run_batch
 from semsearch_cli.planners import LsosParams, lsos_goals
 from semsearch_cli.tasks.objects import parse_label, request_label, timeline_at
 from semsearch_cli.planners import Variant
-from semsearch_cli.world.office import HOURS, TABLE_5_1
+from semsearch_cli.world.buildings.office import HOURS, TABLE_5_1
 
 ROOT = Path(__file__).resolve().parents[1]
 OFFICE = ROOT / "configs" / "office.yaml"

@@ -12,7 +12,7 @@ from semsearch_cli.kernels.harmonic import ascend, harmonic_field
 from semsearch_cli.metrics import spl
 from semsearch_cli.navigation import advance
 from semsearch_cli.sensors import DoorCamera, ObjectCamera, detect_probability
-from semsearch_cli.world.scenario import Signs, World
+from semsearch_cli.world.ground_truth import Signs, World
 
 
 def test_advance_moves_one_step_along_the_waypoints():

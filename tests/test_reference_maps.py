@@ -3,7 +3,7 @@
 import pytest
 
 from semsearch_cli.runner import Loaded
-from semsearch_cli.world.mobilesim import import_mobilesim
+from semsearch_cli.world.importers.mobilesim import import_mobilesim
 
 from .conftest import REF, needs_reference
 

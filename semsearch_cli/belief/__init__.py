@@ -1,3 +1,3 @@
-from .belief import Belief, Candidates
+from .doors import Belief, Candidates
 
 __all__ = ["Belief", "Candidates"]

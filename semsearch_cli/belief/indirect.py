@@ -5,7 +5,7 @@ observation multiplies it by a likelihood image (and the outside cell by a numbe
 renormalises:
 
 - A not seen (Eqs. 6-7): ``1 - D_A``, D_A the robot's model of detecting A in each cell from the
-  pose (:class:`~semsearch_cli.sensors.semantic.YawMemory`: the probability of detecting A in this
+  pose (:class:`~semsearch_cli.sensors.indirect.YawMemory`: the probability of detecting A in this
   frame given the frames before missed it); the outside cell 1.
 - B seen at cell c (Eqs. 8-9, 12-13): the likelihood image of B is 1 at c and 0 elsewhere, so the
   cross-likelihood (Eq. 14) is the relation mask centred on c, R_B/A(ij - c) / S(ij), and the

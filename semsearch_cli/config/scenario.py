@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal, Union
 
 import yaml
-from pydantic import Field, Tag, TypeAdapter, ValidationError, field_validator
+from pydantic import Field, Tag, TypeAdapter, ValidationError
 
 from ..errors import ScenarioError
 from ..files import read_user_text

@@ -25,8 +25,7 @@ from .policies import PlannerPolicy
 SHIPPED = {"DoorSearch-Hotel-v0": ("doors", "hotel"), "DoorSearch-Normal-v0": ("doors", "normal"),
            "DoorSearch-Inverse-v0": ("doors", "inverse"), "DoorSearch-KTH-v0": ("doors", "kth"),
            "ObjectSearch-Office-v0": ("objects", "office"), "IndirectSearch-Quick-v0": ("indirect", "indirect_quick")}
-ENTRY = {"doors": "semsearch_cli.envs.doors:DoorSearchEnv", "objects": "semsearch_cli.envs.objects:ObjectSearchEnv",
-         "indirect": "semsearch_cli.envs.indirect:IndirectSearchEnv"}
+ENTRY = {env.kind: env for env in (DoorSearchEnv, ObjectSearchEnv, IndirectSearchEnv)}  # kind -> its environment
 
 
 def register_envs() -> list[str]:
@@ -34,7 +33,7 @@ def register_envs() -> list[str]:
     ids = {"semsearch/DoorSearch-v0": (ENTRY["doors"], {}),
            "semsearch/ObjectSearch-v0": (ENTRY["objects"], {}),
            "semsearch/IndirectSearch-v0": (ENTRY["indirect"], {}),
-           "semsearch/DoorSearch-Generated-v0": ("semsearch_cli.envs.generated:GeneratedDoorSearchEnv", {})}
+           "semsearch/DoorSearch-Generated-v0": (GeneratedDoorSearchEnv, {})}
     for name, (kind, config) in SHIPPED.items():
         ids[f"semsearch/{name}"] = (ENTRY[kind], {"scenario": f"shipped:{config}"})
     for env_id, (entry, kwargs) in ids.items():

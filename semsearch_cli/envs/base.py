@@ -27,7 +27,7 @@ from ..config import load_scenario
 from ..errors import ScenarioError
 from ..tasks import Task, build_task
 from ..tasks.episodes import Episode, episode_seed
-from ..world.scenario import build_world
+from ..world.ground_truth import build_world
 
 SUCCESS_BONUS = 100.0
 BIG = 1e6  # bound of the observations' coordinates (m), as config.base.MAX_COORD, and of sign numbers

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from gymnasium.utils import seeding
 
-from ..world.generate import LAYOUTS, SCHEMES, generate_building
+from ..world.buildings.numbered import LAYOUTS, SCHEMES, generate_building
 from .base import load_task
 from .doors import DoorSearchEnv
 

@@ -1,5 +1,5 @@
 """The view cone of a pitched camera on a grid (numba): the robot's model of the semantic camera
-(see :mod:`semsearch_cli.sensors.semantic` for the geometry, Eqs. 37-40)."""
+(see :mod:`semsearch_cli.sensors.indirect` for the geometry, Eqs. 37-40)."""
 
 from __future__ import annotations
 

@@ -47,7 +47,7 @@ from scipy import ndimage
 
 from ..belief.indirect import IndirectBelief
 from ..geometry import GridFrame
-from ..sensors.semantic import ConeTemplates
+from ..sensors.indirect import ConeTemplates
 from .base import Planner, register_planner
 
 

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 from pydantic import BaseModel, ConfigDict, Field
 
-from ..belief.heatmap import goal_cells, heat_map
+from ..belief.objects import goal_cells, heat_map
 from ..geometry import GridFrame
 from .base import NoParams, Planner, register_planner
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..belief.heatmap import heat_map
+from ..belief.objects import heat_map
 from ..planners import LsosParams, lsos_goals
 from ..runner import run_rows
 from ..tasks.objects import parse_label, read_log

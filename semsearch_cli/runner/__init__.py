@@ -2,8 +2,10 @@
 
 from .batch import check_folder, run_batch
 from .lock import folder_lock
-from .executors import EXECUTORS, ProcessExecutor, SerialExecutor, check_kind, execute, make_executor
+from .execution import execute
+from .executors import EXECUTORS, ProcessExecutor, SerialExecutor, check_kind, make_executor
 from .specs import Loaded, RunSpec, expand, file_stem
+from . import cluster  # noqa: F401  (registers the dask executor; Dask itself is imported at first use)
 from .store import RowWriter, read_runs, run_rows, save_run_files
 
 __all__ = ["EXECUTORS", "Loaded", "check_folder", "check_kind", "ProcessExecutor", "RowWriter", "RunSpec", "SerialExecutor", "execute", "expand", "file_stem", "folder_lock",

@@ -13,7 +13,8 @@ import pandas as pd
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import temp_path
 from ..planners import code_of
-from .executors import Executor, SerialExecutor, make_executor
+from .execution import Executor
+from .executors import SerialExecutor, make_executor
 from .lock import folder_lock
 from .specs import Loaded, RunSpec
 from .store import RowWriter, read_runs, run_rows

@@ -15,16 +15,17 @@ import itertools
 from pathlib import Path
 from typing import Iterable, Iterator
 
-import dask
-from distributed import Client, LocalCluster, as_completed
-
 from ..errors import ScenarioError
-from .executors import NO_PATH, Executor, execute
+from ..optional import lazy_module
+from .execution import NO_PATH, Executor, execute
+from .executors import register_executor
 from .specs import Loaded, RunSpec
 from .store import save_run_files
 
 
 CONNECT_S = 8  # s to reach a scheduler before the command gives up
+dask = lazy_module("dask")  # imported at first use (the dask extra; None without it)
+distributed = lazy_module("distributed")
 
 
 def _run_chunk(loaded: Loaded, specs: list[RunSpec], trace: bool) -> list[tuple]:
@@ -59,7 +60,7 @@ class DaskExecutor(Executor):
     def _client(self):
         if self.address:
             try:
-                return Client(self.address, set_as_default=False, timeout=CONNECT_S), None
+                return distributed.Client(self.address, set_as_default=False, timeout=CONNECT_S), None
             except (OSError, TimeoutError, ValueError, TypeError) as exc:  # unreachable, refused, a malformed address
                 raise ScenarioError("<command line>", "--scheduler", f"no Dask scheduler answers at {self.address!r} "
                                     f"within {CONNECT_S} s ({type(exc).__name__}: {exc}); give tcp://HOST:PORT of a "
@@ -70,9 +71,9 @@ class DaskExecutor(Executor):
         # processes (semsearch_cli/__init__.py); docs/usage.md "Running on a cluster" for your own workers.
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                               "distributed.nanny.pre-spawn-environ.NUMPY_MADVISE_HUGEPAGE": "0"}):
-            cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+            cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
                                    silence_logs=50)  # CRITICAL: no heartbeat noise when the cluster closes
-        return Client(cluster, set_as_default=False), cluster
+        return distributed.Client(cluster, set_as_default=False), cluster
 
     def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
         owned = self._kept is None
@@ -88,7 +89,7 @@ class DaskExecutor(Executor):
                 _close(client, cluster)
 
     def _stream(self, client, shared, specs: Iterator[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
-        pending = as_completed(loop=client.loop)
+        pending = distributed.as_completed(loop=client.loop)
         ahead = 2 * max(1, sum(client.nthreads().values()))
 
         def submit(n: int):
@@ -117,3 +118,11 @@ def _close(client, cluster) -> None:
     client.close()
     if cluster is not None:
         cluster.close()
+
+
+@register_executor("dask")
+def dask_executor(workers: int, start_method: str | None, address: str | None, chunk: int) -> DaskExecutor:
+    """The Dask scheduler at ``address``, or a local cluster of ``workers`` processes."""
+    if distributed is None:
+        raise ScenarioError("<command line>", "--executor", "dask needs the distributed package: pip install 'semsearch[dask]'")
+    return DaskExecutor(workers, address, chunk)

@@ -4,96 +4,20 @@ worker processes that each receive the loaded scenario once."""
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 import itertools
-import math
 import multiprocessing
 import os
 import signal
 import threading
 import time
-import traceback
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterable, Iterator
 
-import numpy as np
-
-from ..errors import BatchStopped, RunTimeout, ScenarioError
-from ..tasks import RunResult
-from ..tasks.loop import running
+from ..errors import BatchStopped, ScenarioError
+from .execution import Executor, run_and_save
 from .specs import Loaded, RunSpec
-from .store import save_run_files
-
-
-def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[dict], RunResult]:
-    """Run one spec; returns (rows, result). A planner that raises or exits (``sys.exit``
-    included) gives one row with outcome ``error`` and the message; a run past
-    ``experiment.run_time_limit`` s of wall-clock time, one with outcome ``timeout``; either
-    way the rest of the batch goes on."""
-    task = loaded.task
-    limit = loaded.sc.experiment.run_time_limit
-    empty = np.zeros((0, 2), np.float32)
-    running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
-    try:
-        with wall_clock_limit(limit):
-            res = task.run(spec.variant, spec.episode, spec.seed, trace)
-    except RunTimeout:
-        res = RunResult("timeout", math.nan, 0, 0, limit, empty,
-                        message=f"the run took longer than {limit:g} s of wall-clock time (experiment.run_time_limit)")
-    except (Exception, SystemExit) as exc:  # a user's planner (or a bug): recorded, not fatal to the batch
-        where = traceback.extract_tb(exc.__traceback__)[-1]
-        msg = f"{type(exc).__name__}: {exc} ({Path(where.filename).name}:{where.lineno})"
-        res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=msg)
-    finally:
-        running(None)
-    return task.rows(spec.variant, spec.episode, spec.seed, res), res
-
-
-@contextmanager
-def wall_clock_limit(seconds: float):
-    """Raise :class:`RunTimeout` in the block after ``seconds`` of wall-clock time (SIGALRM;
-    only in a process's main thread, where signals arrive: not on Dask's worker threads)."""
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
-        yield
-        return
-
-    def alarm(signum, frame):
-        raise RunTimeout()
-
-    before = signal.signal(signal.SIGALRM, alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, before)
-
-
-NO_PATH = ("error", "timeout")  # outcomes of runs that leave no path to save
-
-
-def _run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list[dict]:
-    rows, res = execute(loaded, spec, trace)
-    if res.outcome not in NO_PATH:
-        save_run_files(out, spec.stem, res)
-    return rows
-
-
-class Executor:
-    """What every executor gives the runner: ``rows(loaded, specs, out, trace)`` yields each run's
-    rows as it finishes. An executor is also a context manager: inside ``with`` it may keep what
-    it starts (a cluster) for several batches (a sweep's values); outside, each batch starts and
-    stops its own. Nothing to keep here."""
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        return None
 
 
 class SerialExecutor(Executor):
@@ -104,7 +28,7 @@ class SerialExecutor(Executor):
 
     def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
         for spec in specs:
-            yield _run_and_save(loaded, spec, out, trace)
+            yield run_and_save(loaded, spec, out, trace)
 
 
 _CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process once
@@ -131,7 +55,7 @@ WATCH_S = 0.5  # s between a worker's looks at its parent
 
 
 def _worker_run(spec: RunSpec, out: str, trace: bool) -> list[dict]:
-    return _run_and_save(_CACHE["loaded"], spec, Path(out), trace)
+    return run_and_save(_CACHE["loaded"], spec, Path(out), trace)
 
 
 class ProcessExecutor(Executor):
@@ -184,10 +108,28 @@ class ProcessExecutor(Executor):
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-EXECUTORS = ("processes", "dask")
-# executors on optional dependencies, by name: the module holding each (imported on demand, so
-# that a command that does not use Dask does not pay for importing it) and its class
-OPTIONAL = {"dask": ("semsearch_cli.runner.cluster", "DaskExecutor", "distributed", "dask")}
+EXECUTORS: dict = {}  # --executor name -> a factory (workers, start_method, address, chunk) -> Executor
+
+
+def register_executor(name: str):
+    """Decorator adding an executor factory under ``name`` (once per name); the factory is
+    called with (workers, start_method, address, chunk) and returns an :class:`Executor`."""
+
+    def deco(factory):
+        if not callable(factory):
+            raise TypeError(f"executor {name!r}: {factory!r} is not callable")
+        if name in EXECUTORS:
+            raise ValueError(f"executor {name!r} is already registered")
+        EXECUTORS[name] = factory
+        return factory
+
+    return deco
+
+
+@register_executor("processes")
+def process_executor(workers: int, start_method: str | None, address: str | None, chunk: int) -> Executor:
+    """A process pool for more than one worker, else the serial executor."""
+    return ProcessExecutor(workers, start_method) if workers > 1 else SerialExecutor()
 
 
 def check_kind(kind: str) -> None:
@@ -197,15 +139,9 @@ def check_kind(kind: str) -> None:
 
 
 def make_executor(workers: int, start_method: str | None = None, kind: str = "processes", address: str | None = None,
-                  chunk: int = 4):
+                  chunk: int = 4) -> Executor:
     """An executor: ``processes`` (the default) is a process pool for more than one worker, else
-    the serial executor; ``dask`` runs on the Dask scheduler at ``address``, or on a local
-    cluster of ``workers`` processes (see :class:`~semsearch_cli.runner.cluster.DaskExecutor`)."""
+    the serial executor; ``dask`` (:mod:`.cluster`) runs on the Dask scheduler at ``address``, or
+    on a local cluster of ``workers`` processes."""
     check_kind(kind)
-    if kind in OPTIONAL:
-        module, cls, package, extra = OPTIONAL[kind]
-        if importlib.util.find_spec(package) is None:
-            raise ScenarioError("<command line>", "--executor", f"{kind} needs the {package} package: "
-                                f"pip install 'semsearch[{extra}]'")
-        return getattr(importlib.import_module(module), cls)(workers, address, chunk)
-    return ProcessExecutor(workers, start_method) if workers > 1 else SerialExecutor()
+    return EXECUTORS[kind](workers, start_method, address, chunk)

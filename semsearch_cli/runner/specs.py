@@ -17,7 +17,7 @@ from ..files import safe_chars
 from ..planners import Variant
 from ..tasks import Task, build_task
 from ..tasks.episodes import Episode
-from ..world.scenario import World, build_world
+from ..world.ground_truth import World, build_world
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from ..errors import PlannerError, ScenarioError
 from ..metrics import run_row
 from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
-from ..world.scenario import World
+from ..world.ground_truth import World
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words, region_mask
 
 

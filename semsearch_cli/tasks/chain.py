@@ -34,7 +34,7 @@ import yaml
 from ..errors import ScenarioError
 from ..metrics import CAUSES, spl
 from ..planners import PLANNERS, Variant
-from ..world.demo import write_demo
+from ..world.buildings.demo import write_demo
 from .base import RobotState, RunResult, Task, register_task
 from .episodes import Episode, episode_seed
 from .doors import DoorTask

@@ -23,8 +23,8 @@ from ..navigation import NAVIGATORS
 from ..planners import PlanContext
 from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
-from ..world.scenario import check_goals_reachable
-from ..world.demo import write_demo
+from ..world.ground_truth import check_goals_reachable
+from ..world.buildings.demo import write_demo
 from .base import Outcome, RobotState, Task, checked_cell, register_task
 from .loop import run_loop
 

@@ -34,7 +34,7 @@ from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
-from ..sensors.semantic import SemanticCamera, YawMemory
+from ..sensors.indirect import SemanticCamera, YawMemory
 from ..world.rooms import Room, estimate_relations, generate_rooms, read_rooms
 from .base import Outcome, RobotState, RunResult, Task, checked_point, register_task
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
@@ -206,7 +206,7 @@ class IndirectSearch:
     def detection(self, cls: str, st: RobotState) -> np.ndarray:
         """The robot's model of detecting ``cls`` in each cell from this frame's pose: A on the
         map's grid, the secondary objects on the grid of their non-detections; given the misses
-        before, per yaw hypothesis (:class:`~semsearch_cli.sensors.semantic.YawMemory`), or the
+        before, per yaw hypothesis (:class:`~semsearch_cli.sensors.indirect.YawMemory`), or the
         table's mean over yaws (``camera.model: mean``). Reused at the next frame."""
         main = cls == self.task.spec.target
         fr, occ = (self.grid.frame, self.occ) if main else (self.neg_frame, self.neg_occ)

@@ -48,7 +48,7 @@ from ..kernels.grid import dijkstra
 from ..navigation import KnownMap
 from ..planners import ObjectContext
 from ..sensors import PlaceCamera
-from ..world.office import office_image, office_scenario
+from ..world.buildings.office import office_image, office_scenario
 from .base import Outcome, RobotState, Task, checked_point, register_task
 from .loop import run_loop
 from ..files import read_user_text, temp_path, user_file

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..config import DoorCameraSpec, LaserSpec
 from ..geometry import wrap_angle
-from ..world.scenario import World
+from ..world.ground_truth import World
 from ..kernels.raycast import cast_rays, facing_within, line_of_sight
 
 

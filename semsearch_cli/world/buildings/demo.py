@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 import yaml
 
-from .files import write_doors
+from ..scenario_folder import write_doors
 
 RES = 0.1
 SIZE = (30.0, 20.0)  # m

@@ -13,12 +13,12 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..errors import ScenarioError
-from ..geometry import GridFrame
-from .files import scenario_dict, write_building
+from ...errors import ScenarioError
+from ...geometry import GridFrame
+from ..scenario_folder import scenario_dict, write_building
 from .mobilesim import snap_report, snap_signs, spread_goals
-from .ros import FREE, clean_free, copy_ros_map, read_ros_map
-from .scenario import read_doors
+from ..ros_map import FREE, clean_free, copy_ros_map, read_ros_map
+from ..ground_truth import read_doors
 
 
 ROBOT_RADIUS = 0.25  # m: the scenario's robot.radius default, which map.clean uses when the scenario loads

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .files import corridor_floor
+from ..scenario_folder import corridor_floor
 
 WIDTH_M, HEIGHT_M = 44.0, 20.0
 WALL_M = 0.15

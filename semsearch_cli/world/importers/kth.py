@@ -25,14 +25,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..errors import ScenarioError
-from ..files import user_file
-from ..geometry import GridFrame
-from .files import map_image, scenario_dict, write_building
-from .labels import parse_label
-from ..config import parse_scenario
+from ...errors import ScenarioError
+from ...files import user_file
+from ...geometry import GridFrame
+from ..scenario_folder import map_image, scenario_dict, write_building
+from ..labels import parse_label
+from ...config import parse_scenario
 from .mobilesim import MARGIN_M, snap_report, snap_signs, spread_goals
-from .scenario import build_world
+from ..ground_truth import build_world
 
 
 def _label(name: str):

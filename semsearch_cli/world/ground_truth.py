@@ -22,7 +22,7 @@ from ..geometry import GridFrame
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from .images import read_gray
-from .ros import clean_free, read_ros_map
+from .ros_map import clean_free, read_ros_map
 
 WALL_BELOW = 100
 FREE_FROM = 200

@@ -36,11 +36,11 @@ import cv2
 import numpy as np
 import yaml
 
-from ..errors import ScenarioError
-from ..geometry import GridFrame
-from ..kernels.grid import dijkstra
-from .files import map_image, scenario_dict, write_building
-from .mobilesim import spread_goals
+from ...errors import ScenarioError
+from ...geometry import GridFrame
+from ...kernels.grid import dijkstra
+from ..scenario_folder import map_image, scenario_dict, write_building
+from ..importers.mobilesim import spread_goals
 
 LAYOUTS = ("grid", "wings", "angled", "single")
 SCHEMES = ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks", "random")

@@ -15,12 +15,12 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from ..errors import ScenarioError
-from ..files import read_user_text
-from ..geometry import GridFrame
-from ..kernels.grid import dijkstra
-from .files import map_image, scenario_dict, write_building
-from .labels import parse_label
+from ...errors import ScenarioError
+from ...files import read_user_text
+from ...geometry import GridFrame
+from ...kernels.grid import dijkstra
+from ..scenario_folder import map_image, scenario_dict, write_building
+from ..labels import parse_label
 
 MARGIN_M = 1.0
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .files import corridor_floor
+from ..scenario_folder import corridor_floor
 
 WIDTH_M, HEIGHT_M = 20.5, 14.5
 WALL_M = 0.15

@@ -1,0 +1,87 @@
+"""What every executor shares: running one spec (errors and time limits recorded as rows, never
+fatal to the batch), saving its path, and the :class:`Executor` protocol. The executors
+themselves are in :mod:`.executors` (serial, processes) and :mod:`.cluster` (Dask)."""
+
+from __future__ import annotations
+
+import math
+import signal
+import threading
+import traceback
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import RunTimeout
+from ..tasks import RunResult
+from ..tasks.loop import running
+from .specs import Loaded, RunSpec
+from .store import save_run_files
+
+
+def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[dict], RunResult]:
+    """Run one spec; returns (rows, result). A planner that raises or exits (``sys.exit``
+    included) gives one row with outcome ``error`` and the message; a run past
+    ``experiment.run_time_limit`` s of wall-clock time, one with outcome ``timeout``; either
+    way the rest of the batch goes on."""
+    task = loaded.task
+    limit = loaded.sc.experiment.run_time_limit
+    empty = np.zeros((0, 2), np.float32)
+    running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
+    try:
+        with wall_clock_limit(limit):
+            res = task.run(spec.variant, spec.episode, spec.seed, trace)
+    except RunTimeout:
+        res = RunResult("timeout", math.nan, 0, 0, limit, empty,
+                        message=f"the run took longer than {limit:g} s of wall-clock time (experiment.run_time_limit)")
+    except (Exception, SystemExit) as exc:  # a user's planner (or a bug): recorded, not fatal to the batch
+        where = traceback.extract_tb(exc.__traceback__)[-1]
+        msg = f"{type(exc).__name__}: {exc} ({Path(where.filename).name}:{where.lineno})"
+        res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=msg)
+    finally:
+        running(None)
+    return task.rows(spec.variant, spec.episode, spec.seed, res), res
+
+
+@contextmanager
+def wall_clock_limit(seconds: float):
+    """Raise :class:`RunTimeout` in the block after ``seconds`` of wall-clock time (SIGALRM;
+    only in a process's main thread, where signals arrive: not on Dask's worker threads)."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def alarm(signum, frame):
+        raise RunTimeout()
+
+    before = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, before)
+
+
+NO_PATH = ("error", "timeout")  # outcomes of runs that leave no path to save
+
+
+def run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list[dict]:
+    rows, res = execute(loaded, spec, trace)
+    if res.outcome not in NO_PATH:
+        save_run_files(out, spec.stem, res)
+    return rows
+
+
+class Executor:
+    """What every executor gives the runner: ``rows(loaded, specs, out, trace)`` yields each run's
+    rows as it finishes. An executor is also a context manager: inside ``with`` it may keep what
+    it starts (a cluster) for several batches (a sweep's values); outside, each batch starts and
+    stops its own. Nothing to keep here."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
