@@ -332,9 +332,7 @@ def episodes(scenario: str | Path, out: str | Path) -> tuple[Path, list, str]:
     ``episodes: {file: that.csv}`` in a scenario runs exactly that set."""
     loaded = Loaded.load(Path(scenario))
     eps = loaded.task.episodes
-    rows = pd.DataFrame([e.row() for e in eps], columns=EPISODE_COLUMNS)
-    if loaded.kind == "indirect":
-        rows["room"] = [loaded.task.room_name(e) for e in eps]
+    rows = pd.DataFrame([loaded.task.episode_row(e) for e in eps], columns=EPISODE_COLUMNS)
     path = output_file(out, "--out", (".csv",))
     tmp = temp_path(path)
     rows.to_csv(tmp, index=False)

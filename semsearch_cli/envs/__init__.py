@@ -22,20 +22,16 @@ from .indirect import IndirectSearchEnv
 from .objects import ObjectSearchEnv
 from .policies import PlannerPolicy
 
-SHIPPED = {"DoorSearch-Hotel-v0": ("doors", "hotel"), "DoorSearch-Normal-v0": ("doors", "normal"),
-           "DoorSearch-Inverse-v0": ("doors", "inverse"), "DoorSearch-KTH-v0": ("doors", "kth"),
-           "ObjectSearch-Office-v0": ("objects", "office"), "IndirectSearch-Quick-v0": ("indirect", "indirect_quick")}
-ENTRY = {env.kind: env for env in (DoorSearchEnv, ObjectSearchEnv, IndirectSearchEnv)}  # kind -> its environment
+ENVS = (DoorSearchEnv, ObjectSearchEnv, IndirectSearchEnv)  # each: semsearch/<name>-v0 and its shipped buildings
 
 
 def register_envs() -> list[str]:
     """Register every environment id (once); returns the ids."""
-    ids = {"semsearch/DoorSearch-v0": (ENTRY["doors"], {}),
-           "semsearch/ObjectSearch-v0": (ENTRY["objects"], {}),
-           "semsearch/IndirectSearch-v0": (ENTRY["indirect"], {}),
-           "semsearch/DoorSearch-Generated-v0": (GeneratedDoorSearchEnv, {})}
-    for name, (kind, config) in SHIPPED.items():
-        ids[f"semsearch/{name}"] = (ENTRY[kind], {"scenario": f"shipped:{config}"})
+    ids = {f"semsearch/{env.env_name}-v0": (env, {}) for env in ENVS}
+    ids["semsearch/DoorSearch-Generated-v0"] = (GeneratedDoorSearchEnv, {})
+    for env in ENVS:
+        for building, config in env.shipped.items():
+            ids[f"semsearch/{env.env_name}-{building}-v0"] = (env, {"scenario": f"shipped:{config}"})
     for env_id, (entry, kwargs) in ids.items():
         if env_id not in registry:
             register(id=env_id, entry_point=entry, kwargs=kwargs)

@@ -130,6 +130,8 @@ class SearchEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
     kind = ""
+    env_name = ""  # the id: semsearch/<env_name>-v0
+    shipped: dict = {}  # building -> a shipped config: semsearch/<env_name>-<building>-v0
 
     def __init__(self, scenario: str | Path, action_mode: str = "macro", observation_mode: str = "dict",
                  render_mode: str | None = None, success_bonus: float = SUCCESS_BONUS):

@@ -72,6 +72,8 @@ class DoorSearchEnv(SearchEnv):
     """Door-sign search over a door scenario (see the module docstring for the spaces)."""
 
     kind = "doors"
+    env_name = "DoorSearch"  # registered as semsearch/DoorSearch-v0, and one id per shipped building:
+    shipped = {"Hotel": "hotel", "Normal": "normal", "Inverse": "inverse", "KTH": "kth"}
 
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
                  success_bonus: float = 100.0, window: int = 32, max_candidates: int = 64, max_signs: int = 32,

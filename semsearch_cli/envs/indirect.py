@@ -70,6 +70,8 @@ class IndirectSearchEnv(SearchEnv):
     """Indirect search over an indirect scenario (see the module docstring for the spaces)."""
 
     kind = "indirect"
+    env_name = "IndirectSearch"
+    shipped = {"Quick": "indirect_quick"}
 
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
                  success_bonus: float = 100.0, masks: str | None = "soft", negative: bool = True, lattice: float = 0.5):

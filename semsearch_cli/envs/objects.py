@@ -64,6 +64,8 @@ class ObjectSearchEnv(SearchEnv):
     """Object search over an object scenario (see the module docstring for the spaces)."""
 
     kind = "objects"
+    env_name = "ObjectSearch"
+    shipped = {"Office": "office"}
 
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
                  success_bonus: float = 100.0):

@@ -243,7 +243,7 @@ def baseline_of(labels) -> str:
 
 def expand_variants(specs, file: str = "<scenario>", task: str | None = None, base: Path | None = None) -> list[Variant]:
     """Planner entries -> variants; list-valued parameters expand into one variant per value.
-    With ``task`` ("doors" or "objects"), planners for the other kind of search are refused.
+    With ``task`` (a task's ``planner_kind``), planners that answer another kind are refused.
     An entry with ``module`` first loads that file (relative to ``base``, the scenario's folder);
     a name nothing registered is looked for among the installed entry points."""
     out: list[Variant] = []
@@ -262,9 +262,8 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
         if name not in PLANNERS:
             raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}; valid: {', '.join(valid)}")
         if task is not None and PLANNERS[name].task != task:
-            kind = {"doors": "door", "objects": "object"}.get
-            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} is a {kind(PLANNERS[name].task, PLANNERS[name].task)}-search planner and this is "
-                                f"a {kind(task, task)}-search scenario; valid: {', '.join(valid)}")
+            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} answers {PLANNERS[name].task} scenarios, not {task} "
+                                f"ones; valid: {', '.join(valid)}")
         keys = sorted(params)
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]
         for k, vs in zip(keys, values):

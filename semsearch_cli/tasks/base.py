@@ -137,9 +137,13 @@ class Task:
     registered planners answer it) and implement :meth:`episode` (and usually :meth:`goals`)."""
 
     kind: ClassVar[str] = ""
-    planner_kind: ClassVar[str] = "doors"
+    planner_kind: ClassVar[str] = ""  # the ``task`` of the registered planners that answer it
     noun: ClassVar[str] = ""  # what the kind searches for, in a sentence ("door signs")
     records: ClassVar[tuple[str, ...]] = ()  # the row columns this kind fills beyond every kind's own
+
+    def episode_row(self, ep: Episode) -> dict:
+        """An episode as a row of ``semsearch episodes``' CSV."""
+        return ep.row()
 
     @classmethod
     def example(cls, folder: Path, planner: str) -> Path:

@@ -471,6 +471,9 @@ class IndirectTask(Task):
     def room_name(self, ep: Episode) -> str:
         return self.grids[ep.room].room.name
 
+    def episode_row(self, ep: Episode) -> dict:
+        return ep.row() | {"room": self.room_name(ep)}
+
     def build_episodes(self) -> list[Episode]:
         """Per view scale, the rooms' episodes: each room from its own start (no ``episodes``
         section); ``starts`` drawn per room, the same for every scale, uniformly over the cells the
