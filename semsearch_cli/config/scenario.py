@@ -21,6 +21,7 @@ from pydantic import Field, Tag, TypeAdapter, ValidationError
 
 from ..errors import ScenarioError
 from ..files import read_user_text
+from ..registry import Registry
 from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
 
@@ -54,7 +55,7 @@ class OnMap(Scenario):
     start: StartSpec = Field(description="where the robot starts (m, degrees)")
 
 
-KINDS: dict[str, type[Scenario]] = {}  # kind -> its scenario model, in registration order
+KINDS = Registry("scenario kind", Scenario)  # kind -> its scenario model, in registration order
 _DEFAULT: list[str] = []
 
 
@@ -64,13 +65,9 @@ def register_kind(kind: str, default: bool = False):
     kind's section are of this kind. A kind is registered once."""
 
     def deco(cls):
-        if not (isinstance(cls, type) and issubclass(cls, Scenario)):
-            raise TypeError(f"scenario kind {kind!r}: {cls!r} is not a Scenario subclass")
-        if kind in KINDS:
-            raise ValueError(f"scenario kind {kind!r} is already registered (by {KINDS[kind].__module__})")
-        if not cls.section or cls.section not in cls.model_fields:
+        if isinstance(cls, type) and issubclass(cls, Scenario) and (not cls.section or cls.section not in cls.model_fields):
             raise TypeError(f"scenario kind {kind!r}: {cls.__name__}.section must name one of its fields")
-        KINDS[kind] = cls
+        KINDS.add(kind, cls)
         if default:
             _DEFAULT[:] = [kind]
         global _ADAPTER

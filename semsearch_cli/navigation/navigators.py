@@ -17,6 +17,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..kernels.harmonic import ascend, harmonic_field
+from ..registry import Registry
 
 HARMONIC_MARGIN_M = 3.0
 LOOKAHEAD_M = 8.0
@@ -32,22 +33,12 @@ class Navigator:
         raise NotImplementedError
 
 
-NAVIGATORS: dict[str, type[Navigator]] = {}
+NAVIGATORS = Registry("navigator", Navigator, names=True)
 
 
 def register_navigator(name: str):
     """Class decorator adding a :class:`Navigator` subclass under ``name`` (once per name)."""
-
-    def deco(cls):
-        if not (isinstance(cls, type) and issubclass(cls, Navigator)):
-            raise TypeError(f"navigator {name!r}: {cls!r} is not a Navigator subclass")
-        if name in NAVIGATORS:
-            raise ValueError(f"navigator {name!r} is already registered (by {NAVIGATORS[name].__module__})")
-        cls.name = name
-        NAVIGATORS[name] = cls
-        return cls
-
-    return deco
+    return NAVIGATORS.register(name)
 
 
 @register_navigator("geodesic")

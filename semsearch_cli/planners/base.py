@@ -36,6 +36,7 @@ from .. import __version__
 from ..errors import ScenarioError
 from ..files import user_file
 from ..provenance import code_hash, files_hash
+from ..registry import Registry
 
 
 class NoParams(BaseModel):
@@ -116,22 +117,12 @@ class Planner:
         raise NotImplementedError
 
 
-PLANNERS: dict[str, type[Planner]] = {}
+PLANNERS = Registry("planner", Planner, names=True)  # name -> class (ObjectPlanner and IndirectPlanner subclass Planner)
 
 
 def register_planner(name: str):
     """Class decorator adding a planner to the registry under ``name`` (must be new)."""
-
-    def deco(cls):
-        if not (isinstance(cls, type) and issubclass(cls, Planner)):
-            raise TypeError(f"planner {name!r}: {cls!r} is not a subclass of Planner (or ObjectPlanner, IndirectPlanner)")
-        if name in PLANNERS:
-            raise ValueError(f"planner {name!r} is already registered (by {PLANNERS[name].__module__}); choose another name")
-        cls.name = name
-        PLANNERS[name] = cls
-        return cls
-
-    return deco
+    return PLANNERS.register(name)
 
 
 ENTRY_POINT_GROUP = "semsearch.planners"

@@ -7,6 +7,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..registry import Registry
+
 
 @dataclass(frozen=True)
 class Section:
@@ -24,17 +26,12 @@ class Section:
     replays: bool = False
 
 
-SECTIONS: dict[str, Section] = {}
+SECTIONS = Registry("report section", Section)  # kind -> its Section
 
 
 def register_section(section: Section) -> Section:
     """Add a kind's report section (once per kind)."""
-    if not isinstance(section, Section):
-        raise TypeError(f"a report section must be a Section, not {type(section).__name__}")
-    if section.kind in SECTIONS:
-        raise ValueError(f"a report section for kind {section.kind!r} is already registered")
-    SECTIONS[section.kind] = section
-    return section
+    return SECTIONS.add(getattr(section, "kind", ""), section)
 
 
 def replaying() -> list[str]:

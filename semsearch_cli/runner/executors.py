@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from ..errors import BatchStopped, ScenarioError
+from ..registry import Registry
 from .execution import Executor, run_and_save
 from .specs import Loaded, RunSpec
 
@@ -108,22 +109,9 @@ class ProcessExecutor(Executor):
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-EXECUTORS: dict = {}  # --executor name -> a factory (workers, start_method, address, chunk) -> Executor
-
-
-def register_executor(name: str):
-    """Decorator adding an executor factory under ``name`` (once per name); the factory is
-    called with (workers, start_method, address, chunk) and returns an :class:`Executor`."""
-
-    def deco(factory):
-        if not callable(factory):
-            raise TypeError(f"executor {name!r}: {factory!r} is not callable")
-        if name in EXECUTORS:
-            raise ValueError(f"executor {name!r} is already registered")
-        EXECUTORS[name] = factory
-        return factory
-
-    return deco
+# --executor name -> a factory called with (workers, start_method, address, chunk) that returns an Executor
+EXECUTORS = Registry("executor")
+register_executor = EXECUTORS.register
 
 
 @register_executor("processes")

@@ -23,6 +23,7 @@ from ..config import Scenario
 from ..kernels.grid import dijkstra
 from ..errors import PlannerError, ScenarioError
 from ..metrics import run_row
+from ..registry import Registry
 from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
 from ..world.ground_truth import World
@@ -115,21 +116,6 @@ def checked_point(planner: str, x, y, frame, heading=None) -> tuple[float, float
     if not (0 <= r < frame.height and 0 <= c < frame.width):
         raise PlannerError(f"planner {planner!r} chose the point ({fx:.2f}, {fy:.2f}) m, off the map")
     return fx, fy
-
-
-TASKS: dict[str, type["Task"]] = {}
-
-
-def register_task(cls):
-    """Class decorator: the task answers scenarios of kind ``cls.kind`` (a :class:`Task` subclass,
-    one per kind)."""
-    if not (isinstance(cls, type) and issubclass(cls, Task)):
-        raise TypeError(f"{cls!r} is not a Task subclass")
-    if not cls.kind or cls.kind in TASKS:
-        raise ValueError(f"task kind {cls.kind!r} is empty or already registered"
-                         + (f" (by {TASKS[cls.kind].__module__})" if cls.kind in TASKS else ""))
-    TASKS[cls.kind] = cls
-    return cls
 
 
 class Task:
@@ -366,6 +352,15 @@ class Task:
         w = self.world
         return {"name": self.sc.name, "kind": self.kind, "grid": f"{w.frame.height} x {w.frame.width} cells at {w.frame.res} m",
                 "planners": self.planner_labels()}
+
+
+TASKS = Registry("task", Task)  # kind -> its Task subclass
+
+
+def register_task(cls):
+    """Class decorator: the task answers scenarios of kind ``cls.kind`` (a :class:`Task` subclass,
+    one per kind)."""
+    return TASKS.add(getattr(cls, "kind", ""), cls)
 
 
 def build_task(sc: Scenario, world: World, path: Path) -> Task:
