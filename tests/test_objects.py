@@ -136,7 +136,7 @@ def test_a_recorded_log_replays_like_its_timeline(office, tmp_path):
 
 @pytest.mark.parametrize("edit, field, needle", [
     (lambda d: d["objects"]["timelines"]["Static"]["mug"].update({3: "Z"}), "objects.timelines.Static.mug.3", "unknown place 'Z'"),
-    (lambda d: d.update(planners=[{"name": "nsos"}]), "planners[0].name", "door-search planner"),
+    (lambda d: d.update(planners=[{"name": "nsos"}]), "planners[0].name", "answers doors scenarios, not objects ones"),
     (lambda d: d["objects"]["cases"][0].update(record=["Tuesday"]), "objects.cases[0].record", "unknown timeline"),
     (lambda d: d["objects"]["places"][0].update(x=-5.0), "objects.places[0]", "outside the map"),
     (lambda d: d["objects"]["requests"][0].update(hour=25), "objects.requests[0].hour", "less than 24"),

@@ -22,7 +22,7 @@ class StraightOn(Planner):
 
     def choose(self, ctx, cands):
         if len(cands) == 0:
-            return None  # nowhere left to go: the run ends stuck
+            return None  # no frontier: the robot goes to look at walls it has not read yet
         x, y = ctx.belief.frame.to_world(cands.rows, cands.cols)
         dist = np.hypot(x - ctx.x, y - ctx.y)
         turn = np.abs((np.arctan2(y - ctx.y, x - ctx.x) - ctx.heading + np.pi) % (2 * np.pi) - np.pi)
