@@ -30,7 +30,7 @@ import numpy as np
 
 from semsearch_cli.belief import Belief
 from semsearch_cli.config import NavigationSpec, PlannerSpec
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks import build_task
 from semsearch_cli.navigation import GeodesicNavigator, HarmonicNavigator
 from semsearch_cli.planners import Variant
@@ -69,7 +69,7 @@ def thesis_tables(say, out: Path) -> None:
         t0 = time.perf_counter()
         L = Loaded.load(repo / "configs" / f"{name}.yaml")
         specs = expand(L, 10, planners=["greedy", "nsos"])
-        runs = run_batch(L, specs, out / name, workers=2)
+        runs = run_batch(L, specs, out / name, BatchOptions(workers=2))
         wall = time.perf_counter() - t0
         n_all += len(runs)
         wall_all += wall
@@ -192,7 +192,7 @@ def main() -> int:
         L = L.with_planners(tables[key])  # the task's own planners (setting L.sc alone left them as they were)
         specs = expand(L, 10)
         t0 = time.perf_counter()
-        runs = run_batch(L, specs, tmp / f"table-{key}", workers=2)
+        runs = run_batch(L, specs, tmp / f"table-{key}", BatchOptions(workers=2))
         wall = time.perf_counter() - t0
         labels = sorted(runs["planner"].unique())
         say(f"## 3. whole Hotel table: 4 goals x {', '.join(labels)} x 10 seeds = {len(specs)} runs, 2 workers")

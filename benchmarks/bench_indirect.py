@@ -20,7 +20,7 @@ from pathlib import Path
 
 from semsearch_cli.report.build import write_meta
 from semsearch_cli.config import read_yaml
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 
 SCENARIO = Path(__file__).resolve().parents[1] / "configs" / "indirect.yaml"
 
@@ -43,7 +43,7 @@ def main() -> None:
         raise SystemExit(f"{runs_csv} exists: the benchmark times a fresh run; give another --out")
     write_meta(args.out, loaded)  # so that `semsearch report OUT` can replay a search
     t0 = time.perf_counter()
-    rows = run_batch(loaded, specs, args.out, workers=args.workers)
+    rows = run_batch(loaded, specs, args.out, BatchOptions(workers=args.workers))
     wall = time.perf_counter() - t0
     print(f"{len(rows)} searches ({len(loaded.task.variants())} methods x {len(loaded.goals)} view scales x {trials} "
           f"trials), {args.workers} workers: {wall:.1f} s = {wall / 60:.1f} min (target for 15,400: 30 min); "

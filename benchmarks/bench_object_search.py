@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 from semsearch_cli.config import load_scenario
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks.objects import ObjectTask
 from semsearch_cli.planners import Variant
 from semsearch_cli.world.ground_truth import build_world
@@ -60,7 +60,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as d:
         specs = expand(L)
         t = time.perf_counter()
-        rows = run_batch(L, specs, Path(d), workers=2)
+        rows = run_batch(L, specs, Path(d), BatchOptions(workers=2))
         wall = time.perf_counter() - t
     print(f"| whole office experiment, {len(rows)} runs, 2 workers | {wall:.1f} s | "
           f"{rows['distance_m'].sum() / 1000:.1f} km travelled |")

@@ -26,7 +26,7 @@ from output import emit
 
 from semsearch_cli.config import PlannerSpec, read_yaml
 from semsearch_cli.report.document import markdown_table
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 
 PLANNERS = [PlannerSpec(name="greedy"), PlannerSpec(name="bvp"), PlannerSpec(name="geometric"),
             PlannerSpec(name="nsos", alpha=0.9), PlannerSpec(name="draft")]
@@ -58,7 +58,7 @@ def main() -> int:
                 data["goals"] = sorted({w.signs.number[i] for i in range(len(w.signs)) if w.readable_mask(i).any()}, key=str)
                 L = Loaded.load(p, data)
             L = L.with_planners(PLANNERS)
-            runs = run_batch(L, expand(L, a.seeds), a.out / L.sc.name, a.workers)
+            runs = run_batch(L, expand(L, a.seeds), a.out / L.sc.name, BatchOptions(workers=a.workers))
             frames.append(runs.assign(source=src.name))
             print(f"{L.sc.name}: {len(runs)} runs, {int((runs.outcome != 'found').sum())} not found", file=sys.stderr, flush=True)
     df = pd.concat(frames, ignore_index=True)

@@ -21,7 +21,7 @@ from output import emit
 from semsearch_cli.config import PlannerSpec
 from semsearch_cli.report.document import markdown_table
 from semsearch_cli.report.tables import goal_key
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 
 ROOT = Path(__file__).resolve().parents[1]
 PLANNERS = [PlannerSpec(name="greedy"), PlannerSpec(name="nsos", alpha=[0.8, 0.9, 1.0]), PlannerSpec(name="draft")]
@@ -39,7 +39,7 @@ def main() -> int:
     t0 = time.perf_counter()
     for name in a.configs.split(","):
         L = Loaded.load(ROOT / "configs" / f"{name}.yaml").with_planners(PLANNERS)
-        runs = run_batch(L, expand(L, a.seeds), a.out / name, a.workers)
+        runs = run_batch(L, expand(L, a.seeds), a.out / name, BatchOptions(workers=a.workers))
         g = runs.groupby(["goal", "planner"])["distance_m"].agg(["mean", "std"])
         cell = (g["mean"].round(1).astype(str) + " +- " + g["std"].round(1).astype(str)).unstack("planner")
         cell.index = [f"{name} {goal}" for goal in cell.index]

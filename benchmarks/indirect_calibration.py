@@ -39,7 +39,7 @@ import pandas as pd
 from semsearch_cli.config import read_yaml, with_param
 from semsearch_cli.report import stats
 from semsearch_cli.report.indirect import PAIR_KEYS, paired_success
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 
 SCENARIO = Path(__file__).resolve().parents[1] / "configs" / "indirect.yaml"
 SCALES = [1.0, 2.5]
@@ -170,7 +170,7 @@ def main() -> None:
 
 def searches(data: dict, folder: Path, workers: int) -> pd.DataFrame:
     loaded = Loaded.load(SCENARIO, data)
-    rows = run_batch(loaded, expand(loaded), folder, workers=workers)
+    rows = run_batch(loaded, expand(loaded), folder, BatchOptions(workers=workers))
     return rows[rows["stage"] == ""]
 
 

@@ -35,7 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from semsearch_cli.api import episodes as write_episodes  # noqa: E402
 from semsearch_cli.report.document import markdown_table  # noqa: E402
 from semsearch_cli.report.stats import paired  # noqa: E402
-from semsearch_cli.runner import Loaded, expand, run_batch  # noqa: E402
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch  # noqa: E402
 from semsearch_cli.tasks.episodes import Episode  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -107,7 +107,7 @@ def main() -> int:
     for scheme in SCHEMES:
         t0 = time.perf_counter()
         loaded = Loaded.load(scenario(work, scheme, episodes, a.starts))
-        df = run_batch(loaded, expand(loaded), work / scheme, workers=a.workers)
+        df = run_batch(loaded, expand(loaded), work / scheme, BatchOptions(workers=a.workers))
         runs[scheme] = df
         g, n = df[df["planner"] == "greedy"], df[df["planner"].str.startswith("nsos")]
         pr = paired(n, g)

@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from thesis import GREEDY, MAPS, NSOS, SHORTEST  # noqa: E402
 
 from semsearch_cli.config import PlannerSpec  # noqa: E402
-from semsearch_cli.runner import Loaded, expand, run_batch  # noqa: E402
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch  # noqa: E402
 from semsearch_cli.planners import expand_variants  # noqa: E402
 from semsearch_cli.report.build import write_meta  # noqa: E402
 from semsearch_cli.report.tables import summarise  # noqa: E402
@@ -67,7 +67,7 @@ def main() -> int:
         todo = expand(L, a.seeds)
         t0 = time.perf_counter()
         write_meta(a.out / name.lower(), L)
-        runs = run_batch(L, todo, a.out / name.lower(), a.workers)
+        runs = run_batch(L, todo, a.out / name.lower(), BatchOptions(workers=a.workers))
         print(f"{name}: {len(todo)} runs in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
         s = summarise(runs).set_index(["goal", "planner"])
         for g in goals:

@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from semsearch_cli.report.document import markdown_table  # noqa: E402
 from semsearch_cli.report.stats import mean_ci  # noqa: E402
-from semsearch_cli.runner import Loaded, expand, run_batch  # noqa: E402
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch  # noqa: E402
 from scipy.stats import wilcoxon  # noqa: E402
 
 CONFIGS = ("normal", "inverse", "hotel_thesis", "kth")
@@ -45,7 +45,7 @@ def run_policy(replan: str, out: Path, workers: int) -> tuple[pd.DataFrame, floa
         data = yaml.safe_load(path.read_text())
         data.setdefault("navigation", {})["replan"] = replan
         L = Loaded.load(path, data)
-        runs = run_batch(L, expand(L, 10, planners=["greedy", "nsos"]), out / replan / name, workers=workers)
+        runs = run_batch(L, expand(L, 10, planners=["greedy", "nsos"]), out / replan / name, BatchOptions(workers=workers))
         frames.append(runs.assign(config=name))
     return pd.concat(frames, ignore_index=True), time.perf_counter() - t0
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 
 
 def main() -> int:
@@ -28,7 +28,7 @@ def main() -> int:
     for line in (a.batch / "index.txt").read_text().split():
         p = a.batch / line
         L = Loaded.load(p)
-        runs = run_batch(L, expand(L), p.parent / "results", a.workers)
+        runs = run_batch(L, expand(L), p.parent / "results", BatchOptions(workers=a.workers))
         layout, scheme = L.sc.name.split("-", 1)[0], L.sc.name.split("-", 1)[1].rsplit("-", 1)[0]
         frames.append(runs.assign(layout=layout, scheme=scheme))
         print(f"{L.sc.name}: {len(runs)} rows", file=sys.stderr, flush=True)

@@ -23,6 +23,7 @@ import pandas as pd
 from output import emit
 
 from semsearch_cli import api
+from semsearch_cli.runner import BatchOptions
 from semsearch_cli.report.document import markdown_table
 
 REPO = Path(__file__).resolve().parents[1]
@@ -45,7 +46,7 @@ def main() -> int:
             for k in range(a.repeat):
                 out = Path(tmp) / f"{executor}-{workers}-{k}"
                 t0 = time.perf_counter()
-                res = api.run(a.scenario, seeds=a.seeds, workers=workers, planners=[a.planner], out=out, plots=False, executor=executor)
+                res = api.run(a.scenario, BatchOptions(seeds=a.seeds, workers=workers, planners=[a.planner], out=out, executor=executor), plots=False)
                 times.append(time.perf_counter() - t0)
                 got = res.runs[SAME].sort_values(["planner", "goal", "seed"]).reset_index(drop=True)
                 if reference is None:

@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from semsearch_cli.report.document import markdown_table  # noqa: E402
 from semsearch_cli.report.stats import mean_ci  # noqa: E402
-from semsearch_cli.runner import Loaded, expand, run_batch  # noqa: E402
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch  # noqa: E402
 
 ORIGIN = (-3.0, -2.0)
 CLI = [sys.executable, "-c", "from semsearch_cli.cli import main; main()"]
@@ -91,7 +91,7 @@ def main() -> int:
         data = yaml.safe_load((out / "scenario.yaml").read_text())
         data["planners"] = [{"name": "greedy"}, {"name": "nsos", "alpha": 0.9}]
         L = Loaded.load(out / "scenario.yaml", data)
-        runs[name] = run_batch(L, expand(L, a.seeds), out / "runs", workers=a.workers)
+        runs[name] = run_batch(L, expand(L, a.seeds), out / "runs", BatchOptions(workers=a.workers))
     key = ["planner", "goal", "seed"]
     both = runs["without --clean"].merge(runs["with --clean"], on=key, suffixes=("_raw", "_clean"))
     rows = []

@@ -19,7 +19,7 @@ from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import Loaded, check_folder, check_kind, expand, folder_lock, make_executor, run_batch, run_rows
+from .runner import BatchOptions, Loaded, check_folder, expand, folder_lock, make_executor, run_batch, run_rows
 from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
@@ -41,51 +41,18 @@ def default_out(loaded: Loaded, out: str | Path | None) -> Path:
     return Path("results") / loaded.sc.name
 
 
-MAX_WORKERS = 512  # even with --oversubscribe
-
-
-def workers_for(workers: int | None, oversubscribe: bool = False) -> int:
-    """The number of worker processes: by default the CPU count, at most 4; more workers than
-    CPUs only slow each run down and multiply memory, so they are refused unless
-    ``oversubscribe`` (never more than :data:`MAX_WORKERS`)."""
-    cpus = os.cpu_count() or 1
-    if workers is None:
-        return max(1, min(4, cpus))
-    if workers < 1 or workers > MAX_WORKERS or (workers > cpus and not oversubscribe):
-        limit = f"at most {cpus} (the CPU count)" + (f", or up to {MAX_WORKERS} with --oversubscribe" if workers <= MAX_WORKERS else "")
-        raise ScenarioError("<command line>", "--workers", f"{workers} workers on {cpus} CPUs: {limit}")
-    return workers
-
-
-def check_executor(executor: str, scheduler: str | None, workers: int | None, oversubscribe: bool) -> int:
-    """The worker count for a batch on ``executor``; a :class:`ScenarioError` for an unknown
-    executor or a scheduler given to the process pool. With a scheduler, the cluster's own
-    workers run the batch and ``workers`` is not checked."""
-    check_kind(executor)
-    if scheduler is not None and executor != "dask":
-        raise ScenarioError("<command line>", "--scheduler", "a scheduler address goes with --executor dask")
-    if scheduler is not None and not scheduler.strip():
-        raise ScenarioError("<command line>", "--scheduler", "an empty address; give tcp://HOST:PORT")
-    if scheduler:
-        return workers or 1
-    return workers_for(workers, oversubscribe)
-
-
-def run(scenario: str | Path, seeds: int | None = None, workers: int | None = None, goals=None,
-        planners=None, out: str | Path | None = None, progress=None, plots: bool = True,
-        trace: bool = False, planner_specs=None, force: bool = False, oversubscribe: bool = False,
-        executor: str = "processes", scheduler: str | None = None) -> RunOutput:
-    """Run a scenario's experiment: rows to runs.csv, then summary.csv and plots/.
-
-    ``planner_specs`` (a list of :class:`~semsearch_cli.config.PlannerSpec`) replaces the
-    scenario's planners; ``trace`` writes each run's decisions to traces/<run>.jsonl. The
-    output folder is locked for the command; rows of another (or an edited) scenario in it are
-    refused unless ``force`` (see :func:`~semsearch_cli.runner.run_batch`). ``workers`` is
-    checked by :func:`workers_for`. ``executor`` (``processes`` or ``dask``) and ``scheduler``
-    (a Dask scheduler's address; without one, a local cluster of ``workers``) say where the runs
-    run (see :func:`~semsearch_cli.runner.make_executor`).
+def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=None, plots: bool = True,
+        planner_specs=None) -> RunOutput:
+    """Run a scenario's experiment (:class:`~semsearch_cli.runner.BatchOptions` say which runs,
+    where and how): rows to runs.csv, then summary.csv and the report's tables and PNG figures
+    (``plots``). ``planner_specs`` (a list of :class:`~semsearch_cli.config.PlannerSpec`)
+    replaces the scenario's planners. The output folder is locked for the command; rows of
+    another (or an edited) scenario in it are refused unless ``options.force`` (see
+    :func:`~semsearch_cli.runner.run_batch`). ``progress(row, done, total)`` is called as each run
+    finishes.
     """
-    workers = check_executor(executor, scheduler, workers, oversubscribe)
+    options = options.checked()
+    goals, planners = options.goals, options.planners
     loaded = Loaded.load(Path(scenario))
     if planner_specs is not None:
         loaded = loaded.with_planners(planner_specs)
@@ -94,15 +61,15 @@ def run(scenario: str | Path, seeds: int | None = None, workers: int | None = No
         for g in goals:
             if str(g) not in known:
                 raise ScenarioError("<command line>", "--goal", f"goal {g} is not among the scenario's goals {loaded.goals}")
-    specs = expand(loaded, seeds, goals, planners)
+    specs = expand(loaded, options.seeds, goals, planners)
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
-    out_dir = default_out(loaded, out)
+    out_dir = default_out(loaded, options.out)
     with folder_lock(out_dir):
-        check_folder(loaded, out_dir, force)
+        check_folder(loaded, out_dir, options.force)
         report_build.write_meta(out_dir, loaded)
         loaded.task.write_inputs(out_dir)
-        runs = run_batch(loaded, specs, out_dir, workers, progress, trace, executor=executor, scheduler=scheduler)
+        runs = run_batch(loaded, specs, out_dir, options, progress)
         summary = write_summary(runs, out_dir)
         if plots:
             report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
@@ -129,9 +96,7 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
     return report_build.build_report([Path(f) for f in folders], output_folder(out) if out is not None else None, formats, replay)
 
 
-def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = None, workers: int | None = None,
-                goals=None, out: str | Path | None = None, progress=None, trace: bool = False, force: bool = False,
-                oversubscribe: bool = False, executor: str = "processes", scheduler: str | None = None) -> RunOutput:
+def sweep_alpha(scenario: str | Path, alphas: list[float], options: BatchOptions = BatchOptions(), progress=None) -> RunOutput:
     """The planner that sweeps alpha (:attr:`Planner.swept`: nsos) at each alpha with the baseline
     planner (:attr:`Planner.baseline`: greedy) beside it: the rows and summary of :func:`run`, plus
     ``plots/alpha_sweep.png``. The swept planner is the scenario's first entry of one that sweeps
@@ -148,8 +113,7 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], seeds: int | None = N
     base = entry.params() if entry is not None else {}
     base.pop("alpha", None)
     specs = [PlannerSpec(name=baseline), PlannerSpec(name=name, alpha=[float(a) for a in alphas], **base)]
-    res = run(scenario, seeds, workers, goals, None, out, progress, True, trace, planner_specs=specs, force=force,
-              oversubscribe=oversubscribe, executor=executor, scheduler=scheduler)
+    res = run(scenario, options.replace(planners=None), progress, True, planner_specs=specs)
     labels = {v.label for v in expand_variants(specs, str(scenario))}
     (res.out / "plots").mkdir(parents=True, exist_ok=True)
     plot_alpha_sweep(run_rows(res.runs)[run_rows(res.runs)["planner"].isin(labels)], res.out / "plots" / "alpha_sweep.png")
@@ -197,37 +161,34 @@ def parse_param(text: str) -> tuple[str, list]:
     return name.strip(), values
 
 
-def sweep(scenario: str | Path, param: str, values: list, seeds: int | None = None, workers: int | None = None,
-          goals=None, planners=None, out: str | Path | None = None, progress=None, trace: bool = False,
-          force: bool = False, oversubscribe: bool = False, executor: str = "processes",
-          scheduler: str | None = None) -> SweepOutput:
+def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions = BatchOptions(), progress=None) -> SweepOutput:
     """Run a scenario once per value of one parameter (see
     :func:`~semsearch_cli.config.with_param`): each value's rows go to ``out/<param>=<value>/``
     (resumable, as :func:`run`), then ``sweep.csv``, ``sweep.md`` and ``sweep.png`` compare them.
     Every value is checked before anything runs."""
-    workers = check_executor(executor, scheduler, workers, oversubscribe)
+    options = options.checked()
     path = Path(scenario)
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
     for v, ld in zip(values, loaded):
         _typed(param, v, ld)
-    out_dir = Path(out) if out else inside(Path("results"), f"{loaded[0].sc.name}-sweep-{param}")
+    out_dir = Path(options.out) if options.out else inside(Path("results"), f"{loaded[0].sc.name}-sweep-{param}")
     # one Dask cluster (or client) for every value; the process pool starts per value (a fork costs little)
-    shared = make_executor(workers, None, executor, scheduler) if executor != "processes" else nullcontext()
+    shared = (make_executor(options.workers, None, options.executor, options.scheduler) if options.executor != "processes"
+              else nullcontext())
     with folder_lock(out_dir), shared as runner:
         subs = [inside(out_dir, f"{param}={v}") for v in values]
         for ld, sub in zip(loaded, subs):  # refuse foreign rows before anything runs
-            check_folder(ld, sub, force)
+            check_folder(ld, sub, options.force)
         frames = []
         for v, ld, sub in zip(values, loaded, subs):
-            specs = expand(ld, seeds, goals, planners)
+            specs = expand(ld, options.seeds, options.goals, options.planners)
             if not specs:
-                raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
+                raise ScenarioError("<command line>", "--planner", f"no planner variant matches {options.planners}")
             with folder_lock(sub):
                 report_build.write_meta(sub, ld)
                 ld.task.write_inputs(sub)
-                runs = run_batch(ld, specs, sub, workers, progress, trace, force=force, executor=executor,
-                                 scheduler=scheduler, runner=runner)
+                runs = run_batch(ld, specs, sub, options, progress, runner=runner)
                 write_summary(runs, sub)
             frames.append(run_rows(runs).assign(value=v))
         runs = pd.concat(frames, ignore_index=True)

@@ -18,6 +18,7 @@ from rich.text import Text
 
 from . import api
 from .provenance import version_line
+from .runner import BatchOptions
 from .belief.presence import presence_scores, read_counts
 from .config.base import MAX_SEEDS
 from .config.indirect import IndirectSpec
@@ -73,40 +74,58 @@ def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
     return [int(v) if v.lstrip("-").isdigit() else v for v in items]
 
 
+# the batch options of run, sweep-alpha and sweep, declared once (see runner.BatchOptions)
+SEEDS = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Repeats of each episode per planner variant (default: the scenario's experiment.seeds).")
+WORKERS = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe).")
+GOALS = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate).")
+PLANNERS = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate).")
+TRACE = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl.")
+FORCE = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak.")
+OVERSUBSCRIBE = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O).")
+EXECUTOR = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers).")
+SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask).")
+
+
+def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler) -> BatchOptions:
+    return BatchOptions(seeds=seeds, goals=_split(goal, "--goal"), planners=_split(planner, "--planner"), out=out_dir,
+                        workers=workers, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace,
+                        force=force)
+
+
 @app.command()
 def run(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Repeats of each episode per planner variant (default: the scenario's experiment.seeds)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
-    goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate)."),
-    planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate)."),
+    seeds: Optional[int] = SEEDS,
+    workers: Optional[int] = WORKERS,
+    goal: Optional[List[str]] = GOALS,
+    planner: Optional[List[str]] = PLANNERS,
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
-    trace: bool = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl."),
-    force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
-    oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
-    executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
+    trace: bool = TRACE,
+    force: bool = FORCE,
+    oversubscribe: bool = OVERSUBSCRIBE,
+    executor: str = EXECUTOR,
+    scheduler: Optional[str] = SCHEDULER,
 ):
     """Run a scenario's experiment: episodes x planner variants x repeats; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
-    _batch(lambda tick: api.run(scenario, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir, progress=tick, trace=trace,
-                                force=force, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler))
+    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler)
+    _batch(lambda tick: api.run(scenario, opts, progress=tick))
 
 
 @app.command("sweep-alpha")
 def sweep_alpha(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
     alphas: str = typer.Option("0,0.5,0.8,0.9,1.0", "--alphas", help="Comma-separated alpha values for nsos."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Runs per goal and variant (default: the scenario's)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
-    goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
+    seeds: Optional[int] = SEEDS,
+    workers: Optional[int] = WORKERS,
+    goal: Optional[List[str]] = GOALS,
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
-    trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
-    force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
-    oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
-    executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
+    trace: bool = TRACE,
+    force: bool = FORCE,
+    oversubscribe: bool = OVERSUBSCRIBE,
+    executor: str = EXECUTOR,
+    scheduler: Optional[str] = SCHEDULER,
 ):
     """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
     plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
@@ -117,8 +136,8 @@ def sweep_alpha(
         _fail(ScenarioError("<command line>", "--alphas", f"expected comma-separated numbers, got {alphas!r}"))
     if not values or any(not 0.0 <= a <= 1.0 for a in values):
         _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
-    res = _batch(lambda tick: api.sweep_alpha(scenario, values, seeds, workers, _split(goal, "--goal"), out_dir, progress=tick, trace=trace,
-                                                     force=force, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler))
+    opts = _options(seeds, workers, goal, None, out_dir, trace, force, oversubscribe, executor, scheduler)
+    res = _batch(lambda tick: api.sweep_alpha(scenario, values, opts, progress=tick))
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
 
@@ -127,16 +146,16 @@ def sweep(
     scenario: Path = typer.Argument(..., help="Scenario YAML file."),
     param: str = typer.Option(..., "--param", help="SECTION.FIELD=V1,V2,... e.g. door_camera.p_misread=0,0.02,0.05,0.1, "
                               "or PLANNER.PARAM=... e.g. nsos.alpha=0.8,0.9,1.0."),
-    seeds: Optional[int] = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Runs per goal and variant (default: the scenario's)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe)."),
-    goal: Optional[List[str]] = typer.Option(None, "--goal", help="Only these goals."),
-    planner: Optional[List[str]] = typer.Option(None, "--planner", help="Only these planners, by name or label."),
+    seeds: Optional[int] = SEEDS,
+    workers: Optional[int] = WORKERS,
+    goal: Optional[List[str]] = GOALS,
+    planner: Optional[List[str]] = PLANNERS,
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>-sweep-<param>)."),
-    trace: bool = typer.Option(False, "--trace", help="Also write decision traces."),
-    force: bool = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak."),
-    oversubscribe: bool = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O)."),
-    executor: str = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers)."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask)."),
+    trace: bool = TRACE,
+    force: bool = FORCE,
+    oversubscribe: bool = OVERSUBSCRIBE,
+    executor: str = EXECUTOR,
+    scheduler: Optional[str] = SCHEDULER,
 ):
     """Run a scenario once per value of one parameter: each value's rows in <out>/<param>=<value>/
     (resumable), then sweep.csv, sweep.md and sweep.png (mean ratio to the shortest path and success
@@ -146,8 +165,8 @@ def sweep(
         name, values = api.parse_param(param)
     except ScenarioError as exc:
         _fail(exc)
-    res = _with_progress(lambda tick: api.sweep(scenario, name, values, seeds, workers, _split(goal, "--goal"), _split(planner, "--planner"), out_dir,
-                                                progress=tick, trace=trace, force=force, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler))
+    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler)
+    res = _with_progress(lambda tick: api.sweep(scenario, name, values, opts, progress=tick))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
     out.print(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv")

@@ -33,6 +33,17 @@ def soft_spl(shortest: float, distance: float, left: float) -> float:
     return progress * shortest / max(shortest, distance)
 
 
+def result_columns(outcome: str, distance: float, shortest: float, steps: int, decisions: int, wall_s: float) -> dict:
+    """The columns that say how a run (or a chain's stage) went: outcome, cause, success, distance
+    beside the shortest path (m), ratio, SPL, counts and wall time; the one place they are made."""
+    success = outcome == "found"
+    return {"outcome": outcome, "cause": CAUSES.get(outcome, outcome), "success": int(success),
+            "distance_m": round(distance, 3), "shortest_m": round(shortest, 3),
+            "ratio": round(distance / shortest, 4) if shortest > 0 else float("nan"),
+            "spl": round(spl(success, shortest, distance), 4), "steps": steps, "decisions": decisions,
+            "wall_s": round(wall_s, 3)}
+
+
 def run_row(kind: str, scenario: str, variant, ep, seed: int, result, navigator: str, room: str = "") -> dict:
     """One row: the run's identity (kind, scenario, planner label and parameters, goal, episode,
     repeat and start), its outcome and, when it failed, why (``cause``: budget, stuck, explored
@@ -58,19 +69,10 @@ def run_row(kind: str, scenario: str, variant, ep, seed: int, result, navigator:
         "room": room,
         "stage": "",
         "map": "",
-        "outcome": result.outcome,
-        "cause": CAUSES.get(result.outcome, result.outcome),
-        "success": int(success),
-        "distance_m": round(d, 3),
-        "shortest_m": round(shortest, 3),
-        "ratio": round(d / shortest, 4) if shortest > 0 else float("nan"),
-        "spl": round(spl(success, shortest, d), 4),
+        **result_columns(result.outcome, d, shortest, result.steps, result.decisions, result.wall_s),
         "soft_spl": round(soft_spl(shortest, d, 0.0 if success else left), 4) if d == d else float("nan"),
         "left_m": round(left, 3) if left == left else "",
         "time_s": round(result.time_s, 2) if result.time_s == result.time_s else "",
-        "steps": result.steps,
-        "decisions": result.decisions,
         "navigator": navigator,
-        "wall_s": round(result.wall_s, 3),
         "message": result.message,
     }

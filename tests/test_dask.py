@@ -21,7 +21,7 @@ from typer.testing import CliRunner
 
 from semsearch_cli import api
 from semsearch_cli.cli import app
-from semsearch_cli.runner import read_runs
+from semsearch_cli.runner import BatchOptions, read_runs
 
 distributed = pytest.importorskip("distributed")
 cluster_module = pytest.importorskip("semsearch_cli.runner.cluster")
@@ -66,8 +66,8 @@ def _rows(folder: Path) -> pd.DataFrame:
 
 def test_rows_on_the_cluster_match_the_process_pool(cluster, demo_dir, tmp_path):
     address, _ = cluster
-    pool = api.run(demo_dir / "scenario.yaml", seeds=3, workers=2, out=tmp_path / "pool", plots=False)
-    dask = api.run(demo_dir / "scenario.yaml", seeds=3, out=tmp_path / "dask", plots=False, executor="dask", scheduler=address)
+    pool = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=3, workers=2, out=tmp_path / "pool"), plots=False)
+    dask = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=3, out=tmp_path / "dask", executor="dask", scheduler=address), plots=False)
     assert len(pool.runs) == len(dask.runs) == 12
     pd.testing.assert_frame_equal(_rows(tmp_path / "pool"), _rows(tmp_path / "dask"))
     assert len(list((tmp_path / "dask" / "paths").glob("*.npz"))) == 12  # written by the client: no shared folder needed
@@ -83,26 +83,25 @@ def test_a_worker_killed_mid_batch_loses_and_duplicates_no_run(cluster, demo_dir
             os.kill(victim.pid, signal.SIGKILL)  # mid-batch: the other chunks of that worker are lost with it
             killed.append(done)
 
-    res = api.run(demo_dir / "scenario.yaml", seeds=10, out=tmp_path / "o", plots=False, executor="dask", scheduler=address,
-                  progress=tick)
+    res = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=10, out=tmp_path / "o", executor="dask", scheduler=address), plots=False, progress=tick)
     assert killed and victim.wait(timeout=10) == -signal.SIGKILL
     runs = read_runs(tmp_path / "o" / "runs.csv")
     keys = list(zip(runs["planner"], runs["goal"].astype(str), runs["seed"]))
     assert len(runs) == len(res.runs) == 40 and len(set(keys)) == 40  # every run exactly once
-    pool = api.run(demo_dir / "scenario.yaml", seeds=10, workers=2, out=tmp_path / "pool", plots=False)
+    pool = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=10, workers=2, out=tmp_path / "pool"), plots=False)
     pd.testing.assert_frame_equal(_rows(tmp_path / "o"), _rows(tmp_path / "pool"))
     assert len(pool.runs) == 40
 
 
 def test_a_batch_resumes_across_executors(demo_dir, tmp_path):
     out = tmp_path / "o"
-    api.run(demo_dir / "scenario.yaml", seeds=1, workers=2, out=out, plots=False)  # the process pool starts it
+    api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=1, workers=2, out=out), plots=False)  # the process pool starts it
     shutil.copy(out / "runs.csv", tmp_path / "first.csv")
-    res = api.run(demo_dir / "scenario.yaml", seeds=2, workers=2, out=out, plots=False, executor="dask")  # a local cluster ends it
+    res = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=2, workers=2, out=out, executor="dask"), plots=False)  # a local cluster ends it
     assert len(res.runs) == 8
     first = pd.read_csv(tmp_path / "first.csv")
     assert res.runs.head(len(first))["wall_s"].tolist() == first["wall_s"].tolist()  # the first rows were kept, not re-run
-    whole = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, out=tmp_path / "one", plots=False)
+    whole = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=2, workers=1, out=tmp_path / "one"), plots=False)
     pd.testing.assert_frame_equal(_rows(out), _rows(tmp_path / "one"))
     assert len(whole.runs) == 8
 
@@ -116,10 +115,10 @@ def test_a_sweep_uses_one_cluster_for_all_its_values(demo_dir, tmp_path, monkeyp
             super().__init__(*a, **k)
 
     monkeypatch.setattr(cluster_module.distributed, "LocalCluster", Counted)
-    kw = dict(seeds=2, goals=[452], planners=["greedy"], workers=2)
-    res = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], out=tmp_path / "dask", executor="dask", **kw)
+    opts = BatchOptions(seeds=2, goals=[452], planners=["greedy"], workers=2)
+    res = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], opts.replace(out=tmp_path / "dask", executor="dask"))
     assert len(started) == 1  # not one per value
-    pool = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], out=tmp_path / "pool", **kw)
+    pool = api.sweep(demo_dir / "scenario.yaml", "door_camera.p_misread", [0, 0.5, 0.9], opts.replace(out=tmp_path / "pool"))
     assert res.table["n"].tolist() == [2, 2, 2]
     pd.testing.assert_frame_equal(res.table, pool.table)
     for v in ("0", "0.5", "0.9"):

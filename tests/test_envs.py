@@ -16,7 +16,7 @@ from gymnasium.utils.env_checker import check_env, data_equivalence  # noqa: E40
 import semsearch_cli.envs as envs  # noqa: E402
 from semsearch_cli.envs import PlannerPolicy  # noqa: E402
 from semsearch_cli.planners import Variant  # noqa: E402
-from semsearch_cli.runner import Loaded, RunSpec, run_batch  # noqa: E402
+from semsearch_cli.runner import BatchOptions, Loaded, RunSpec, run_batch  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 KWARGS = {"semsearch/DoorSearch-v0": {"scenario": str(ROOT / "configs/demo.yaml")},
@@ -130,7 +130,7 @@ def batch_rows(tmp_path_factory):
         L = Loaded.load(ROOT / "configs" / f"{name}.yaml")
         specs = [RunSpec(ep, v, s) for ep in L.task.episodes[:2] for v in (Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),)))
                  for s in range(2)]
-        out[name] = run_batch(L, specs, tmp_path_factory.mktemp(name), workers=1)
+        out[name] = run_batch(L, specs, tmp_path_factory.mktemp(name), BatchOptions(workers=1))
     return out
 
 

@@ -13,7 +13,7 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks.episodes import region_mask
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -122,7 +122,7 @@ def test_rows_carry_the_episode_and_its_start(tmp_path):
     p = demo(tmp_path, episodes={"list": [{"goal": 452, "x": 15.0, "y": 10.0, "heading": 90.0},
                                           {"goal": 304, "x": 5.0, "y": 10.0}]})
     L = Loaded.load(p)
-    rows = run_batch(L, expand(L), tmp_path / "out", 1)
+    rows = run_batch(L, expand(L), tmp_path / "out", BatchOptions(workers=1))
     assert sorted(zip(rows["episode"], rows["seed"])) == [(0, 0), (0, 1), (1, 0), (1, 1)]
     first = rows[rows["episode"] == 0]
     assert (first["start_heading"] == 90.0).all() and (first["goal"] == 452).all() and (first["start_x"] == 15.0).all()
@@ -137,8 +137,8 @@ def test_rows_carry_the_episode_and_its_start(tmp_path):
 def test_a_renamed_copy_gives_identical_rows(tmp_path):
     (tmp_path / "elsewhere").mkdir()
     a, b = demo(tmp_path, "demo"), demo(tmp_path / "elsewhere", "another-name")
-    ra = run_batch(Loaded.load(a), expand(Loaded.load(a)), tmp_path / "a", 1)
-    rb = run_batch(Loaded.load(b), expand(Loaded.load(b)), tmp_path / "b", 1)
+    ra = run_batch(Loaded.load(a), expand(Loaded.load(a)), tmp_path / "a", BatchOptions(workers=1))
+    rb = run_batch(Loaded.load(b), expand(Loaded.load(b)), tmp_path / "b", BatchOptions(workers=1))
     cols = [c for c in ra.columns if c not in ("scenario", "wall_s", "fingerprint")]  # the name is part of the fingerprint
     key = ["goal", "episode", "seed"]
     pd.testing.assert_frame_equal(ra.sort_values(key)[cols].reset_index(drop=True), rb.sort_values(key)[cols].reset_index(drop=True))
@@ -241,7 +241,7 @@ def test_object_search_and_chains_draw_starts_too(tmp_path):
         r, c = w.frame.to_index(e.x, e.y)
         assert rooms[r, c] and w.reach[r, c]
         assert e.shortest_m == pytest.approx(w.geodesic((int(r), int(c)), t.goal_cells(e.goal))[0], abs=1e-6)
-    rows = run_batch(L, expand(L, goals=[t.goals[0]]), tmp_path / "out", 1)
+    rows = run_batch(L, expand(L, goals=[t.goals[0]]), tmp_path / "out", BatchOptions(workers=1))
     assert len(rows) == 3 and (rows["start_x"].tolist() == [e.x for e in t.episodes[:3]])
     h = yaml.safe_load((CONFIGS / "hospital.yaml").read_text())
     h["map"]["image"] = str(ROOT / "maps" / "hospital" / "map.png")
@@ -276,11 +276,11 @@ def test_a_changed_episode_set_never_passes_off_another_starts_rows(tmp_path):
     p = demo(tmp_path, goals=[304], episodes={"starts": 2, "shared": True, "min_distance": 5.0})
     L = Loaded.load(p)
     out = tmp_path / "out"
-    first = run_batch(L, expand(L, seeds=1), out, 1)
+    first = run_batch(L, expand(L, seeds=1), out, BatchOptions(workers=1))
     p2 = demo(tmp_path, goals=[304, 452], episodes={"starts": 2, "shared": True, "min_distance": 5.0})
     L2 = Loaded.load(p2)
     starts = {(str(e.goal), e.index): (e.x, e.y) for e in L2.task.episodes}
-    again = run_batch(L2, expand(L2, seeds=1), out, 1)
+    again = run_batch(L2, expand(L2, seeds=1), out, BatchOptions(workers=1))
     assert len(again) == 4 and all(starts[(str(g), e)] == (x, y) for g, e, x, y in
                                    zip(again["goal"], again["episode"], again["start_x"], again["start_y"]))
     side = pd.read_csv(out / "runs.superseded.csv")

@@ -12,7 +12,7 @@ from semsearch_cli import api
 from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
 from semsearch_cli.tasks import build_task
-from semsearch_cli.runner import expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, run_batch
 from semsearch_cli.planners import PLANNERS, Variant, expand_variants
 from semsearch_cli.config import PlannerSpec
 
@@ -66,8 +66,8 @@ def _rows(df):
 
 def test_rows_do_not_depend_on_worker_count(demo_loaded, tmp_path):
     specs = expand(demo_loaded, seeds=2)
-    one = run_batch(demo_loaded, specs, tmp_path / "w1", workers=1)
-    two = run_batch(demo_loaded, specs, tmp_path / "w2", workers=2)
+    one = run_batch(demo_loaded, specs, tmp_path / "w1", BatchOptions(workers=1))
+    two = run_batch(demo_loaded, specs, tmp_path / "w2", BatchOptions(workers=2))
     assert len(one) == len(specs) == 8
     pd.testing.assert_frame_equal(_rows(one), _rows(two))
 
@@ -105,7 +105,7 @@ def test_list_valued_parameters_expand_into_variants():
 
 
 def test_api_run_filters_planner(demo_dir, tmp_path):
-    res = api.run(demo_dir / "scenario.yaml", seeds=1, workers=1, goals=[452], planners=["bvp"], out=tmp_path / "o", plots=False)
+    res = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=1, workers=1, goals=[452], planners=["bvp"], out=tmp_path / "o"), plots=False)
     assert list(res.runs["planner"]) == ["bvp"]
 
 
@@ -208,7 +208,7 @@ def test_sweep_runs_one_folder_per_value(demo_dir, tmp_path):
         assert len(rows) == 2
     assert (out / "sweep.png").stat().st_size > 0 and "| door_camera.p_misread |" in (out / "sweep.md").read_text()
     # value 0 is the scenario itself: the same rows as a plain run
-    plain = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, goals=[452], planners=["greedy"], out=tmp_path / "plain", plots=False)
+    plain = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=2, workers=1, goals=[452], planners=["greedy"], out=tmp_path / "plain"), plots=False)
     a = pd.read_csv(out / "door_camera.p_misread=0" / "runs.csv").sort_values("seed")
     assert a["distance_m"].tolist() == plain.runs.sort_values("seed")["distance_m"].tolist()
 
@@ -233,7 +233,7 @@ def test_a_goal_with_a_slash_writes_its_path_file(tmp_path):
     sc = scenario_dict("slash", 0.1, (2.0, 1.5), ["12/2"], planners=[{"name": "greedy"}])
     p = write_building(tmp_path / "b", img, [("12/2", 8.0, 2.5, 270.0), (14, 4.0, 0.5, 90.0)], sc, "a goal with a slash")
     L = Loaded.load(p)
-    runs = run_batch(L, expand(L, 1), tmp_path / "out", 1)
+    runs = run_batch(L, expand(L, 1), tmp_path / "out", BatchOptions(workers=1))
     assert runs["outcome"].tolist() == ["found"]
     assert "/" not in file_stem("greedy", "12/2", 0, 0)
     assert (tmp_path / "out" / "paths" / f"{file_stem('greedy', '12/2', 0, 0)}.npz").is_file()

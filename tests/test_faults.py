@@ -14,7 +14,7 @@ import pytest
 
 from semsearch_cli import cli
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.runner import batch, expand, read_runs, run_batch, store
+from semsearch_cli.runner import batch, BatchOptions, expand, read_runs, run_batch, store
 from semsearch_cli.tasks import loop
 
 
@@ -163,7 +163,7 @@ def test_a_batch_that_would_not_fit_in_memory_is_refused_with_the_workers_that_f
     need = demo_loaded.task.memory_per_run()
     monkeypatch.setattr(batch, "available_memory", lambda: int(need * 2.5))
     with pytest.raises(ScenarioError) as err:
-        run_batch(demo_loaded, expand(demo_loaded, 2), tmp_path / "o", workers=4)
+        run_batch(demo_loaded, expand(demo_loaded, 2), tmp_path / "o", BatchOptions(workers=4))
     assert err.value.field == "--workers" and "run with --workers 2" in err.value.message
     assert not (tmp_path / "o" / "runs.csv").exists() or len(read_runs(tmp_path / "o" / "runs.csv")) == 0
 
@@ -171,6 +171,6 @@ def test_a_batch_that_would_not_fit_in_memory_is_refused_with_the_workers_that_f
 def test_a_long_run_says_it_is_alive(demo_loaded, tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(loop, "PROGRESS_S", 0.0)
     specs = list(expand(demo_loaded, 1))[:1]
-    run_batch(demo_loaded, specs, tmp_path / "o", workers=1)
+    run_batch(demo_loaded, specs, tmp_path / "o", BatchOptions(workers=1))
     err = capsys.readouterr().err
     assert f"run {specs[0].variant.label} goal {specs[0].episode.goal}" in err and "m so far" in err

@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.runner import batch, expand, run_batch
+from semsearch_cli.runner import batch, BatchOptions, expand, run_batch
 from semsearch_cli.tasks.objects import read_log
 
 runner = CliRunner()
@@ -99,5 +99,5 @@ def test_show_into_a_folder_that_takes_no_files_is_refused(demo_dir, tmp_path):
 
 def test_a_batch_of_many_runs_says_so_before_it_starts(demo_loaded, tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(batch, "MANY_RUNS", 4)
-    run_batch(demo_loaded, expand(demo_loaded, 2), tmp_path / "o", workers=1)
+    run_batch(demo_loaded, expand(demo_loaded, 2), tmp_path / "o", BatchOptions(workers=1))
     assert "runs: 8 to do (2 planner variant(s)" in capsys.readouterr().err

@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.planners import PLANNERS, base as planner_base
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks import TASKS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -62,8 +62,8 @@ def test_every_task_and_planner(kind, planner, tmp_path):
     back = pickle.loads(pickle.dumps(loaded))
     assert back.goals == loaded.goals and back.shortest == loaded.shortest
     specs = expand(loaded, seeds=1)[:2]
-    a = run_batch(loaded, specs, tmp_path / "w1", workers=1)
-    b = run_batch(back, specs, tmp_path / "w2", workers=2)
+    a = run_batch(loaded, specs, tmp_path / "w1", BatchOptions(workers=1))
+    b = run_batch(back, specs, tmp_path / "w2", BatchOptions(workers=2))
     assert set(a["kind"]) == {kind}
     for col in TASKS[kind].records:  # what the kind says it records, it records
         assert (a[col].astype(str) != "").all() and a[col].notna().all(), col
@@ -128,8 +128,8 @@ def test_a_planner_from_the_users_file_runs_in_spawned_workers(tmp_path):
     p = user_scenario(tmp_path, "spawned", body="pass")
     loaded = Loaded.load(p)
     specs = expand(loaded)
-    a = run_batch(loaded, specs, tmp_path / "serial", workers=1)
-    b = run_batch(loaded, specs, tmp_path / "spawn", workers=2, start_method="spawn")
+    a = run_batch(loaded, specs, tmp_path / "serial", BatchOptions(workers=1))
+    b = run_batch(loaded, specs, tmp_path / "spawn", BatchOptions(workers=2, start_method="spawn"))
     assert set(b["planner"]) == {"greedy", "spawned"} and (b["outcome"] != "error").all(), b["message"].tolist()
     key, cols = ["planner", "goal", "seed"], [c for c in a.columns if c != "wall_s"]
     pd.testing.assert_frame_equal(a.sort_values(key)[cols].reset_index(drop=True), b.sort_values(key)[cols].reset_index(drop=True))

@@ -15,7 +15,7 @@ from semsearch_cli.belief.indirect import (IndirectBelief, basic_masks, basic_pr
 from semsearch_cli.cli import app
 from semsearch_cli.config.indirect import EVERY_YAW_TABLE, SIDE_BLIND_TABLES, TABLE2, MasksSpec, SemanticCameraSpec
 from semsearch_cli.geometry import GridFrame
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.sensors.indirect import SemanticCamera, YawMemory
 from semsearch_cli.tasks.indirect import RoomGrid
 from semsearch_cli.world.rooms import Room, Thing, estimate_relations, generate_rooms, read_rooms, ring, write_rooms
@@ -371,7 +371,7 @@ def test_informed_global_search_finds_the_monitor_more_often_than_uninformed(tmp
     p = tmp_path / "indirect.yaml"
     p.write_text(yaml.safe_dump(d))
     loaded = Loaded.load(p)
-    rows = run_batch(loaded, expand(loaded), tmp_path / "out", workers=2)
+    rows = run_batch(loaded, expand(loaded), tmp_path / "out", BatchOptions(workers=2))
     found = rows.groupby("planner")["success"].sum()
     assert len(rows) == 80 and rows["room"].nunique() == 20
     assert found.to_dict() == {"ISCG-PN-SM": 37, "UIS": 29}

@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from semsearch_cli.planners.doors.nsos import NSOS
-from semsearch_cli.runner import Loaded, expand, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.world.labels import SignLabel, parse_label
 
 
@@ -31,7 +31,7 @@ def relabelled(demo_dir, tmp_path, rename, goals, planners):
     p = tmp_path / "s.yaml"
     p.write_text(yaml.safe_dump(d))
     loaded = Loaded.load(p)
-    return run_batch(loaded, expand(loaded), tmp_path / "out", workers=1)
+    return run_batch(loaded, expand(loaded), tmp_path / "out", BatchOptions(workers=1))
 
 
 PLANNERS = [{"name": "nsos", "alpha": 0.9}, {"name": "draft"}]

@@ -9,7 +9,7 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.runner import Loaded, execute, expand, run_batch
+from semsearch_cli.runner import BatchOptions, execute, expand, Loaded, run_batch
 from semsearch_cli.planners import LsosParams, lsos_goals
 from semsearch_cli.tasks.objects import parse_label, request_label, timeline_at
 from semsearch_cli.planners import Variant
@@ -102,8 +102,8 @@ def test_moved_mug_lsos_tries_a_then_finds_it_at_h(office):
 
 def test_rows_do_not_depend_on_workers(office, tmp_path):
     specs = [s for s in expand(office, seeds=2) if s.goal in ("Mobile.mug@0", "Shift.mug@12")]
-    a = run_batch(office, specs, tmp_path / "a", workers=1).sort_values(["planner", "goal", "seed"])
-    b = run_batch(office, specs, tmp_path / "b", workers=2).sort_values(["planner", "goal", "seed"])
+    a = run_batch(office, specs, tmp_path / "a", BatchOptions(workers=1)).sort_values(["planner", "goal", "seed"])
+    b = run_batch(office, specs, tmp_path / "b", BatchOptions(workers=2)).sort_values(["planner", "goal", "seed"])
     cols = ["planner", "goal", "seed", "outcome", "distance_m", "steps", "decisions"]
     assert a[cols].reset_index(drop=True).equals(b[cols].reset_index(drop=True))
     (row,), _ = execute(office, specs[0])

@@ -10,7 +10,7 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
-from semsearch_cli.runner import Loaded, expand, read_runs, run_batch
+from semsearch_cli.runner import BatchOptions, expand, Loaded, read_runs, run_batch
 
 runner = CliRunner()
 
@@ -58,7 +58,7 @@ def scenario(demo_dir, tmp_path, name, limit=None):
 
 def run(p, tmp_path, trace=False, workers=1):
     loaded = Loaded.load(p)
-    return run_batch(loaded, expand(loaded), tmp_path / "out", workers=workers, trace=trace)
+    return run_batch(loaded, expand(loaded), tmp_path / "out", BatchOptions(workers=workers, trace=trace))
 
 
 def test_sys_exit_inside_choose_is_that_runs_error_and_the_batch_goes_on(demo_dir, tmp_path):

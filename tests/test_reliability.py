@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from semsearch_cli import api
 from semsearch_cli.cli import app
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.runner import Loaded, ProcessExecutor, expand, folder_lock, read_runs, run_batch
+from semsearch_cli.runner import BatchOptions, expand, folder_lock, Loaded, ProcessExecutor, read_runs, run_batch
 
 runner = CliRunner()
 
@@ -62,17 +62,17 @@ def test_the_lock_is_reentrant_and_released(tmp_path):
 def test_rows_of_another_scenario_are_refused_then_forced(demo_dir, tmp_path):
     out = tmp_path / "out"
     a = demo_copy(demo_dir, tmp_path, "a.yaml")
-    api.run(a, seeds=1, workers=1, goals=[452], out=out, plots=False)
+    api.run(a, BatchOptions(seeds=1, workers=1, goals=[452], out=out), plots=False)
     b = demo_copy(demo_dir, tmp_path, "b.yaml", experiment={"seeds": 1, "max_distance": 300.0})  # an edited budget
     with pytest.raises(ScenarioError, match="--force"):
-        api.run(b, seeds=1, workers=1, goals=[452], out=out, plots=False)
+        api.run(b, BatchOptions(seeds=1, workers=1, goals=[452], out=out), plots=False)
     r = runner.invoke(app, ["run", str(b), "--seeds", "1", "--goal", "452", "--out", str(out), "--workers", "1"])
     assert r.exit_code == 2 and "another scenario" in " ".join(r.output.split())
-    res = api.run(b, seeds=1, workers=1, goals=[452], out=out, plots=False, force=True)
+    res = api.run(b, BatchOptions(seeds=1, workers=1, goals=[452], out=out, force=True), plots=False)
     assert len(res.runs) == 1 and res.runs["fingerprint"].nunique() == 1
     assert (out / "runs.1.csv.bak").is_file()  # nothing is lost
     # the same scenario resumes: nothing re-runs
-    again = api.run(b, seeds=1, workers=1, goals=[452], out=out, plots=False)
+    again = api.run(b, BatchOptions(seeds=1, workers=1, goals=[452], out=out), plots=False)
     assert len(again.runs) == 1
 
 
@@ -99,14 +99,14 @@ def test_the_fingerprint_ignores_the_run_list_but_not_the_map(demo_dir, tmp_path
 @pytest.mark.parametrize("cut", [5, 40, -3])
 def test_a_torn_last_line_is_dropped_wherever_it_is_cut(demo_loaded, tmp_path, cut):
     out = tmp_path / "out"
-    run_batch(demo_loaded, expand(demo_loaded, 2)[:2], out, 1)
+    run_batch(demo_loaded, expand(demo_loaded, 2)[:2], out, BatchOptions(workers=1))
     f = out / "runs.csv"
     lines = f.read_bytes().split(b"\n")
     last = lines[-2]
     assert b'"{' in last or b"{" in last  # the params field is quoted JSON
     f.write_bytes(b"\n".join(lines[:-2]) + b"\n" + last[:cut])  # cut inside the last row
     assert len(read_runs(f)) == 1
-    runs = run_batch(demo_loaded, expand(demo_loaded, 2)[:2], out, 1)
+    runs = run_batch(demo_loaded, expand(demo_loaded, 2)[:2], out, BatchOptions(workers=1))
     assert len(runs) == 2 and len(pd.read_csv(f)) == 2
 
 
@@ -182,6 +182,6 @@ def test_ctrl_c_stops_the_batch_keeps_its_rows_and_says_how_to_resume(demo_dir, 
     kept = read_runs(out / "runs.csv")
     assert 3 <= len(kept) < 400
     # resuming reuses every finished run: with fewer seeds, only the missing ones of those run
-    res = api.run(demo_dir / "scenario.yaml", seeds=2, workers=1, out=out, plots=False)
+    res = api.run(demo_dir / "scenario.yaml", BatchOptions(seeds=2, workers=1, out=out), plots=False)
     first = {(p, str(g), s) for p, g, s in zip(kept["planner"], kept["goal"], kept["seed"])}
     assert len(res.runs) == len(kept) + len({(p, str(g), s) for p in ("greedy", "bvp") for g in (304, 452) for s in (0, 1)} - first)

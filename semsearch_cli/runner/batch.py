@@ -15,6 +15,7 @@ from ..files import temp_path
 from ..planners import code_of
 from .execution import Executor
 from .executors import SerialExecutor, make_executor
+from .options import BatchOptions
 from .lock import folder_lock
 from .specs import Loaded, RunSpec
 from .store import RowWriter, read_runs, run_rows
@@ -125,17 +126,14 @@ def check_memory(loaded: Loaded, workers: int) -> None:
               "prints its progress every few seconds", file=sys.stderr)
 
 
-def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int = 1,
-              progress: Callable[[dict, int, int], None] | None = None, trace: bool = False,
-              start_method: str | None = None, force: bool = False, executor: str = "processes",
-              scheduler: str | None = None, runner: Executor | None = None) -> pd.DataFrame:
+def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
+              progress: Callable[[dict, int, int], None] | None = None, runner: Executor | None = None) -> pd.DataFrame:
     """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
-    With ``trace``, each run it runs also writes its decision trace to ``out/traces/``;
-    ``start_method`` is the worker processes' (see :class:`ProcessExecutor`); ``executor`` is
-    ``processes`` or ``dask`` (on the scheduler at ``scheduler``, or a local cluster of
-    ``workers``), see :func:`make_executor`: rows do not depend on it, and a batch started on one
-    resumes on another; ``runner``, an executor the caller made (and entered), e.g. one Dask
-    cluster for every value of a sweep, replaces both. ``progress(row, done, total)`` is called as
+    Of the :class:`BatchOptions`, ``workers`` (None: one), ``executor``, ``scheduler`` and
+    ``start_method`` say where the runs run (see :func:`make_executor`: rows do not depend on it,
+    and a batch started on one resumes on another), ``trace`` writes each run's decision trace to
+    ``out/traces/`` and ``force`` is explained below; ``runner``, an executor the caller made (and
+    entered), e.g. one Dask cluster for every value of a sweep, replaces the executor options. ``progress(row, done, total)`` is called as
     each run finishes, with the runs finished so far and the runs this batch has to do. The specs
     are streamed to the executor, never listed whole (a
     :class:`~semsearch_cli.runner.specs.RunList` of any length costs no memory).
@@ -145,11 +143,12 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
     folder are refused, unless ``force``, which moves that runs.csv aside (kept as
     ``runs.<n>.csv.bak``) and starts afresh."""
     runs_csv = out / "runs.csv"
+    workers, executor, trace = options.workers or 1, options.executor, options.trace
     fp = loaded.fingerprint
     variants = specs.variants if hasattr(specs, "variants") else list({s.variant for s in specs})
     codes = {v.label: code_of(v)["hash"] for v in variants}
     with folder_lock(out):
-        done = check_folder(loaded, out, force, codes)
+        done = check_folder(loaded, out, options.force, codes)
         have = {(str(p), str(g), int(e), int(s)) for p, g, e, s in zip(done["planner"], done["goal"], done["episode"], done["seed"])} \
             if len(done) else set()
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
@@ -162,7 +161,8 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, workers: int 
             check_memory(loaded, max(1, min(workers, total)))
         if runner is None:
             serial = total == 0 or (executor == "processes" and total == 1)
-            runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), start_method, executor, scheduler)
+            runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), options.start_method, executor,
+                                                                   options.scheduler)
         writer = RowWriter(runs_csv)
         n = 0
         try:

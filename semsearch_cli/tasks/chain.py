@@ -32,7 +32,7 @@ import pandas as pd
 import yaml
 
 from ..errors import ScenarioError
-from ..metrics import CAUSES, spl
+from ..metrics import result_columns
 from ..planners import PLANNERS, Variant
 from ..world.buildings.demo import write_demo
 from .base import RobotState, RunResult, Task, register_task
@@ -259,12 +259,8 @@ def _stage_row(k: int, s: Stage, mode: str, outcome: str, distance: float, steps
                wall: float) -> dict:
     """The columns of a stage row that differ from its chain's row (SoftSPL and the distance left
     are the chain's alone: empty here)."""
-    success = outcome == "found"
-    return {"stage": f"{k}:{s.label}", "map": mode, "outcome": outcome, "cause": CAUSES.get(outcome, outcome),
-            "success": int(success), "soft_spl": "", "left_m": "",
-            "distance_m": round(distance, 3), "shortest_m": round(shortest, 3),
-            "ratio": round(distance / shortest, 4) if shortest > 0 else float("nan"),
-            "spl": round(spl(success, shortest, distance), 4), "steps": steps, "decisions": decisions, "wall_s": round(wall, 3)}
+    return {"stage": f"{k}:{s.label}", "map": mode, **result_columns(outcome, distance, shortest, steps, decisions, wall),
+            "soft_spl": "", "left_m": ""}
 
 
 def _nearest_place(log: pd.DataFrame, places: dict) -> pd.Series:

@@ -11,7 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from semsearch_cli.planners import PLANNERS, Variant
-from semsearch_cli.runner import Loaded, RunSpec, run_batch
+from semsearch_cli.runner import BatchOptions, Loaded, run_batch, RunSpec
 
 ROOT = Path(__file__).resolve().parents[2]
 FILE = Path(__file__).with_name("rows.csv")
@@ -36,7 +36,7 @@ def golden_rows(out: Path) -> pd.DataFrame:
     for config, kind, episodes, repeats in CASES:
         L = Loaded.load(ROOT / "configs" / f"{config}.yaml")
         specs = [RunSpec(L.task.episodes[k], v, s) for v in planners(kind) for k in episodes for s in repeats]
-        run_batch(L, specs, out / config, workers=1)
+        run_batch(L, specs, out / config, BatchOptions(workers=1))
         frames.append(pd.read_csv(out / config / "runs.csv", dtype=str, keep_default_na=False))
     rows = pd.concat(frames, ignore_index=True).drop(columns=list(IGNORED))
     key = ["scenario", "planner", "goal", "episode", "seed", "stage"]
