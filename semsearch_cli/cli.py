@@ -87,9 +87,13 @@ SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, 
 
 
 def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler) -> BatchOptions:
-    return BatchOptions(seeds=seeds, goals=_split(goal, "--goal"), planners=_split(planner, "--planner"), out=out_dir,
-                        workers=workers, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace,
-                        force=force)
+    """The batch options of the command line (a bad --goal or --planner list exits with status 2)."""
+    try:
+        goals, planners = _split(goal, "--goal"), _split(planner, "--planner")
+    except ScenarioError as exc:
+        _fail(exc)
+    return BatchOptions(seeds=seeds, goals=goals, planners=planners, out=out_dir, workers=workers,
+                        oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace, force=force)
 
 
 @app.command()

@@ -30,3 +30,12 @@ def test_the_worked_example_on_the_planner_page_is_the_shipped_file():
     page = (ROOT / "docs" / "planners.md").read_text()
     for f in ("my_planner.py", "scenario.yaml"):
         assert (ROOT / "examples" / "custom_planner" / f).read_text() in page, f
+
+
+def test_the_observer_example_on_the_planner_page_runs(capsys, monkeypatch):
+    page = (ROOT / "docs" / "planners.md").read_text()
+    code = page.split("## Watching a run", 1)[1].split("```python\n", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(ROOT)
+    exec(compile(code, "planners.md", "exec"), {})
+    outcome, _, n, _ = capsys.readouterr().out.split(maxsplit=3)
+    assert outcome == "found" and int(n) > 0

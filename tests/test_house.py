@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 from semsearch_cli.cli import app
 from semsearch_cli.planners import PLANNERS, base as planner_base
 from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
-from semsearch_cli.tasks import TASKS
+from semsearch_cli.tasks import TASKS, TraceObserver
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"
@@ -79,10 +79,11 @@ def test_decisions_count_new_targets_only(demo_loaded):
     greedy and nsos choose the same cell again at periodic re-plans; neither counts."""
     for name in ("greedy", "bvp", "nsos"):
         v = planner_base.Variant(name, ())
-        res = demo_loaded.task.run(v, 452, 2, trace=True)
-        assert res.decisions == len(res.trace) > 0
-        assert not any(d.get("kept") for d in res.trace)
-        targets = [tuple(d["target"]) for d in res.trace]
+        tracer = TraceObserver()
+        res = demo_loaded.task.run(v, 452, 2, tracer)
+        assert res.decisions == len(tracer.rows) > 0
+        assert not any(d.get("kept") for d in tracer.rows)
+        targets = [tuple(d["target"]) for d in tracer.rows]
         assert all(a != b for a, b in zip(targets, targets[1:])), name
 
 

@@ -14,6 +14,7 @@ from semsearch_cli.planners import LsosParams, lsos_goals
 from semsearch_cli.tasks.objects import parse_label, request_label, timeline_at
 from semsearch_cli.planners import Variant
 from semsearch_cli.world.buildings.office import HOURS, TABLE_5_1
+from semsearch_cli.tasks import TraceObserver
 
 ROOT = Path(__file__).resolve().parents[1]
 OFFICE = ROOT / "configs" / "office.yaml"
@@ -176,7 +177,9 @@ def test_when_the_mug_is_gone_lsos_and_brute_force_look_everywhere_then_give_up(
         res = gone.task.run(Variant(planner, ()), req.label, 0)
         assert res.outcome == "not_found"
     # lsos went to its heat-map goals, then to every place the camera had not yet seen, in patrol order
-    trace = gone.task.run(Variant("lsos", ()), req.label, 0, trace=True).trace
+    tracer = TraceObserver()
+    gone.task.run(Variant("lsos", ()), req.label, 0, tracer)
+    trace = tracer.rows
     kinds = [t["kind"] for t in trace]
     k = kinds.count("heat")
     assert k == 2 and kinds == ["heat"] * k + ["patrol"] * (len(kinds) - k)

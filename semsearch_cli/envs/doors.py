@@ -126,7 +126,7 @@ class DoorSearchEnv(SearchEnv):
         t, ep = self.task, self.episode
         self.state = st = t.start_state(ep, self.rng)
         st.belief = t.new_belief()
-        self.search = DoorSearch(t, _Agent(self.replan_on_signs), ep.goal, self.rng, False, None)
+        self.search = DoorSearch(t, _Agent(self.replan_on_signs), ep.goal, self.rng)
         self.goal_label = parse_label(ep.goal)
         self.decision = None
         if self.action_mode == "macro":

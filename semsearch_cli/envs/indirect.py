@@ -100,7 +100,7 @@ class IndirectSearchEnv(SearchEnv):
         t, ep = self.task, self.episode
         self.grid = t.grids[ep.room]
         self.agent = _Agent(self.masks, self.negative)
-        self.search = IndirectSearch(t, self.grid, self.agent, float(ep.goal), self.rng, False)
+        self.search = IndirectSearch(t, self.grid, self.agent, float(ep.goal), self.rng)
         self.state = st = t.start_state(ep, self.rng)
         st.belief = self.search.new_belief()
         self.max_steps = int(round(t.spec.time_limit * t.spec.camera.fps))

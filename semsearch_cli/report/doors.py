@@ -15,7 +15,7 @@ from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import (animate_run, budget_curve, episode_mean, image_formats, swept_values, plot_alpha_sweep, plot_boxes, plot_budget,
                     plot_path_panels, plot_scenario, planner_colors)
-from .runfiles import load_paths, median_label, safe_name, start_points, stems
+from .runfiles import Frames, load_paths, median_label, safe_name, start_points, stems
 from .tables import goal_key
 
 
@@ -133,12 +133,12 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
             _replay(doc, loaded, rows, fdir, T.planner_order(rows["planner"]), replay)
 
 
-def _rerun(task, variant, goal, episode: int, seed: int, recorder):
+def _rerun(task, variant, goal, episode: int, seed: int, observer):
     """Re-simulate one run (runs are deterministic): the one place the report calls ``task.run``.
     ``episode`` is the row's index in the task's episode set; when that episode is not of ``goal``
     (rows from before episodes read as episode 0), the goal's first episode."""
     ep = next((e for e in task.episodes if e.index == episode and str(e.goal) == str(goal)), None)
-    return task.run(variant, ep if ep is not None else goal, seed, recorder=recorder)
+    return task.run(variant, ep if ep is not None else goal, seed, observer)
 
 
 def _replay(doc, loaded, runs, fdir, order, choice=True) -> None:
@@ -170,10 +170,11 @@ def _replay(doc, loaded, runs, fdir, order, choice=True) -> None:
     signs = w.signs
     where = {}
 
-    def rec(belief, trail, distance, cands, dec):
+    def rec(event):
         count[0] += 1
         if count[0] % step:
             return
+        belief, trail, cands = event.belief, event.trail, event.candidates
         m = np.where(belief.seen, np.where(belief.free, 2, 0), 1).astype(np.uint8)
         cx, cy = w.frame.to_world(cands.rows, cands.cols)
         read = []
@@ -181,11 +182,11 @@ def _replay(doc, loaded, runs, fdir, order, choice=True) -> None:
             if lab not in where:
                 where[lab] = signs.indices_of(lab)
             read += where[lab]
-        frames.append({"map": m[::2, ::2], "path": np.asarray(trail, float), "distance": distance,
+        frames.append({"map": m[::2, ::2], "path": np.asarray(trail, float), "distance": event.distance,
                        "cands": np.stack([cx, cy], axis=1) if len(cands) else np.zeros((0, 2)),
-                       "target": w.frame.to_world(dec.row, dec.col), "read": read})
+                       "target": event.target_xy, "read": read})
 
-    res = _rerun(loaded.task, variant, goal, episode, seed, rec)
+    res = _rerun(loaded.task, variant, goal, episode, seed, Frames(rec))
     if not frames:
         return
     i = signs.index_of(loaded.task.goal_value(goal))

@@ -15,7 +15,7 @@ from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import animate_probability, image_formats, plot_rooms, plot_success_by_scale
-from .runfiles import stems
+from .runfiles import Frames, stems
 
 # The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each
 PAPER_SCALES = (1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -235,13 +235,13 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
                 _replay(doc, part, run_rows(part.runs), out / "figures", notes, replay)
 
 
-def _rerun(task, variant, scale: float, episode: int, seed: int, recorder):
+def _rerun(task, variant, scale: float, episode: int, seed: int, observer):
     """Re-simulate one search (runs are deterministic): the one place this section calls
     ``task.run``; returns (result, the room searched). ``episode`` is the row's index in the task's
     episode set; when that episode is not at ``scale`` (rows from before episodes, read as episode
     0), the scale's first episode."""
     ep = next((e for e in task.episodes if e.index == episode and float(e.goal) == scale), None) or task.as_episode(scale)
-    return task.run(variant, ep, seed, recorder=recorder), task.grids[ep.room].room
+    return task.run(variant, ep, seed, observer), task.grids[ep.room].room
 
 
 def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, choice=True) -> None:
@@ -273,10 +273,10 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
         return
     frames = []
 
-    def rec(p, p0, trail, t, goal, seen):
-        frames.append({"p": p.copy(), "p0": p0, "trail": trail, "t": t, "goal": (goal.x, goal.y), "seen": seen})
+    def rec(e):
+        frames.append({"p": e.p.copy(), "p0": e.p0, "trail": e.trail, "t": e.t_s, "goal": (e.goal.x, e.goal.y), "seen": e.seen})
 
-    res, room = _rerun(loaded.task, variant, scale, episode, seed, rec)
+    res, room = _rerun(loaded.task, variant, scale, episode, seed, Frames(rec))
     if not frames:
         return
     f = fdir / f"replay_{loaded.sc.name}_{stems(label, f'{scale:g}', seed, episode)[0]}.gif"

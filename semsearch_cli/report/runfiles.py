@@ -12,6 +12,7 @@ import pandas as pd
 
 from ..files import safe_chars
 from ..runner import file_stem
+from ..tasks import Observer
 from .stats import episodes
 
 
@@ -63,3 +64,14 @@ def start_points(rows: pd.DataFrame, world) -> list[tuple[float, float]]:
         if len(xy):
             return [tuple(map(float, r)) for r in xy.to_numpy()]
     return [tuple(map(float, world.start_xy))]
+
+
+class Frames(Observer):
+    """The observer of a replayed run: calls ``on(event)`` at each of its events (a replay keeps
+    a frame from some of them)."""
+
+    def __init__(self, on):
+        self.on = on
+
+    def see(self, event) -> None:
+        self.on(event)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RunTimeout
-from ..tasks import RunResult
+from ..tasks import RunResult, TraceObserver
 from ..tasks.loop import running
 from .specs import Loaded, RunSpec
 from .store import save_run_files
@@ -31,7 +31,10 @@ def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[di
     running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
     try:
         with wall_clock_limit(limit):
-            res = task.run(spec.variant, spec.episode, spec.seed, trace)
+            tracer = TraceObserver() if trace else None
+            res = task.run(spec.variant, spec.episode, spec.seed, tracer)
+            if tracer is not None:
+                res.trace = tracer.rows
     except RunTimeout:
         res = RunResult("timeout", math.nan, 0, 0, limit, empty,
                         message=f"the run took longer than {limit:g} s of wall-clock time (experiment.run_time_limit)")

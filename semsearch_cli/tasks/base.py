@@ -11,6 +11,7 @@ scenario is.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -62,7 +63,58 @@ class Outcome:
     distance_m: float
     steps: int
     decisions: int
-    trace: list = field(default_factory=list)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Event:
+    """What a search decided at a re-plan, as its observers see it. Each kind defines its own
+    (``DoorDecision``, ``ObjectTarget``, ``IndirectGoal``, in its task module) with
+    :meth:`trace_row`, the JSON-able row ``--trace`` writes; ``stage`` is a chain's stage (1, 2,
+    ...), None outside chains; ``traced``: whether the trace keeps it (a new target)."""
+
+    stage: int | None = None
+
+    @property
+    def traced(self) -> bool:
+        return True
+
+    def row(self) -> dict:  # pragma: no cover
+        raise NotImplementedError
+
+    def trace_row(self) -> dict:
+        row = self.row()
+        return row if self.stage is None else {**row, "stage": self.stage}
+
+
+class Observer:
+    """Sees every :class:`Event` of a run (``Task.run(..., observer)``): the trace of
+    ``semsearch run --trace`` (:class:`TraceObserver`), a report's replay, a notebook's plot.
+    Observing changes nothing in the run; a planner may tabulate more for an observed run
+    (``PlanContext.explain``)."""
+
+    def see(self, event: Event) -> None:  # pragma: no cover
+        raise NotImplementedError
+
+
+class TraceObserver(Observer):
+    """Keeps the trace row of each event the trace keeps: ``rows``, what traces/<run>.jsonl holds."""
+
+    def __init__(self):
+        self.rows: list[dict] = []
+
+    def see(self, event: Event) -> None:
+        if event.traced:
+            self.rows.append(event.trace_row())
+
+
+class StageObserver(Observer):
+    """Passes a chain stage's events on to ``inner``, marked with the stage's number."""
+
+    def __init__(self, inner: Observer, stage: int):
+        self.inner, self.stage = inner, stage
+
+    def see(self, event: Event) -> None:
+        self.inner.see(dataclasses.replace(event, stage=self.stage))
 
 
 @dataclass
@@ -74,7 +126,7 @@ class RunResult:
     wall_s: float
     path: np.ndarray  # (n, 2) float32, m
     read_signs: list = field(default_factory=list)  # sign indices read at least once
-    trace: list = field(default_factory=list)  # one dict per decision
+    trace: list = field(default_factory=list)  # one dict per decision, when traced (runner.execute)
     stages: list = field(default_factory=list)  # extra rows of a run (chains: one per stage and mode)
     message: str = ""
     time_s: float = float("nan")  # simulated seconds, for tasks with a clock
@@ -300,8 +352,8 @@ class Task:
         heading = math.radians(ep.heading) if ep.heading is not None else float(rng.uniform(-np.pi, np.pi))
         return RobotState(ep.x, ep.y, heading, trail=[(ep.x, ep.y)])
 
-    def episode(self, state: RobotState, planner, goal, rng: np.random.Generator, trace: bool = False,
-                recorder=None) -> tuple[Outcome, RobotState]:  # pragma: no cover
+    def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
+                observer: Observer | None = None) -> tuple[Outcome, RobotState]:  # pragma: no cover
         raise NotImplementedError
 
     BYTES_PER_CELL: ClassVar[int] = 110  # measured: one run on a 25-million-cell map took 2.6 GB
@@ -312,18 +364,18 @@ class Task:
         f = self.world.frame
         return int(f.height * f.width * self.BYTES_PER_CELL)
 
-    def run(self, variant: Variant, ep: Episode, seed: int, trace: bool = False, recorder=None) -> RunResult:
+    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None) -> RunResult:
         """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode): the start state, then
-        one search."""
+        one search, its decisions shown to ``observer``."""
         t0 = time.perf_counter()
         ep = self.as_episode(ep)
         rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
         st = self.start_state(ep, rng)
         heading = st.heading
-        out, st = self.episode(st, variant.build(), ep.goal, rng, trace, recorder)
+        out, st = self.episode(st, variant.build(), ep.goal, rng, observer)
         left = 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), sorted(st.read_signs), out.trace, left_m=left,
+                         np.asarray(st.trail, np.float32), sorted(st.read_signs), left_m=left,
                          start_heading=heading)
 
     def rows(self, variant: Variant, ep: Episode, seed: int, res: RunResult) -> list[dict]:

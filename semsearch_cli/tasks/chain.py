@@ -35,7 +35,7 @@ from ..errors import ScenarioError
 from ..metrics import result_columns
 from ..planners import PLANNERS, Variant
 from ..world.buildings.demo import write_demo
-from .base import RobotState, RunResult, Task, register_task
+from .base import Observer, RobotState, RunResult, StageObserver, Task, register_task
 from .episodes import Episode, episode_seed
 from .doors import DoorTask
 from .objects import Case, ObjectTask
@@ -181,21 +181,24 @@ class ChainTask(Task):
         return self.legs[key]
 
     # ---- running ----------------------------------------------------------------------
-    def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, trace: bool):
-        """One stage from ``st``: (outcome, decisions, trace)."""
-        out, st = self.doors.episode(st, variant.build(), s.door, rng, trace, reuse_reads=reuse)
-        decisions, tr = out.decisions, list(out.trace)
+    def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, observer: Observer | None):
+        """One stage from ``st``: (outcome, decisions)."""
+        out, st = self.doors.episode(st, variant.build(), s.door, rng, observer, reuse_reads=reuse)
+        decisions = out.decisions
         if out.outcome != "found" or s.cls is None:
-            return out.outcome, decisions, tr
+            return out.outcome, decisions
         room = self.room_places(s.door)
         log = self.logs[ch.name]
         near = _nearest_place(log, self.objects.places)
         planner = Variant(ch.object_planner, ()).build()
         out, st = self.objects.search_episode(st, planner, s.cls, s.hour, self._instances(ch, s), log[near.isin(room)],
-                                              room, None, rng, trace)
-        return out.outcome, decisions + out.decisions, tr + out.trace
+                                              room, None, rng, observer)
+        return out.outcome, decisions + out.decisions
 
-    def run(self, variant: Variant, ep: Episode, seed: int, trace: bool = False, recorder=None) -> RunResult:
+    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None) -> RunResult:
+        """A chain's stages from one robot state (the map and the signs read kept); each stage
+        again from scratch beside it, unobserved. ``observer`` sees the kept stages' events,
+        marked with their stage."""
         t0 = time.perf_counter()
         ep = self.as_episode(ep)
         ch = self.chains[str(ep.goal)]
@@ -203,7 +206,7 @@ class ChainTask(Task):
         st = self.start_state(ep, np.random.default_rng(episode_seed(ep, seed, base)))
         heading = st.heading
         st.belief = self.doors.new_belief()
-        stages, decisions, trace_all = [], 0, []
+        stages, decisions = [], 0
         outcome = "found"
         legs = self.legs_from(ch, ep.x, ep.y)
         leg = iter(legs)
@@ -213,17 +216,17 @@ class ChainTask(Task):
             pose = (st.x, st.y, st.heading)
             d0, s0, t_stage = st.distance, st.steps, time.perf_counter()
             stage_seed = episode_seed(ep, seed, base, k)  # the same draws kept and from scratch
-            outcome, dec, tr = self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True, trace)
+            outcome, dec = self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True,
+                                       StageObserver(observer, k) if observer is not None else None)
             n_legs = 2 if s.cls is not None else 1
             shortest = sum(next(leg) for _ in range(n_legs))
             used += n_legs
             decisions += dec
-            trace_all += [{**d, "stage": k} for d in tr]
             stages.append(_stage_row(k, s, "kept", outcome, st.distance - d0, st.steps - s0, shortest, dec, time.perf_counter() - t_stage))
             # the same stage from scratch: same pose, empty map, same seed
             fresh = RobotState(*pose, trail=[pose[:2]])
             t_s = time.perf_counter()
-            o2, d2, _ = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, False)
+            o2, d2 = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, None)
             stages.append(_stage_row(k, s, "scratch", o2, fresh.distance, fresh.steps, shortest, d2, time.perf_counter() - t_s))
             if outcome != "found":
                 # left: to this stage's door and on to its object (when its door was not read), or
@@ -237,7 +240,7 @@ class ChainTask(Task):
                 left += rest
                 break
         res = RunResult(outcome, st.distance, st.steps, decisions, time.perf_counter() - t0,
-                        np.asarray(st.trail, np.float32), sorted(st.read_signs), trace_all, stages, left_m=left,
+                        np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=stages, left_m=left,
                         start_heading=heading)
         return res
 

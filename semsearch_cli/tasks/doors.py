@@ -13,6 +13,8 @@ reached by path planning on the map built so far, to the mean pose of its reads.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import yaml
 
@@ -20,12 +22,13 @@ from ..belief import Belief
 from ..errors import ScenarioError
 from ..geometry import wrap_angle
 from ..navigation import NAVIGATORS
-from ..planners import PlanContext
+from ..belief import Candidates
+from ..planners import Decision, PlanContext
 from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
 from ..world.buildings.demo import write_demo
-from .base import Outcome, RobotState, Task, checked_cell, register_task
+from .base import Event, Observer, Outcome, RobotState, Task, checked_cell, register_task
 from .loop import run_loop
 
 MAX_RETRIES = 5
@@ -60,6 +63,32 @@ class DoorSensing:
         st.headings.append(st.heading)
 
 
+@dataclass(frozen=True, kw_only=True)
+class DoorDecision(Event):
+    """A door planner's new target: at ``step``, ``distance`` m into the episode, from the pose
+    (``x``, ``y`` m, ``heading`` rad), the target ``target_xy`` (m) chosen among ``candidates`` by
+    ``decision`` (its ``info`` the numbers behind it), on the map built so far (``belief``, as it
+    is at this moment: copy what you keep) after the path ``trail`` [(x, y) m]."""
+
+    step: int
+    distance: float
+    x: float
+    y: float
+    heading: float
+    target_xy: tuple
+    candidates: Candidates
+    decision: Decision
+    belief: Belief
+    trail: list
+
+    def row(self) -> dict:
+        tx, ty = self.target_xy
+        return {"step": self.step, "distance_m": round(self.distance, 3), "x": round(float(self.x), 3),
+                "y": round(float(self.y), 3), "heading_deg": round(float(np.degrees(self.heading)), 1),
+                "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(self.candidates),
+                **self.decision.info}
+
+
 def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
     """Frames from which a wall face must be seen before a sign on it counts as read-or-absent:
     the fewest n with (1 - p_read)^n <= ``miss`` (1 for a camera that never misses), at most
@@ -74,9 +103,9 @@ def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
 class DoorSearch(DoorSensing):
     """Explore with a door planner until the goal sign is read."""
 
-    def __init__(self, task, planner, goal, rng, trace: bool, recorder):
+    def __init__(self, task, planner, goal, rng, observer: Observer | None = None):
         super().__init__(task, goal, rng)
-        self.planner, self.keep_trace, self.recorder = planner, trace, recorder
+        self.planner, self.observer = planner, observer
         self.navigator = NAVIGATORS[task.sc.navigation.navigator]()
         self.uses_signs = getattr(planner, "replan_on_signs", False)
         self.replan_every = task.sc.navigation.replan_every
@@ -86,7 +115,6 @@ class DoorSearch(DoorSensing):
         self.looked_around = False
         self.decisions = 0
         self.target: tuple[int, int] | None = None  # the cell the robot is heading for
-        self.trace: list = []
         self.start_distance = 0.0
         cam = task.sc.door_camera
         # completeness sweep: how close to an unviewed wall face to go, and the turns that
@@ -163,7 +191,7 @@ class DoorSearch(DoorSensing):
             b.refresh_derived()
             cands = b.candidates()
         ctx = PlanContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
-                          explain=self.keep_trace or self.recorder is not None)
+                          explain=self.observer is not None)
         return ctx, cands
 
     def attempt(self, st, ctx, cands, dec):
@@ -205,14 +233,10 @@ class DoorSearch(DoorSensing):
         # re-plan or kept by the planner (info["kept"]), is not one, for every planner alike
         kept = dec.info.get("kept", False) or (dec.row, dec.col) == self.target
         self.decisions += not kept
-        if self.recorder is not None and not kept:
-            self.recorder(b, st.trail, st.distance - self.start_distance, cands, dec)
-        if self.keep_trace and not kept:
-            tx, ty = fr.to_world(dec.row, dec.col)
-            self.trace.append({"step": st.steps, "distance_m": round(st.distance - self.start_distance, 3),
-                               "x": round(float(st.x), 3), "y": round(float(st.y), 3),
-                               "heading_deg": round(float(np.degrees(st.heading)), 1),
-                               "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(cands), **dec.info})
+        if self.observer is not None and not kept:
+            self.observer.see(DoorDecision(step=st.steps, distance=st.distance - self.start_distance, x=st.x, y=st.y,
+                                           heading=st.heading, target_xy=fr.to_world(dec.row, dec.col), candidates=cands,
+                                           decision=dec, belief=b, trail=st.trail))
         p = self.navigator.plan(b, ctx.row, ctx.col, dec.row, dec.col)
         if p is not None and len(p[0]) >= 2:
             self.looked_around = False
@@ -231,7 +255,6 @@ class GoToRead(DoorSensing):
         self.target = target_xy
         self.path = None
         self.decisions = 0
-        self.trace: list = []
 
     def sense(self, st):
         found, event = super().sense(st)
@@ -314,21 +337,21 @@ class DoorTask(Task):
     def new_belief(self) -> Belief:
         return Belief(self.world.frame, self.sc.belief, self.sc.robot.radius)
 
-    def episode(self, state, planner, goal, rng, trace=False, recorder=None, reuse_reads: bool = False):
+    def episode(self, state, planner, goal, rng, observer: Observer | None = None, reuse_reads: bool = False):
         """Search for sign ``goal`` from ``state`` (a new belief when it has none). With
         ``reuse_reads`` and the sign already read, go there on the map built so far."""
         if state.belief is None:
             state.belief = self.new_belief()
         d0, s0 = state.distance, state.steps
         target = read_position(state.belief, goal) if reuse_reads else None
-        search = GoToRead(self, goal, rng, target) if target is not None else DoorSearch(self, planner, goal, rng, trace, recorder)
+        search = GoToRead(self, goal, rng, target) if target is not None else DoorSearch(self, planner, goal, rng, observer)
         search.start_distance = d0
         outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
         if outcome == "stuck" and isinstance(search, GoToRead):  # the map built so far has no path: search again
-            search = DoorSearch(self, planner, goal, rng, trace, recorder)
+            search = DoorSearch(self, planner, goal, rng, observer)
             search.start_distance = d0
             outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
-        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
+        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def describe(self):
         w = self.world

@@ -36,7 +36,7 @@ from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.indirect import SemanticCamera, YawMemory
 from ..world.rooms import Room, estimate_relations, generate_rooms, read_rooms
-from .base import Outcome, RobotState, RunResult, Task, checked_point, register_task
+from .base import Event, Observer, Outcome, RobotState, RunResult, Task, checked_point, register_task
 from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
 from .loop import run_loop
 
@@ -112,12 +112,42 @@ class RoomGrid:
         return xs, ys
 
 
+@dataclass(frozen=True, kw_only=True)
+class IndirectGoal(Event):
+    """An indirect planner's goal at a re-plan (every re-plan; ``new`` when it changed, and only
+    those are traced): at ``step`` (``t_s`` s of simulated time), from the pose (``x``, ``y`` m,
+    ``heading`` rad), the :class:`~semsearch_cli.planners.Goal` ``goal``; ``p`` the probability
+    map of A as it is now (copy what you keep), ``p0`` the outside cell's probability, ``trail``
+    the path so far ((n, 2) m) and ``seen`` the secondary objects seen (class -> (x, y) m)."""
+
+    step: int
+    t_s: float
+    x: float
+    y: float
+    heading: float
+    goal: Goal
+    new: bool
+    p: np.ndarray
+    p0: float
+    trail: np.ndarray
+    seen: dict
+
+    @property
+    def traced(self) -> bool:
+        return self.new
+
+    def row(self) -> dict:
+        return {"step": self.step, "t_s": round(self.t_s, 2), "x": round(self.x, 3), "y": round(self.y, 3),
+                "heading_deg": round(math.degrees(self.heading), 1),
+                "target": [round(self.goal.x, 3), round(self.goal.y, 3)], **self.goal.info}
+
+
 class IndirectSearch:
     """One search (a :class:`~semsearch_cli.tasks.loop.Search`)."""
 
-    def __init__(self, task: "IndirectTask", grid: RoomGrid, planner, scale: float, rng, trace: bool, recorder=None):
+    def __init__(self, task: "IndirectTask", grid: RoomGrid, planner, scale: float, rng, observer: Observer | None = None):
         self.task, self.grid, self.planner, self.scale, self.rng = task, grid, planner, scale, rng
-        self.recorder = recorder  # recorder(p, p0, trail, t_s, goal, seen) at every plan
+        self.observer = observer
         spec = task.spec
         self.dt = 1.0 / spec.camera.fps
         self.replan_frames = max(1, int(round(spec.replan_every * spec.camera.fps)))
@@ -133,8 +163,6 @@ class IndirectSearch:
         self.final_heading: float | None = None
         self.goal: Goal | None = None
         self.decisions = 0
-        self.keep_trace = trace
-        self.trace: list = []
         self.D = np.zeros((grid.frame.height, grid.frame.width))
         self.memory: dict[str, YawMemory] = {}
         self.occ = grid.blocked if grid.blocked.any() else None
@@ -246,17 +274,15 @@ class IndirectSearch:
                               self.task.cooccurrence)
         goal = self.planner.plan(ctx)
         checked_point(self.planner.name, goal.x, goal.y, g.frame, goal.heading)
-        if self.recorder is not None:
-            self.recorder(st.belief.p, st.belief.p0, np.asarray(st.trail), st.steps * self.dt, goal, dict(self.seen))
         self.frames_since_plan = 0
         self.since_plan = []
         new = self.goal is None or (goal.x, goal.y, goal.heading) != (self.goal.x, self.goal.y, self.goal.heading)
         self.decisions += new
         self.goal = goal
-        if self.keep_trace and new:
-            self.trace.append({"step": st.steps, "t_s": round(st.steps * self.dt, 2), "x": round(st.x, 3), "y": round(st.y, 3),
-                               "heading_deg": round(math.degrees(st.heading), 1),
-                               "target": [round(goal.x, 3), round(goal.y, 3)], **goal.info})
+        if self.observer is not None:
+            self.observer.see(IndirectGoal(step=st.steps, t_s=st.steps * self.dt, x=st.x, y=st.y, heading=st.heading, goal=goal,
+                                           new=new, p=st.belief.p, p0=st.belief.p0, trail=np.asarray(st.trail),
+                                           seen=dict(self.seen)))
         if math.hypot(goal.x - st.x, goal.y - st.y) < 1e-9:
             xs, ys = np.array([st.x, st.x]), np.array([st.y, st.y])
         else:
@@ -524,31 +550,31 @@ class IndirectTask(Task):
         return out
 
     # ---- running ----------------------------------------------------------------------------
-    def run(self, variant: Variant, ep: Episode, seed: int, trace: bool = False, recorder=None) -> RunResult:
+    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None) -> RunResult:
         t0 = time.perf_counter()
         ep = self.as_episode(ep)
         scale = float(ep.goal)
         rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
         st = self.start_state(ep, rng)
         heading = st.heading
-        out, st = self.episode(st, variant.build(), scale, rng, trace, recorder, room=ep.room)
+        out, st = self.episode(st, variant.build(), scale, rng, observer, room=ep.room)
         left = 0.0 if out.outcome == "found" else self.shortest_of(ep.room, scale, st.x, st.y)
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), [], out.trace,
+                         np.asarray(st.trail, np.float32), [],
                          message="the robot could not move" if out.outcome == "stuck" else "",
                          time_s=out.steps / self.spec.camera.fps, left_m=left, start_heading=heading)
 
-    def episode(self, state, planner, goal, rng, trace=False, recorder=None, room: int = 0):
+    def episode(self, state, planner, goal, rng, observer: Observer | None = None, room: int = 0):
         """Search room ``room`` for A at view scale ``goal`` from ``state`` (a new map of A when it
         has none); the time limit counts from the state's steps (camera frames)."""
         spec = self.spec
-        search = IndirectSearch(self, self.grids[room], planner, float(goal), rng, trace, recorder)
+        search = IndirectSearch(self, self.grids[room], planner, float(goal), rng, observer)
         if state.belief is None:
             state.belief = search.new_belief()
         d0, s0 = state.distance, state.steps
         max_steps = s0 + int(round(spec.time_limit * spec.camera.fps))
         outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move)
-        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
+        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def describe(self):
         spec = self.spec

@@ -39,7 +39,6 @@ class Search(Protocol):
     """The task-specific part of one episode."""
 
     decisions: int
-    trace: list
 
     def sense(self, st: RobotState) -> tuple[bool, bool]:
         """Read the sensors at the robot's pose; (target seen, an event that asks for a re-plan)."""

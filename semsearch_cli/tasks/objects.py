@@ -49,7 +49,7 @@ from ..navigation import KnownMap
 from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..world.buildings.office import office_image, office_scenario
-from .base import Outcome, RobotState, Task, checked_point, register_task
+from .base import Event, Observer, Outcome, RobotState, Task, checked_point, register_task
 from .loop import run_loop
 from ..files import read_user_text, temp_path, user_file
 
@@ -115,17 +115,30 @@ def timeline_at(timeline: dict, hour: float) -> dict[str, tuple]:
     return out
 
 
+@dataclass(frozen=True, kw_only=True)
+class ObjectTarget(Event):
+    """An object planner's next target point ``target_xy`` (m), ``distance`` m into the search,
+    with the planner's ``info``."""
+
+    distance: float
+    target_xy: tuple
+    info: dict
+
+    def row(self) -> dict:
+        x, y = self.target_xy
+        return {"distance_m": round(self.distance, 3), "target": [round(x, 2), round(y, 2)], **self.info}
+
+
 class ObjectSearch:
     """One request answered by an object planner's targets (see the module docstring)."""
 
     def __init__(self, task: "ObjectTask", targets, cls: str, instances: list, camera: PlaceCamera, ctx: ObjectContext,
-                 rng: np.random.Generator, trace: bool = False):
+                 rng: np.random.Generator, observer: Observer | None = None):
         """``targets``: an iterator of (x, y, info); ``instances``: [(class, place)] in the world."""
         self.task, self.targets, self.cls, self.instances = task, targets, cls, instances
-        self.camera, self.ctx, self.rng, self.keep_trace = camera, ctx, rng, trace
+        self.camera, self.ctx, self.rng, self.observer = camera, ctx, rng, observer
         self.look = False  # look around on arriving at the current target
         self.decisions = 0
-        self.trace: list = []
         self.start_distance = 0.0
         self.planner_name = ""  # for the checks of its targets
 
@@ -159,8 +172,8 @@ class ObjectSearch:
             x, y, info = nxt
             x, y = checked_point(self.planner_name, x, y, self.task.world.frame)
             self.decisions += 1
-            if self.keep_trace:
-                self.trace.append({"distance_m": round(st.distance - self.start_distance, 3), "target": [round(x, 2), round(y, 2)], **info})
+            if self.observer is not None:
+                self.observer.see(ObjectTarget(distance=st.distance - self.start_distance, target_xy=(x, y), info=info))
             p = known.path_to(st.x, st.y, x, y)
             if p is None:
                 continue
@@ -268,22 +281,22 @@ class ObjectTask(Task):
     def goals(self) -> list:
         return [r.label for r in self.requests]
 
-    def episode(self, state, planner, goal, rng, trace=False, recorder=None):
+    def episode(self, state, planner, goal, rng, observer: Observer | None = None):
         """Answer the request labelled ``goal`` from ``state``."""
         req = self.request(goal)
         return self.search_episode(state, planner, req.cls, req.hour, self.request_instances(req), self.logs[req.case],
-                                   self.route, self.world.start_xy, rng, trace)
+                                   self.route, self.world.start_xy, rng, observer)
 
-    def search_episode(self, state, planner, cls, hour, instances, log, route, home, rng, trace=False):
+    def search_episode(self, state, planner, cls, hour, instances, log, route, home, rng, observer: Observer | None = None):
         """Search for ``cls`` among ``instances`` [(class, place)] with the places of ``route``."""
         d0, s0 = state.distance, state.steps
         camera = PlaceCamera(self.world, self.spec.camera, self.places, self.facing, instances)
         ctx = ObjectContext(self.world.frame, self.known, self.places, list(route), home, cls, hour, log, rng)
-        search = ObjectSearch(self, planner.targets(ctx), cls, instances, camera, ctx, rng, trace)
+        search = ObjectSearch(self, planner.targets(ctx), cls, instances, camera, ctx, rng, observer)
         search.planner_name = planner.name
         search.start_distance = d0
         outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
-        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions, search.trace), state
+        return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def write_inputs(self, out: Path) -> None:
         for case, log in self.logs.items():
