@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from semsearch_cli.belief import Belief
+from semsearch_cli.belief import DoorBelief
 from semsearch_cli.config import NavigationSpec, PlannerSpec
 from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks import build_task
@@ -43,7 +43,7 @@ REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 def sensing_only(L: Loaded, path: np.ndarray) -> float:
     """Seconds to sense and update the belief at each pose of ``path`` (no planning, no motion)."""
     sc, w = L.sc, L.world
-    b = Belief(w.frame, sc.belief, sc.robot.radius)
+    b = DoorBelief(w.frame, sc.belief, sc.robot.radius)
     laser, cam = Laser(w, sc.laser), DoorCamera(w, sc.door_camera)
     rng = np.random.default_rng(0)
     t0 = time.perf_counter()
@@ -78,9 +78,9 @@ def thesis_tables(say, out: Path) -> None:
     say()
 
 
-def known_belief(L: Loaded) -> Belief:
+def known_belief(L: Loaded) -> DoorBelief:
     w = L.world
-    b = Belief(w.frame, L.sc.belief, L.sc.robot.radius)
+    b = DoorBelief(w.frame, L.sc.belief, L.sc.robot.radius)
     b.seen[:] = True
     b.cv[w.occ] = 15
     b.refresh_free(np.array([0, w.frame.height - 1, 0, w.frame.width - 1]))
@@ -88,7 +88,7 @@ def known_belief(L: Loaded) -> Belief:
     return b
 
 
-def drive(nav, b: Belief, r: int, c: int, tr: int, tc: int, replan_cells: float) -> float | None:
+def drive(nav, b: DoorBelief, r: int, c: int, tr: int, tc: int, replan_cells: float) -> float | None:
     """Length (cells) a robot travels from (r, c) to (tr, tc), re-planning every ``replan_cells``."""
     total = 0.0
     for _ in range(10_000):

@@ -3,7 +3,7 @@ import os
 import numpy as np
 import pytest
 
-from semsearch_cli.belief import Belief
+from semsearch_cli.belief import DoorBelief
 from semsearch_cli.config import BeliefSpec
 from semsearch_cli.geometry import GridFrame
 from semsearch_cli.kernels.grid import GridSearch, dijkstra, local_reach
@@ -13,7 +13,7 @@ from semsearch_cli.kernels.raycast import cast_rays
 
 def make_belief(free):
     H, W = free.shape
-    b = Belief(GridFrame(0.1, 0.0, 0.0, H, W), BeliefSpec(), robot_radius=0.05)
+    b = DoorBelief(GridFrame(0.1, 0.0, 0.0, H, W), BeliefSpec(), robot_radius=0.05)
     b.seen[:] = True
     b.cv[~free] = 10
     b.refresh_free(np.array([0, H - 1, 0, W - 1]))
@@ -197,7 +197,7 @@ def test_fold_scan_with_a_full_change_buffer_matches_a_roomy_one():
     dist, hit = cast_rays(occ, 40.5, 30.5, thetas, 50.0)
     beliefs = []
     for size in (1, 100_000):
-        b = Belief(GridFrame(0.1, 0.0, 0.0, 80, 90), BeliefSpec(), robot_radius=0.05)
+        b = DoorBelief(GridFrame(0.1, 0.0, 0.0, 80, 90), BeliefSpec(), robot_radius=0.05)
         b._touched = np.empty(size, np.int64)
         b.fold_scan(40.5, 30.5, thetas, dist, hit)
         beliefs.append(b)
@@ -211,12 +211,12 @@ def test_fold_scan_with_a_full_change_buffer_matches_a_roomy_one():
 @pytest.mark.parametrize("buffer", [1, 100_000])
 def test_lost_counts_the_free_cells_a_scan_turns_to_walls(buffer):
     # an open room scanned, then a wall appearing across free space (a door closed): the cells it
-    # covers stop being free, and Belief.lost (the events re-planning policy's trigger) counts
+    # covers stop being free, and DoorBelief.lost (the events re-planning policy's trigger) counts
     # them, through the kernel and through the refresh of a whole box alike
     occ = np.zeros((80, 90), bool)
     occ[:, 85:] = True
     thetas = np.linspace(-np.pi / 2, np.pi / 2, 181)
-    b = Belief(GridFrame(0.1, 0.0, 0.0, 80, 90), BeliefSpec(), robot_radius=0.05)
+    b = DoorBelief(GridFrame(0.1, 0.0, 0.0, 80, 90), BeliefSpec(), robot_radius=0.05)
     b.fold_scan(40.5, 30.5, thetas, *cast_rays(occ, 40.5, 30.5, thetas, 50.0))
     assert b.lost == 0 and b.free[40, 60]
     occ[:, 60] = True

@@ -90,10 +90,10 @@ def test_decisions_count_new_targets_only(demo_loaded):
 # ---- planners from the user's own files -------------------------------------------------
 PLANNER_FILE = '''
 import numpy as np
-from semsearch_cli.planners import Decision, Planner, register_planner
+from semsearch_cli.planners import Decision, DoorPlanner, register_planner
 
 @register_planner("{name}")
-class Mine(Planner):
+class Mine(DoorPlanner):
     def choose(self, ctx, cands):
         if len(cands) == 0:
             return None

@@ -9,7 +9,7 @@ import yaml
 
 from semsearch_cli.config import KINDS, OnMap, Scenario, kind_of, parse_scenario, register_kind
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.planners import PLANNERS, Planner, register_planner
+from semsearch_cli.planners import PLANNERS, DoorPlanner, Planner, register_planner
 from semsearch_cli.report.sections import SECTIONS, Section, register_section
 from semsearch_cli.tasks import TASKS, Task, register_task
 
@@ -57,11 +57,13 @@ def test_the_registries_refuse_duplicates_and_wrong_base_classes():
     with pytest.raises(TypeError):
         register_task(dict)
     with pytest.raises(ValueError, match="already registered"):
-        register_planner("greedy")(type("Again", (Planner,), {}))
+        register_planner("greedy")(type("Again", (DoorPlanner,), {}))
+    with pytest.raises(TypeError, match="subclass DoorPlanner"):
+        register_planner("no-kind")(type("NoKind", (Planner,), {}))
     with pytest.raises(TypeError, match="not a subclass of Planner"):
         register_planner("not-a-planner")(dict)
     with pytest.raises(ValueError, match="already registered"):
         register_section(Section("doors", print, print, print))
     with pytest.raises(TypeError):
         register_section({"kind": "cats"})
-    assert "cats" not in KINDS and "not-a-planner" not in PLANNERS
+    assert "cats" not in KINDS and "not-a-planner" not in PLANNERS and "no-kind" not in PLANNERS

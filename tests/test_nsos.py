@@ -120,7 +120,7 @@ def test_bad_alphas(demo_dir):
 
 
 def _junction_context(goal=7):
-    from semsearch_cli.planners import PlanContext
+    from semsearch_cli.planners import DoorContext
 
     from .test_belief import make_belief
 
@@ -136,7 +136,7 @@ def _junction_context(goal=7):
         for _ in range(3):
             b.reads.add(lab, 30 * W + 40 + 4 * k, (40 + 4 * k) * 0.1, 3.0, 0.0)
     cands = b.candidates()
-    ctx = PlanContext(b, 30, 30, 3.05, 3.05, 0.0, goal, np.random.default_rng(0), [0.0] * 10)
+    ctx = DoorContext(b, 30, 30, 3.05, 3.05, 0.0, goal, np.random.default_rng(0), [0.0] * 10)
     return b, cands, ctx
 
 

@@ -21,11 +21,11 @@ import time
 
 import numpy as np
 
-from semsearch_cli.planners import Decision, Planner, register_planner
+from semsearch_cli.planners import Decision, DoorPlanner, register_planner
 
 
 @register_planner("{name}")
-class Bad(Planner):
+class Bad(DoorPlanner):
     def choose(self, ctx, cands):
         if len(cands) == 0:
             return None

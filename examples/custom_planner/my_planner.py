@@ -8,7 +8,7 @@ Of the frontier candidates, take the one that costs least in straight-line dista
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from semsearch_cli.planners import Decision, Planner, register_planner
+from semsearch_cli.planners import Decision, DoorPlanner, register_planner
 
 
 class StraightOnParams(BaseModel):
@@ -17,7 +17,7 @@ class StraightOnParams(BaseModel):
 
 
 @register_planner("straight_on")
-class StraightOn(Planner):
+class StraightOn(DoorPlanner):
     Params = StraightOnParams
 
     def choose(self, ctx, cands):

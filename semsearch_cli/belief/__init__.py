@@ -1,3 +1,3 @@
-from .doors import Belief, Candidates
+from .doors import DoorBelief, Candidates
 
-__all__ = ["Belief", "Candidates"]
+__all__ = ["DoorBelief", "Candidates"]

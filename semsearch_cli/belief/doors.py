@@ -121,7 +121,7 @@ class DoorReads:
         return out
 
 
-class Belief:
+class DoorBelief:
     """What the robot knows. Arrays are (H, W) and share the world's :class:`GridFrame`.
 
     Attributes

@@ -105,7 +105,7 @@ class DoorSearchEnv(SearchEnv):
         self._buf = {k: np.zeros(s.shape, s.dtype) for k, s in spaces.items()}
         self._free = np.zeros((n, n), np.uint8)
         self.bind(self.task)
-        self.decision = None  # (PlanContext, Candidates) while the agent is to choose (macro)
+        self.decision = None  # (DoorContext, Candidates) while the agent is to choose (macro)
 
     def bind(self, task) -> None:
         """Run ``task`` from the next reset on, with what the steps read of it."""

@@ -1,17 +1,17 @@
 """Planners: the protocol, the registry and the built-in planners (importing this package
 registers them).
 
-The public API for planner authors: :class:`Planner`, :class:`Decision`, :class:`PlanContext`
+The public API for planner authors: :class:`DoorPlanner`, :class:`Decision`, :class:`DoorContext`
 and :func:`register_planner` (door search), :class:`ObjectPlanner` and :class:`ObjectContext`
 (object search), :class:`IndirectPlanner`, :class:`IndirectContext` and :class:`Goal` (indirect
 search).
 """
 
-from .base import (PLANNERS, Decision, NoParams, PlanContext, Planner, Variant, code_of, expand_variants, load_entry_points,
+from .base import (PLANNERS, Decision, DoorContext, DoorPlanner, NoParams, Planner, Variant, code_of, expand_variants, load_entry_points,
                    load_planner_file, planner_class, register_planner)
 from .doors import bvp, draft, greedy, nsos  # noqa: F401  (registration side effect)
 from .indirect import Goal, IndirectContext, IndirectPlanner
 from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 
-__all__ = ["PLANNERS", "Decision", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "PlanContext", "Planner",
+__all__ = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner",
            "Variant", "code_of", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class", "register_planner"]

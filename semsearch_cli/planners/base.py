@@ -1,6 +1,6 @@
 """The planner interface and registry.
 
-A planner picks the next target from the belief. It sees a :class:`PlanContext` and the frontier
+A planner picks the next target from the belief. It sees a :class:`DoorContext` and the frontier
 :class:`~semsearch_cli.belief.Candidates`, and returns a :class:`Decision` (a target cell and the
 numbers behind the choice, for traces). Adding a planner: subclass :class:`Planner`, give it a
 pydantic ``Params`` model, and decorate it with ``@register_planner(name)``; nothing in the
@@ -31,7 +31,7 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from ..belief import Belief, Candidates
+from ..belief import DoorBelief, Candidates
 from .. import __version__
 from ..errors import ScenarioError
 from ..files import user_file
@@ -44,7 +44,7 @@ class NoParams(BaseModel):
 
 
 @dataclass
-class PlanContext:
+class DoorContext:
     """What a door planner may look at at a re-plan: the belief, the robot's pose and history,
     the goal and the run's random generator.
 
@@ -52,7 +52,7 @@ class PlanContext:
     falls; ``belief.frame`` converts (``to_world(row, col)`` -> (x, y) m of the cell centre,
     ``to_index(x, y)`` -> cell, ``res`` m per cell).
 
-    - ``belief``: the map built so far (:class:`~semsearch_cli.belief.Belief`): ``free``,
+    - ``belief``: the map built so far (:class:`~semsearch_cli.belief.DoorBelief`): ``free``,
       ``seen``, ``visited``, ``passable`` (free and the robot fits), ``skeleton`` and
       ``clearance`` (m) as (H, W) arrays; ``search(row, col, rows, cols, n)`` skeleton distances
       (cells) to target cells; ``reads`` every sign read (``reads.total``: label -> count) and
@@ -68,7 +68,7 @@ class PlanContext:
       for traces and recordings); a planner may skip tabulating them when it is False.
     """
 
-    belief: Belief
+    belief: DoorBelief
     row: int
     col: int
     x: float
@@ -92,11 +92,9 @@ class Decision:
 
 
 class Planner:
-    """A door-search planner (and the base of every kind's planner protocol): ``choose(ctx,
-    cands)`` gets a :class:`PlanContext` and the frontier
-    :class:`~semsearch_cli.belief.Candidates` and returns a :class:`Decision`, or None when there
-    is nowhere to go. Object planners subclass :class:`~semsearch_cli.planners.ObjectPlanner`,
-    indirect ones :class:`~semsearch_cli.planners.IndirectPlanner`.
+    """What every planner is, whatever it searches for; each kind has its own protocol on top:
+    :class:`DoorPlanner`, :class:`~semsearch_cli.planners.ObjectPlanner` and
+    :class:`~semsearch_cli.planners.IndirectPlanner`, which set ``task``.
 
     Class attributes: ``Params`` (a pydantic model of the planner's parameters, checked when the
     scenario is loaded), ``task`` (the kind of search it answers), ``rank``, ``baseline`` and
@@ -104,7 +102,7 @@ class Planner:
     """
 
     name: ClassVar[str] = ""
-    task: ClassVar[str] = "doors"  # or "objects": which kind of scenario the planner answers
+    task: ClassVar[str] = ""  # which kind of scenario the planner answers (a task's planner_kind)
     Params: ClassVar[type[BaseModel]] = NoParams
     rank: ClassVar[int] = 100  # where reports list it among its kind's planners (lower first; then by name)
     baseline: ClassVar[bool] = False  # reports compare the other planners with this one, paired
@@ -113,16 +111,32 @@ class Planner:
     def __init__(self, params: BaseModel):
         self.params = params
 
-    def choose(self, ctx: PlanContext, cands: Candidates) -> Decision | None:  # pragma: no cover
+
+class DoorPlanner(Planner):
+    """A door-search planner: ``choose(ctx, cands)`` gets a :class:`DoorContext` and the
+    frontier :class:`~semsearch_cli.belief.Candidates` and returns a :class:`Decision`, or None
+    when no candidate suits (the robot then looks at the walls it has not read yet)."""
+
+    task: ClassVar[str] = "doors"
+
+    def choose(self, ctx: DoorContext, cands: Candidates) -> Decision | None:  # pragma: no cover
         raise NotImplementedError
 
 
-PLANNERS = Registry("planner", Planner, names=True)  # name -> class (ObjectPlanner and IndirectPlanner subclass Planner)
+PLANNERS = Registry("planner", Planner, names=True)  # name -> class
 
 
 def register_planner(name: str):
-    """Class decorator adding a planner to the registry under ``name`` (must be new)."""
-    return PLANNERS.register(name)
+    """Class decorator adding a planner to the registry under ``name`` (must be new); the class
+    subclasses one kind's protocol (:class:`DoorPlanner`, ``ObjectPlanner``, ``IndirectPlanner``)."""
+
+    def deco(cls):
+        if isinstance(cls, type) and issubclass(cls, Planner) and not cls.task:
+            raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search; subclass DoorPlanner (door "
+                            "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
+        return PLANNERS.add(name, cls)
+
+    return deco
 
 
 ENTRY_POINT_GROUP = "semsearch.planners"

@@ -115,9 +115,6 @@ class IndirectPlanner(Planner):
     def plan(self, ctx: IndirectContext) -> Goal:  # pragma: no cover
         raise NotImplementedError
 
-    def choose(self, ctx, cands):  # door-search interface; never called for indirect planners
-        raise TypeError(f"{self.name} is an indirect-search planner")
-
 
 class LocalParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)

@@ -54,9 +54,6 @@ class ObjectPlanner(Planner):
     def targets(self, ctx: ObjectContext) -> Iterator[tuple[float, float, dict]]:  # pragma: no cover
         raise NotImplementedError
 
-    def choose(self, ctx, cands):  # door-search interface; never called for object planners
-        raise TypeError(f"{self.name} is an object-search planner")
-
 
 def patrol_targets(ctx: ObjectContext, skip_seen: bool = False):
     """The route's places in order (without those already in view, with ``skip_seen``)."""

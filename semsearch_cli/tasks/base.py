@@ -90,7 +90,7 @@ class Observer:
     """Sees every :class:`Event` of a run (``Task.run(..., observer)``): the trace of
     ``semsearch run --trace`` (:class:`TraceObserver`), a report's replay, a notebook's plot.
     Observing changes nothing in the run; a planner may tabulate more for an observed run
-    (``PlanContext.explain``)."""
+    (``DoorContext.explain``)."""
 
     def see(self, event: Event) -> None:  # pragma: no cover
         raise NotImplementedError

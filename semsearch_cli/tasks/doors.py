@@ -18,12 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 import yaml
 
-from ..belief import Belief
+from ..belief import DoorBelief
 from ..errors import ScenarioError
 from ..geometry import wrap_angle
 from ..navigation import NAVIGATORS
 from ..belief import Candidates
-from ..planners import Decision, PlanContext
+from ..planners import Decision, DoorContext
 from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
@@ -78,7 +78,7 @@ class DoorDecision(Event):
     target_xy: tuple
     candidates: Candidates
     decision: Decision
-    belief: Belief
+    belief: DoorBelief
     trail: list
 
     def row(self) -> dict:
@@ -190,7 +190,7 @@ class DoorSearch(DoorSensing):
                 return "found"
             b.refresh_derived()
             cands = b.candidates()
-        ctx = PlanContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
+        ctx = DoorContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
                           explain=self.observer is not None)
         return ctx, cands
 
@@ -281,7 +281,7 @@ class GoToRead(DoorSensing):
         return self.path
 
 
-def read_position(belief: Belief, goal) -> tuple[float, float] | None:
+def read_position(belief: DoorBelief, goal) -> tuple[float, float] | None:
     """Mean robot position (m) at the reads of sign ``goal``, or None when it was never read."""
     reads = belief.reads
     if goal not in reads._label_id:
@@ -334,8 +334,8 @@ class DoorTask(Task):
         """The poses that read sign ``goal`` (see :meth:`World.reading_cells`)."""
         return self.world.reading_cells(goal)
 
-    def new_belief(self) -> Belief:
-        return Belief(self.world.frame, self.sc.belief, self.sc.robot.radius)
+    def new_belief(self) -> DoorBelief:
+        return DoorBelief(self.world.frame, self.sc.belief, self.sc.robot.radius)
 
     def episode(self, state, planner, goal, rng, observer: Observer | None = None, reuse_reads: bool = False):
         """Search for sign ``goal`` from ``state`` (a new belief when it has none). With

@@ -20,7 +20,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from ...kernels.harmonic import FLAT, ascend, harmonic_field
-from ..base import Decision, Planner, register_planner
+from ..base import Decision, DoorPlanner, register_planner
 from .greedy import nearest_candidate
 
 
@@ -31,7 +31,7 @@ class BVPParams(BaseModel):
 
 
 @register_planner("bvp")
-class BVP(Planner):
+class BVP(DoorPlanner):
     rank = 1
 
     Params = BVPParams

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import Decision, Planner, register_planner
+from ..base import Decision, DoorPlanner, register_planner
 
 
 def nearest_candidate(ctx, cands) -> Decision | None:
@@ -21,7 +21,7 @@ def nearest_candidate(ctx, cands) -> Decision | None:
 
 
 @register_planner("greedy")
-class Greedy(Planner):
+class Greedy(DoorPlanner):
     """The nearest frontier candidate (the thesis' geometric baseline)."""
 
     rank = 0

@@ -18,7 +18,7 @@ For each frontier candidate c (segment S(c), branch direction theta_f(c)):
   on 0, 20, 40, ... degrees (for 18 bins; the seeds do not say where the bins start, so both
   histograms are centred alike);
 - closeness (paper Eq. 16): ``phi_c = 1 - (1 - D_min / D(c))^4``, D the path length along the
-  skeleton (see :meth:`semsearch_cli.belief.Belief.search`).
+  skeleton (see :meth:`semsearch_cli.belief.DoorBelief.search`).
 
 ``SF = phi_g phi_p`` (Eq. 4.5), ``GF = ((phi_o + phi_r) phi_c + phi_c) / 3`` (Eq. 4.6),
 ``phi = alpha SF + (1 - alpha) GF`` (Eq. 4.7); the robot goes to argmax phi (Eq. 4.8). Ties go to
@@ -35,7 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ...geometry import wrap_angle
 from ...world.labels import SignLabel, parse_label
-from ..base import Decision, Planner, register_planner
+from ..base import Decision, DoorPlanner, register_planner
 
 
 # ---- the five factors, as pure functions ------------------------------------------------------
@@ -162,7 +162,7 @@ def pick(phi: np.ndarray, D: np.ndarray, keep: int | None, hysteresis: float, rn
     return int(best[0] if best.size == 1 else rng.choice(best))
 
 
-class KeepTarget(Planner):
+class KeepTarget(DoorPlanner):
     """A scoring planner with hysteresis between re-plans: subclasses give ``_decide(ctx, cands,
     keep)``, ``keep`` the index of the last target among ``cands`` when it may be kept.
 
