@@ -194,14 +194,16 @@ def planners_page() -> str:
            "scenario's `planners:` with its parameters (`{name: nsos, alpha: [0.8, 0.9]}`: a list expands into one "
            "variant per value); `semsearch planners` lists these and any planner of your own. The **baseline** is "
            "the planner reports compare the others with, paired on the same episodes; the **swept** parameter is "
-           "the one `semsearch sweep-alpha` varies."]
+           "the one `semsearch sweep-alpha` varies; a report's replay shows the planner **replayed by default** "
+           "(else the last in report order)."]
     for kind in dict.fromkeys(t.planner_kind for t in TASKS.values()):
         kinds = [k for k, t in TASKS.items() if t.planner_kind == kind]
         names = planner_order([n for n, c in builtin.items() if c.task == kind])
         out += ["", f"## For {', '.join(kinds)} scenarios", "", "| planner | role | summary |", "|---|---|---|"]
         for n in names:
             c = builtin[n]
-            role = "; ".join(r for r in ("baseline" if c.baseline else "", f"swept: `{c.swept}`" if c.swept else "") if r)
+            role = "; ".join(r for r in ("baseline" if c.baseline else "", f"swept: `{c.swept}`" if c.swept else "",
+                                         "replayed by default" if c.replay else "") if r)
             first = _own_doc(c).split("\n\n")[0]
             out.append(f"| [`{n}`](#{_anchor(n)}) | {role} | {_cell(first)} |")
         for n in names:

@@ -107,6 +107,7 @@ class Planner:
     rank: ClassVar[int] = 100  # where reports list it among its kind's planners (lower first; then by name)
     baseline: ClassVar[bool] = False  # reports compare the other planners with this one, paired
     swept: ClassVar[str | None] = None  # the parameter `semsearch sweep-alpha` sweeps (and reports plot against)
+    replay: ClassVar[bool] = False  # the planner a report replays by default (else the last in report order)
 
     def __init__(self, params: BaseModel):
         self.params = params

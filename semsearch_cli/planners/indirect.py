@@ -251,6 +251,7 @@ class GlobalSearch(IndirectPlanner):
 
 def _register(name: str, base: type, masks: str | None, negative: bool, rank: int) -> type:
     cls = type(name.replace("-", "_"), (base,), {"masks": masks, "negative": negative, "rank": rank,
+                                                 "replay": name == "ISCG-PN-SM",  # the paper's best reading
                                                  "__doc__": f"{name} (Loncomilla et al. 2018, Section 4.5)"})
     return register_planner(name)(cls)
 

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..planners.base import planner_named
 from ..runner import run_rows
 from . import stats as S
 from . import tables as T
@@ -255,7 +256,7 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
     scales = runs["goal"].astype(float)
     if choice is True:
         order = T.planner_order(runs["planner"])
-        label = "ISCG-PN-SM" if "ISCG-PN-SM" in order else order[-1]
+        label = next((lab for lab in order if (c := planner_named(lab)) is not None and c.replay), order[-1])
         sub = runs[(runs["planner"] == label) & (scales == scales.min())]
     else:
         try:
