@@ -11,6 +11,7 @@ configs name on their first line for editors.
 from __future__ import annotations
 
 import argparse
+import ast
 import inspect
 import re
 import sys
@@ -213,7 +214,19 @@ def planners_page() -> str:
     return "\n".join(out) + "\n"
 
 
+def benchmarks_page() -> str:
+    """Every script of benchmarks/ with the first paragraph of its docstring."""
+    out = [HEADER + "# Benchmarks", "", "Run from the repository's root, e.g. `python benchmarks/bench_door_search.py --help`.", "",
+           "| script | what it measures |", "|---|---|"]
+    for f in sorted((ROOT / "benchmarks").glob("*.py")):
+        doc = ast.get_docstring(ast.parse(f.read_text())) or ""
+        first = " ".join(doc.split("\n\n")[0].split())
+        out.append(f"| `{f.name}` | {_cell(_md(first))} |")
+    return "\n".join(out) + "\n"
+
+
 PAGES = {"docs/reference/scenario-format.md": scenario_page, "docs/reference/planners.md": planners_page,
+         "docs/reference/benchmarks.md": benchmarks_page,
          "configs/scenario.schema.json": api.schema_text}
 
 
