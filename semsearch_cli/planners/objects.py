@@ -81,6 +81,9 @@ def lsos_goals(frame: GridFrame, known: np.ndarray, log: pd.DataFrame, cls: str,
 
 @register_planner("lsos")
 class Lsos(ObjectPlanner):
+    """The thesis' LSOS: the heat map of the log's detections of the class (Eqs. 5.3-5.6) gives
+    goals in order of windowed heat, then every place not yet in view, in patrol order."""
+
     rank = 2
 
     Params = LsosParams
@@ -96,6 +99,8 @@ class Lsos(ObjectPlanner):
 
 @register_planner("brute_force")
 class BruteForce(ObjectPlanner):
+    """The patrol route, every place in order and back to the start (thesis Fig. 5.11)."""
+
     rank = 0
 
     Params = NoParams
@@ -108,6 +113,8 @@ class BruteForce(ObjectPlanner):
 
 @register_planner("last_seen")
 class LastSeen(ObjectPlanner):
+    """The position of the most recent detection of the class (latest day, then hour)."""
+
     rank = 1
 
     Params = NoParams

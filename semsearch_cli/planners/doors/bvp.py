@@ -32,6 +32,10 @@ class BVPParams(BaseModel):
 
 @register_planner("bvp")
 class BVP(DoorPlanner):
+    """Frontier exploration by the harmonic potential (Prestes et al. 2002), solved in a window
+    around the robot, every frontier cell attracting; the target is kept until reached or no
+    longer a frontier."""
+
     rank = 1
 
     Params = BVPParams
