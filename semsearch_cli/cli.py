@@ -80,20 +80,22 @@ WORKERS = typer.Option(None, "--workers", min=1, help="Parallel processes (defau
 GOALS = typer.Option(None, "--goal", help="Only these goals (repeat or comma-separate).")
 PLANNERS = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate).")
 TRACE = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl.")
+FRAMES = typer.Option(False, "--frames", help="Also write each run's replay frames to frames/<run>.npz: the report then replays any run from them, without re-running it.")
 FORCE = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak.")
 OVERSUBSCRIBE = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O).")
 EXECUTOR = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers).")
 SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask).")
 
 
-def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler) -> BatchOptions:
+def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames=False) -> BatchOptions:
     """The batch options of the command line (a bad --goal or --planner list exits with status 2)."""
     try:
         goals, planners = _split(goal, "--goal"), _split(planner, "--planner")
     except ScenarioError as exc:
         _fail(exc)
     return BatchOptions(seeds=seeds, goals=goals, planners=planners, out=out_dir, workers=workers,
-                        oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace, force=force)
+                        oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace, force=force,
+                        frames=frames)
 
 
 @app.command()
@@ -105,6 +107,7 @@ def run(
     planner: Optional[List[str]] = PLANNERS,
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = TRACE,
+    frames: bool = FRAMES,
     force: bool = FORCE,
     oversubscribe: bool = OVERSUBSCRIBE,
     executor: str = EXECUTOR,
@@ -113,7 +116,7 @@ def run(
     """Run a scenario's experiment: episodes x planner variants x repeats; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
-    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler)
+    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames)
     _batch(lambda tick: api.run(scenario, opts, progress=tick))
 
 

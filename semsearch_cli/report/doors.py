@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from ..runner import run_rows
@@ -15,7 +14,7 @@ from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import (animate_run, budget_curve, episode_mean, image_formats, swept_values, plot_alpha_sweep, plot_boxes, plot_budget,
                     plot_path_panels, plot_scenario, planner_colors)
-from .runfiles import Frames, load_paths, median_label, safe_name, start_points, stems
+from .runfiles import load_paths, median_label, replay_frames, safe_name, start_points, stems
 from .tables import goal_key
 
 
@@ -130,7 +129,7 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
                           "(by distance) bold, its end dotted; the signs near the median run numbered; squares: start"
                           f"{'s' if len(start_points(g, w)) > 1 else ''}; star: the goal")
         if replay:
-            _replay(doc, loaded, rows, fdir, T.planner_order(rows["planner"]), replay)
+            _replay(doc, loaded, part.folder, rows, fdir, T.planner_order(rows["planner"]), replay)
 
 
 def _rerun(task, variant, goal, episode: int, seed: int, observer):
@@ -141,8 +140,9 @@ def _rerun(task, variant, goal, episode: int, seed: int, observer):
     return task.run(variant, ep if ep is not None else goal, seed, observer)
 
 
-def _replay(doc, loaded, runs, fdir, order, choice=True) -> None:
-    """Re-simulate one run, recording the belief at each decision, as an animated GIF: ``choice``
+def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
+    """One run as an animated GIF of the belief at its decisions, from the frames ``semsearch run
+    --frames`` recorded, else re-simulated (see :func:`replay_frames`): ``choice``
     (planner, goal, episode, seed: the ``--replay`` value, checked against the rows before the
     report starts), or by default the median run of the most semantic variant for the first goal."""
     w = loaded.world
@@ -164,36 +164,17 @@ def _replay(doc, loaded, runs, fdir, order, choice=True) -> None:
     variant = next((v for v in loaded.task.variants() if v.label == label), None)
     if variant is None:
         return
-    frames = []
-    step = max(1, int(row["decisions"]) // 60)
-    count = [0]
-    signs = w.signs
-    where = {}
-
-    def rec(event):
-        count[0] += 1
-        if count[0] % step:
-            return
-        belief, trail, cands = event.belief, event.trail, event.candidates
-        m = np.where(belief.seen, np.where(belief.free, 2, 0), 1).astype(np.uint8)
-        cx, cy = w.frame.to_world(cands.rows, cands.cols)
-        read = []
-        for lab in belief.reads.labels:
-            if lab not in where:
-                where[lab] = signs.indices_of(lab)
-            read += where[lab]
-        frames.append({"map": m[::2, ::2], "path": np.asarray(trail, float), "distance": event.distance,
-                       "cands": np.stack([cx, cy], axis=1) if len(cands) else np.zeros((0, 2)),
-                       "target": event.target_xy, "read": read})
-
-    res = _rerun(loaded.task, variant, goal, episode, seed, Frames(rec))
+    frames, how = replay_frames(folder, label, goal, seed, episode,
+                                lambda watch: _rerun(loaded.task, variant, goal, episode, seed, watch))
     if not frames:
         return
+    signs = w.signs
     i = signs.index_of(loaded.task.goal_value(goal))
     mark = (f"goal {goal}", float(signs.x[i]), float(signs.y[i])) if i >= 0 else None
     f = fdir / f"replay_{loaded.sc.name}_{stems(label, goal, seed, episode)[0]}.gif"
     animate_run(w, frames, f"{label}, goal {goal}, episode {episode}, seed {seed}", f, goal=mark)
-    doc.figure(f, f"Replay of {label}, goal {goal}, episode {episode}, seed {seed} ({res.outcome}, {res.distance_m:.1f} m): "
+    doc.figure(f, f"Replay of {label}, goal {goal}, episode {episode}, seed {seed} ({row['outcome']}, "
+               f"{float(row['distance_m']):.1f} m; frames {how}): "
                "the map as built (white free, black occupied, grey unknown), the candidates and the chosen one, the "
                "signs read so far (numbered) and the goal (star)")
 

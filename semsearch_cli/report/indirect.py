@@ -16,7 +16,7 @@ from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import animate_probability, image_formats, plot_rooms, plot_success_by_scale
-from .runfiles import Frames, stems
+from .runfiles import replay_frames, stems
 
 # The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each
 PAPER_SCALES = (1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -236,17 +236,15 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
                 _replay(doc, part, run_rows(part.runs), out / "figures", notes, replay)
 
 
-def _rerun(task, variant, scale: float, episode: int, seed: int, observer):
-    """Re-simulate one search (runs are deterministic): the one place this section calls
-    ``task.run``; returns (result, the room searched). ``episode`` is the row's index in the task's
-    episode set; when that episode is not at ``scale`` (rows from before episodes, read as episode
-    0), the scale's first episode."""
-    ep = next((e for e in task.episodes if e.index == episode and float(e.goal) == scale), None) or task.as_episode(scale)
-    return task.run(variant, ep, seed, observer), task.grids[ep.room].room
+def _episode_of(task, scale: float, episode: int):
+    """The episode a row names: its index in the task's episode set at ``scale``; for rows from
+    before episodes (read as episode 0), the scale's first episode."""
+    return next((e for e in task.episodes if e.index == episode and float(e.goal) == scale), None) or task.as_episode(scale)
 
 
 def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, choice=True) -> None:
-    """Re-simulate one search, recording the probability map at every re-plan, as a GIF:
+    """One search as a GIF of the probability map at its re-plans, from the frames ``semsearch run
+    --frames`` recorded, else re-simulated (see :func:`replay_frames`):
     ``choice`` (the ``--replay`` run: planner, view scale, episode, seed), or by default the first
     search of ISCG-PN-SM (the paper's best; else the last method) at the smallest view scale."""
     loaded = part.loaded(notes, "The replay")
@@ -272,18 +270,16 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
     variant = next((v for v in loaded.task.variants() if v.label == label), None)
     if variant is None:
         return
-    frames = []
-
-    def rec(e):
-        frames.append({"p": e.p.copy(), "p0": e.p0, "trail": e.trail, "t": e.t_s, "goal": (e.goal.x, e.goal.y), "seen": e.seen})
-
-    res, room = _rerun(loaded.task, variant, scale, episode, seed, Frames(rec))
+    ep_run = _episode_of(loaded.task, scale, episode)
+    frames, how = replay_frames(part.folder, label, row["goal"], seed, episode,
+                                lambda watch: loaded.task.run(variant, ep_run, seed, watch))
+    room = loaded.task.grids[ep_run.room].room
     if not frames:
         return
     f = fdir / f"replay_{loaded.sc.name}_{stems(label, f'{scale:g}', seed, episode)[0]}.gif"
     animate_probability(room, loaded.task.spec.target, frames, f"{label}, view scale {scale:g} m, {room.name}", f)
-    doc.figure(f, f"Replay of {label} at view scale {scale:g} m, episode {episode}, seed {seed} ({res.outcome} after "
-               f"{res.time_s:.0f} s): the robot's probability map of A at each re-plan, its path (cyan), the secondary "
+    doc.figure(f, f"Replay of {label} at view scale {scale:g} m, episode {episode}, seed {seed} ({row['outcome']} after "
+               f"{float(row['time_s']):.0f} s; frames {how}): the robot's probability map of A at each re-plan, its path (cyan), the secondary "
                "objects seen (squares), the goal (cross); A ringed in yellow")
 
 

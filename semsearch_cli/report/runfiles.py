@@ -12,7 +12,8 @@ import pandas as pd
 
 from ..files import safe_chars
 from ..runner import file_stem
-from ..tasks import Observer
+from ..runner.store import read_frames
+from ..tasks import FrameRecorder
 from .stats import episodes
 
 
@@ -66,12 +67,22 @@ def start_points(rows: pd.DataFrame, world) -> list[tuple[float, float]]:
     return [tuple(map(float, world.start_xy))]
 
 
-class Frames(Observer):
-    """The observer of a replayed run: calls ``on(event)`` at each of its events (a replay keeps
-    a frame from some of them)."""
+REPLAY_FRAMES = 60  # at most this many frames in a replay
 
-    def __init__(self, on):
-        self.on = on
 
-    def see(self, event) -> None:
-        self.on(event)
+def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rerun) -> tuple[list[dict], str]:
+    """A run's replay frames (at most :data:`REPLAY_FRAMES`, evenly spaced): read from
+    ``frames/<run>.npz`` when ``semsearch run --frames`` recorded them, else by ``rerun(observer)``
+    (re-simulating the run, which is deterministic, with a :class:`FrameRecorder` watching).
+    Returns (frames, "recorded" or "re-simulated")."""
+    for stem in stems(planner, goal, seed, episode):
+        f = Path(folder) / "frames" / f"{stem}.npz"
+        if f.is_file():
+            frames, how = read_frames(f), "recorded"
+            break
+    else:
+        recorder = FrameRecorder()
+        rerun(recorder)
+        frames, how = recorder.frames, "re-simulated"
+    step = max(1, -(-len(frames) // REPLAY_FRAMES))
+    return frames[::step], how

@@ -13,7 +13,7 @@ import pandas as pd
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import temp_path
 from ..planners import code_of
-from .execution import Executor
+from .execution import Executor, Watch
 from .executors import SerialExecutor, make_executor
 from .options import BatchOptions
 from .lock import folder_lock
@@ -132,7 +132,7 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: Batc
     Of the :class:`BatchOptions`, ``workers`` (None: one), ``executor``, ``scheduler`` and
     ``start_method`` say where the runs run (see :func:`make_executor`: rows do not depend on it,
     and a batch started on one resumes on another), ``trace`` writes each run's decision trace to
-    ``out/traces/`` and ``force`` is explained below; ``runner``, an executor the caller made (and
+    ``out/traces/`` and ``frames`` its replay's frames to ``out/frames/`` and ``force`` is explained below; ``runner``, an executor the caller made (and
     entered), e.g. one Dask cluster for every value of a sweep, replaces the executor options. ``progress(row, done, total)`` is called as
     each run finishes, with the runs finished so far and the runs this batch has to do. The specs
     are streamed to the executor, never listed whole (a
@@ -143,7 +143,8 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: Batc
     folder are refused, unless ``force``, which moves that runs.csv aside (kept as
     ``runs.<n>.csv.bak``) and starts afresh."""
     runs_csv = out / "runs.csv"
-    workers, executor, trace = options.workers or 1, options.executor, options.trace
+    workers, executor = options.workers or 1, options.executor
+    watch = Watch(options.trace, options.frames)
     fp = loaded.fingerprint
     variants = specs.variants if hasattr(specs, "variants") else list({s.variant for s in specs})
     codes = {v.label: code_of(v)["hash"] for v in variants}
@@ -166,7 +167,7 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: Batc
         writer = RowWriter(runs_csv)
         n = 0
         try:
-            for rows in runner.rows(loaded, todo, out, trace):
+            for rows in runner.rows(loaded, todo, out, watch):
                 for r in rows:
                     r["fingerprint"] = fp
                     r["code"] = codes.get(r["planner"], "")

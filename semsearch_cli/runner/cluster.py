@@ -17,7 +17,7 @@ from typing import Iterable, Iterator
 
 from ..errors import ScenarioError
 from ..optional import lazy_module
-from .execution import NO_PATH, Executor, execute
+from .execution import NO_PATH, Executor, Watch, execute
 from .executors import register_executor
 from .specs import Loaded, RunSpec
 from .store import save_run_files
@@ -28,11 +28,11 @@ dask = lazy_module("dask")  # imported at first use (the dask extra; None withou
 distributed = lazy_module("distributed")
 
 
-def _run_chunk(loaded: Loaded, specs: list[RunSpec], trace: bool) -> list[tuple]:
+def _run_chunk(loaded: Loaded, specs: list[RunSpec], watch: Watch) -> list[tuple]:
     """On a worker: (spec stem, rows, result) of each run of a chunk."""
     out = []
     for spec in specs:
-        rows, res = execute(loaded, spec, trace)
+        rows, res = execute(loaded, spec, watch)
         out.append((spec.stem, rows, res))
     return out
 
@@ -75,20 +75,20 @@ class DaskExecutor(Executor):
                                    silence_logs=50)  # CRITICAL: no heartbeat noise when the cluster closes
         return distributed.Client(cluster, set_as_default=False), cluster
 
-    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
         owned = self._kept is None
         client, cluster = self._client() if owned else self._kept
         try:
             shared = client.scatter(loaded, broadcast=True)  # once per worker, not with every run
             try:
-                yield from self._stream(client, shared, iter(specs), out, trace)
+                yield from self._stream(client, shared, iter(specs), out, watch)
             finally:
                 shared.release()  # a kept cluster serves the next batch without this one's scenario
         finally:
             if owned:
                 _close(client, cluster)
 
-    def _stream(self, client, shared, specs: Iterator[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+    def _stream(self, client, shared, specs: Iterator[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
         pending = distributed.as_completed(loop=client.loop)
         ahead = 2 * max(1, sum(client.nthreads().values()))
 
@@ -97,7 +97,7 @@ class DaskExecutor(Executor):
                 part = list(itertools.islice(specs, self.chunk))
                 if not part:
                     return
-                pending.add(client.submit(_run_chunk, shared, part, trace, pure=False))
+                pending.add(client.submit(_run_chunk, shared, part, watch, pure=False))
 
         try:
             submit(ahead)

@@ -9,18 +9,28 @@ import signal
 import threading
 import traceback
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import RunTimeout
-from ..tasks import RunResult, TraceObserver
+from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
 from ..tasks.loop import running
 from .specs import Loaded, RunSpec
 from .store import save_run_files
 
 
-def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[dict], RunResult]:
+@dataclass(frozen=True)
+class Watch:
+    """What a batch keeps of each run beside its rows: its decisions' ``trace`` (traces/<run>.jsonl)
+    and its replay's ``frames`` (frames/<run>.npz, which a report replays without re-running)."""
+
+    trace: bool = False
+    frames: bool = False
+
+
+def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list[dict], RunResult]:
     """Run one spec; returns (rows, result). A planner that raises or exits (``sys.exit``
     included) gives one row with outcome ``error`` and the message; a run past
     ``experiment.run_time_limit`` s of wall-clock time, one with outcome ``timeout``; either
@@ -31,10 +41,13 @@ def execute(loaded: Loaded, spec: RunSpec, trace: bool = False) -> tuple[list[di
     running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
     try:
         with wall_clock_limit(limit):
-            tracer = TraceObserver() if trace else None
-            res = task.run(spec.variant, spec.episode, spec.seed, tracer)
+            tracer = TraceObserver() if watch.trace else None
+            recorder = FrameRecorder() if watch.frames else None
+            res = task.run(spec.variant, spec.episode, spec.seed, Observers(tracer, recorder) if tracer or recorder else None)
             if tracer is not None:
                 res.trace = tracer.rows
+            if recorder is not None:
+                res.frames = recorder.frames
     except RunTimeout:
         res = RunResult("timeout", math.nan, 0, 0, limit, empty,
                         message=f"the run took longer than {limit:g} s of wall-clock time (experiment.run_time_limit)")
@@ -70,15 +83,15 @@ def wall_clock_limit(seconds: float):
 NO_PATH = ("error", "timeout")  # outcomes of runs that leave no path to save
 
 
-def run_and_save(loaded: Loaded, spec: RunSpec, out: Path, trace: bool) -> list[dict]:
-    rows, res = execute(loaded, spec, trace)
+def run_and_save(loaded: Loaded, spec: RunSpec, out: Path, watch: Watch) -> list[dict]:
+    rows, res = execute(loaded, spec, watch)
     if res.outcome not in NO_PATH:
         save_run_files(out, spec.stem, res)
     return rows
 
 
 class Executor:
-    """What every executor gives the runner: ``rows(loaded, specs, out, trace)`` yields each run's
+    """What every executor gives the runner: ``rows(loaded, specs, out, watch)`` yields each run's
     rows as it finishes. An executor is also a context manager: inside ``with`` it may keep what
     it starts (a cluster) for several batches (a sweep's values); outside, each batch starts and
     stops its own. Nothing to keep here."""

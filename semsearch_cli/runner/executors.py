@@ -17,7 +17,7 @@ from typing import Iterable, Iterator
 
 from ..errors import BatchStopped, ScenarioError
 from ..registry import Registry
-from .execution import Executor, run_and_save
+from .execution import Executor, Watch, run_and_save
 from .specs import Loaded, RunSpec
 
 
@@ -27,9 +27,9 @@ class SerialExecutor(Executor):
     def __init__(self, workers: int = 1):
         self.workers = 1
 
-    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
         for spec in specs:
-            yield run_and_save(loaded, spec, out, trace)
+            yield run_and_save(loaded, spec, out, watch)
 
 
 _CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process once
@@ -55,8 +55,8 @@ def _die_with(parent: int) -> None:
 WATCH_S = 0.5  # s between a worker's looks at its parent
 
 
-def _worker_run(spec: RunSpec, out: str, trace: bool) -> list[dict]:
-    return run_and_save(_CACHE["loaded"], spec, Path(out), trace)
+def _worker_run(spec: RunSpec, out: str, watch: Watch) -> list[dict]:
+    return run_and_save(_CACHE["loaded"], spec, Path(out), watch)
 
 
 class ProcessExecutor(Executor):
@@ -73,12 +73,12 @@ class ProcessExecutor(Executor):
         self.workers = workers
         self.context = multiprocessing.get_context(start_method)
 
-    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, trace: bool) -> Iterator[list[dict]]:
+    def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
         specs = iter(specs)
         ahead = 2 * self.workers
         pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=self.context, initializer=_worker_init,
                                    initargs=(loaded,))
-        running = {pool.submit(_worker_run, s, str(out), trace) for s in itertools.islice(specs, ahead)}
+        running = {pool.submit(_worker_run, s, str(out), watch) for s in itertools.islice(specs, ahead)}
         try:
             while running:
                 finished, running = wait(running, return_when=FIRST_COMPLETED)
@@ -88,7 +88,7 @@ class ProcessExecutor(Executor):
                         yield f.result()
                 if broken:
                     raise broken[0].exception()
-                running |= {pool.submit(_worker_run, s, str(out), trace) for s in itertools.islice(specs, len(finished))}
+                running |= {pool.submit(_worker_run, s, str(out), watch) for s in itertools.islice(specs, len(finished))}
         except BrokenProcessPool:
             self._stop(pool, running)
             raise BatchStopped("a worker process died (killed by a signal, or by the system for lack of memory), "

@@ -25,7 +25,8 @@ class BatchOptions:
     ``executor``: ``processes`` or ``dask``, on the Dask scheduler at ``scheduler`` or a local
     cluster of ``workers``; ``start_method``: the worker processes' (see
     :class:`~semsearch_cli.runner.ProcessExecutor`); ``trace``: write each run's decisions to
-    ``traces/``; ``force``: start afresh in a folder holding rows of another scenario (the old
+    ``traces/``; ``frames``: write each run's replay frames to ``frames/`` (a report then replays
+    any run without re-running it); ``force``: start afresh in a folder holding rows of another scenario (the old
     runs.csv is kept as ``runs.<n>.csv.bak``)."""
 
     seeds: int | None = None
@@ -38,6 +39,7 @@ class BatchOptions:
     scheduler: str | None = None
     start_method: str | None = None
     trace: bool = False
+    frames: bool = False
     force: bool = False
 
     def replace(self, **changes) -> "BatchOptions":

@@ -171,3 +171,47 @@ def save_run_files(out: Path, stem: str, res) -> None:
             for d in res.trace:
                 fh.write(json.dumps(json_safe(d), allow_nan=False) + "\n")
         os.replace(tmp, traces / f"{stem}.jsonl")
+    if res.frames:
+        write_frames(out / "frames" / f"{stem}.npz", res.frames)
+
+
+def write_frames(path: Path, frames: list[dict]) -> None:
+    """A replay's frames (dicts of arrays, numbers, lists and, for ``seen``, a mapping of class to
+    (x, y)) to one compressed file, atomically; :func:`read_frames` reads them back."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = {}
+    for i, f in enumerate(frames):
+        for k, v in f.items():
+            if k == "seen":
+                arrays[f"{i}/seen_names"] = np.array(list(v), dtype=str)
+                arrays[f"{i}/seen_xy"] = np.array(list(v.values()), float).reshape(-1, 2)
+            else:
+                arrays[f"{i}/{k}"] = np.asarray(v)
+    tmp = temp_path(path)
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, n=np.int64(len(frames)), **arrays)
+    os.replace(tmp, path)
+
+
+def read_frames(path: Path) -> list[dict]:
+    """The frames :func:`write_frames` wrote, as the replay draws them."""
+    with np.load(path) as z:
+        frames = [dict() for _ in range(int(z["n"]))]
+        for key in z.files:
+            if key == "n":
+                continue
+            i, k = key.split("/", 1)
+            frames[int(i)][k] = z[key]
+    for f in frames:
+        if "seen_names" in f:
+            f["seen"] = {str(c): tuple(float(u) for u in xy) for c, xy in zip(f.pop("seen_names"), f.pop("seen_xy"))}
+        for k, v in list(f.items()):
+            if isinstance(v, np.ndarray) and v.ndim == 0:
+                f[k] = v.item()
+        if "read" in f:
+            f["read"] = [int(i) for i in f["read"]]
+        if "target" in f or "goal" in f:
+            for k in ("target", "goal"):
+                if k in f:
+                    f[k] = tuple(float(u) for u in f[k])
+    return frames

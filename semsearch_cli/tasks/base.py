@@ -81,6 +81,10 @@ class Event:
     def row(self) -> dict:  # pragma: no cover
         raise NotImplementedError
 
+    def frame(self) -> dict | None:
+        """What a replay draws of this moment (arrays and numbers; None: nothing to draw)."""
+        return None
+
     def trace_row(self) -> dict:
         row = self.row()
         return row if self.stage is None else {**row, "stage": self.stage}
@@ -107,6 +111,39 @@ class TraceObserver(Observer):
             self.rows.append(event.trace_row())
 
 
+class FrameRecorder(Observer):
+    """Keeps the frames of a run's replay (:meth:`Event.frame`), evenly spaced: every ``step``-th
+    event, ``step`` doubling (and every other frame kept dropped) whenever more than ``limit``
+    are kept, so a long run costs at most ``limit`` frames."""
+
+    def __init__(self, limit: int = 120):
+        self.limit, self.step, self.count = limit, 1, 0
+        self.frames: list[dict] = []
+
+    def see(self, event: Event) -> None:
+        self.count += 1
+        if (self.count - 1) % self.step:
+            return
+        frame = event.frame()
+        if frame is None:
+            return
+        self.frames.append(frame)
+        if len(self.frames) > self.limit:
+            self.frames = self.frames[::2]
+            self.step *= 2
+
+
+class Observers(Observer):
+    """Several observers of one run."""
+
+    def __init__(self, *observers: Observer):
+        self.observers = [o for o in observers if o is not None]
+
+    def see(self, event: Event) -> None:
+        for o in self.observers:
+            o.see(event)
+
+
 class StageObserver(Observer):
     """Passes a chain stage's events on to ``inner``, marked with the stage's number."""
 
@@ -127,6 +164,7 @@ class RunResult:
     path: np.ndarray  # (n, 2) float32, m
     read_signs: list = field(default_factory=list)  # sign indices read at least once
     trace: list = field(default_factory=list)  # one dict per decision, when traced (runner.execute)
+    frames: list = field(default_factory=list)  # a replay's frames, when recorded (runner.execute)
     stages: list = field(default_factory=list)  # extra rows of a run (chains: one per stage and mode)
     message: str = ""
     time_s: float = float("nan")  # simulated seconds, for tasks with a clock

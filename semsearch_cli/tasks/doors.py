@@ -80,6 +80,15 @@ class DoorDecision(Event):
     decision: Decision
     belief: DoorBelief
     trail: list
+    read: tuple = ()  # indices of the signs read so far
+
+    def frame(self) -> dict:
+        b = self.belief
+        cx, cy = b.frame.to_world(self.candidates.rows, self.candidates.cols)
+        return {"map": np.where(b.seen, np.where(b.free, 2, 0), 1).astype(np.uint8)[::2, ::2],
+                "path": np.asarray(self.trail, float), "distance": float(self.distance),
+                "cands": np.stack([cx, cy], axis=1) if len(self.candidates) else np.zeros((0, 2)),
+                "target": tuple(float(v) for v in self.target_xy), "read": list(self.read)}
 
     def row(self) -> dict:
         tx, ty = self.target_xy
@@ -236,7 +245,7 @@ class DoorSearch(DoorSensing):
         if self.observer is not None and not kept:
             self.observer.see(DoorDecision(step=st.steps, distance=st.distance - self.start_distance, x=st.x, y=st.y,
                                            heading=st.heading, target_xy=fr.to_world(dec.row, dec.col), candidates=cands,
-                                           decision=dec, belief=b, trail=st.trail))
+                                           decision=dec, belief=b, trail=st.trail, read=tuple(sorted(st.read_signs))))
         p = self.navigator.plan(b, ctx.row, ctx.col, dec.row, dec.col)
         if p is not None and len(p[0]) >= 2:
             self.looked_around = False

@@ -136,6 +136,10 @@ class IndirectGoal(Event):
     def traced(self) -> bool:
         return self.new
 
+    def frame(self) -> dict:
+        return {"p": self.p.copy(), "p0": float(self.p0), "trail": np.asarray(self.trail, float), "t": float(self.t_s),
+                "goal": (float(self.goal.x), float(self.goal.y)), "seen": dict(self.seen)}
+
     def row(self) -> dict:
         return {"step": self.step, "t_s": round(self.t_s, 2), "x": round(self.x, 3), "y": round(self.y, 3),
                 "heading_deg": round(math.degrees(self.heading), 1),
