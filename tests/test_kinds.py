@@ -10,6 +10,7 @@ import yaml
 from semsearch_cli.config import KINDS, OnMap, Scenario, kind_of, parse_scenario, register_kind
 from semsearch_cli.errors import ScenarioError
 from semsearch_cli.planners import PLANNERS, DoorPlanner, Planner, register_planner
+from semsearch_cli.report import build  # noqa: F401  (registers every kind's report section)
 from semsearch_cli.report.sections import SECTIONS, Section, register_section
 from semsearch_cli.tasks import TASKS, Task, register_task
 

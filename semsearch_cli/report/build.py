@@ -25,6 +25,7 @@ from ..planners import code_of
 from ..files import read_user_text
 from ..runner import Loaded, read_runs, run_rows
 from ..tasks.episodes import set_hash
+from . import doors, objects, chain, indirect  # noqa: F401  (each registers its section)
 from .sections import SECTIONS, replaying
 from .stats import episodes
 from .tables import goal_key, planner_order
