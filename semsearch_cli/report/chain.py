@@ -99,9 +99,11 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     if img:
         order = T.planner_order(runs["planner"])
         f = out / "figures" / "chain_stages.png"
-        plot_chain_stages(runs[runs["stage"] != ""], order, f, img, planner_colors(order))
+        stage_rows = runs[runs["stage"] != ""]
+        plot_chain_stages(stage_rows, order, f, img, planner_colors(order))
+        one = int(stage_rows.groupby(["planner", "goal", "stage", "map"]).size().max()) < 2
         doc.figure(f, "Each stage's mean distance with the map kept (solid) and from scratch (hatched), per planner, "
-                      "with 95% intervals (bootstrap over units)")
+                      + ("one run each, so no interval" if one else "with 95% intervals (bootstrap over units)"))
         _path_figures(doc, parts, out / "figures", notes, img, planner_colors(order))
 
 

@@ -14,7 +14,7 @@ from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import (animate_run, budget_curve, episode_mean, image_formats, swept_values, plot_alpha_sweep, plot_boxes, plot_budget,
                     plot_path_panels, plot_scenario, planner_colors)
-from .runfiles import load_paths, median_label, replay_frames, safe_name, start_points, stems
+from .runfiles import load_paths, median_label, replay_frames, row_variant, safe_name, start_points, stems
 from .tables import goal_key
 
 
@@ -161,7 +161,7 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
             return  # the run is in another folder of this report
         row = runs[m].iloc[0]
     label, goal, seed, episode = str(row["planner"]), row["goal"], int(row["seed"]), int(ep[row.name])
-    variant = next((v for v in loaded.task.variants() if v.label == label), None)
+    variant = row_variant(loaded, row)
     if variant is None:
         return
     frames, how = replay_frames(folder, label, goal, seed, episode,

@@ -16,7 +16,7 @@ from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import animate_probability, image_formats, plot_rooms, plot_success_by_scale
-from .runfiles import replay_frames, stems
+from .runfiles import replay_frames, row_variant, stems
 
 # The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each
 PAPER_SCALES = (1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -267,7 +267,7 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
         return  # the run is in another folder of this report
     row = sub.assign(_ep=ep[sub.index]).sort_values(["_ep", "seed"]).iloc[0]
     label, scale, seed, episode = str(row["planner"]), float(row["goal"]), int(row["seed"]), int(ep[row.name])
-    variant = next((v for v in loaded.task.variants() if v.label == label), None)
+    variant = row_variant(loaded, row)
     if variant is None:
         return
     ep_run = _episode_of(loaded.task, scale, episode)

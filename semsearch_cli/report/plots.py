@@ -770,10 +770,13 @@ def plot_chain_stages(stage_rows, order: list, out: Path, formats=("png",), colo
                 ci = [stats.mean_ci(s["distance_m"].astype(float), stats.units(s)) if len(s) else (np.nan,) * 3
                       for s in (e[e["stage"] == lab] for lab in labels)]
                 mean, lo, hi = (np.array(v, float) for v in zip(*ci))
-                err = np.nan_to_num(np.vstack([mean - lo, hi - mean]))
-                ax.bar(x + (2 * j + m - len(order)) * width + width / 2, mean, width, yerr=err, capsize=1.5,
-                       color=colors[p], alpha=1.0 if mode == "kept" else 0.45, hatch=None if mode == "kept" else "////",
-                       error_kw=dict(lw=0.7))
+                xs = x + (2 * j + m - len(order)) * width + width / 2
+                ax.bar(xs, mean, width, color=colors[p], alpha=1.0 if mode == "kept" else 0.45,
+                       hatch=None if mode == "kept" else "////")
+                has = np.isfinite(lo) & np.isfinite(hi)  # one run per stage has no interval: no bar drawn
+                if has.any():
+                    ax.errorbar(xs[has], mean[has], yerr=np.vstack([mean - lo, hi - mean])[:, has], fmt="none",
+                                ecolor="black", elinewidth=0.7, capsize=1.5)
         ax.set_xticks(x, [f"stage {lab.split(':', 1)[0]}\ndoor {lab.split(':', 1)[1]}" if ":" in lab else lab for lab in labels])
         ax.set_ylabel("distance (m)")
         ax.set_title(f"chain {ch}")
@@ -782,7 +785,9 @@ def plot_chain_stages(stage_rows, order: list, out: Path, formats=("png",), colo
                for p in order if p in n.index]
     handles += [Patch(facecolor="0.5", label="map kept"), Patch(facecolor="0.5", alpha=0.45, hatch="////", label="from scratch")]
     fig.legend(handles=handles, loc="outside lower center", ncol=min(4, len(handles)))
-    fig.suptitle(f"mean distance per stage, 95% CI over {stats.unit_kind(stage_rows)}")
+    one = int(stage_rows.groupby(["planner", "goal", "stage", "map"]).size().max()) < 2
+    fig.suptitle("distance per stage (one run each: no interval)" if one else
+                 f"mean distance per stage, 95% CI over {stats.unit_kind(stage_rows)}")
     return _save(fig, out, formats)
 
 

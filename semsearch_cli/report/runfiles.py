@@ -5,12 +5,14 @@ column: episode 0). The new stem is tried first, then the old one."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..files import safe_chars
+from ..planners import PLANNERS, Variant
 from ..runner import file_stem
 from ..runner.store import read_frames
 from ..tasks import FrameRecorder
@@ -86,3 +88,19 @@ def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rer
         frames, how = recorder.frames, "re-simulated"
     step = max(1, -(-len(frames) // REPLAY_FRAMES))
     return frames[::step], how
+
+
+def row_variant(loaded, row) -> Variant | None:
+    """The planner variant that made a row: one of the scenario's, else a registered planner with
+    the row's parameters (``sweep-alpha`` and ``--param`` sweeps run variants the scenario does
+    not list); None when neither gives the row's label."""
+    label = str(row["planner"])
+    found = next((v for v in loaded.task.variants() if v.label == label), None)
+    if found is not None:
+        return found
+    name = label.split("[", 1)[0]
+    if name not in PLANNERS:
+        return None
+    params = json.loads(str(row.get("params") or "{}") or "{}")
+    v = Variant(name, tuple(sorted(params.items())))
+    return v if v.label == label else None
