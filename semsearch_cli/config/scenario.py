@@ -94,10 +94,6 @@ def kind_of(data: dict) -> str | None:
     return (taken or present)[0]
 
 
-def model_of(kind: str) -> type[Scenario]:
-    return KINDS[kind]
-
-
 def all_fields() -> set[str]:
     """Every top-level field of every kind's model."""
     return {f for cls in KINDS.values() for f in cls.model_fields}

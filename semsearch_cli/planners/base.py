@@ -97,8 +97,8 @@ class Planner:
     :class:`~semsearch_cli.planners.IndirectPlanner`, which set ``task``.
 
     Class attributes: ``Params`` (a pydantic model of the planner's parameters, checked when the
-    scenario is loaded), ``task`` (the kind of search it answers), ``rank``, ``baseline`` and
-    ``swept`` (how reports order and compare it; see the attributes below).
+    scenario is loaded), ``task`` (the kind of search it answers), ``rank``, ``baseline``,
+    ``swept`` and ``replay`` (how reports order, compare and replay it; see the attributes below).
     """
 
     name: ClassVar[str] = ""

@@ -38,7 +38,8 @@ def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     case_order = list(dict.fromkeys(df["case"]))
     out["_c"] = out["case"].map(case_order.index)
     out["_h"] = out["hour"].map(lambda h: (h == 0, h))
-    out["_p"] = out["planner"].map(lambda p: T.planner_order(df["planner"]).index(p))
+    planner_rank = {p: i for i, p in enumerate(T.planner_order(df["planner"]))}
+    out["_p"] = out["planner"].map(planner_rank)
     return out.sort_values(["_c", "class", "_h", "_p"]).drop(columns=["_c", "_h", "_p"]).round(3).reset_index(drop=True)
 
 

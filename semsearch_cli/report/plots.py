@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import functools
 import inspect
-import json
 import os
 from pathlib import Path
 
@@ -22,7 +21,7 @@ import pandas as pd
 
 from ..files import temp_path
 from . import stats
-from ..planners.base import baseline_of, planner_named
+from ..planners.base import baseline_of, planner_named, swept_value
 from .tables import goal_key, planner_order
 
 import cv2
@@ -355,18 +354,17 @@ def plot_scenario(world, goals, title: str, out: Path, formats=("png",)) -> list
 
 
 # ---- statistics over runs -----------------------------------------------------------------------
-def swept_rows(runs: pd.DataFrame) -> tuple[str | None, pd.DataFrame]:
-    """(the swept parameter, the rows of the planners that sweep it, with its value in column
+def swept_rows(runs: pd.DataFrame) -> tuple[type | None, pd.DataFrame]:
+    """(the planner class that sweeps a parameter, its rows with the parameter's value in column
     ``swept``): the first swept planner in report order (:attr:`Planner.swept`; nsos and alpha),
-    its value read from each row's params, the parameter's default where a row does not set it."""
-    for lab in planner_order(runs["planner"].astype(str)):
+    the value read from each row's label (:func:`~semsearch_cli.planners.base.swept_value`)."""
+    labels = runs["planner"].astype(str)
+    for lab in planner_order(labels):
         cls = planner_named(lab)
         if cls is not None and cls.swept is not None:
-            name, param = cls.name, cls.swept
-            default = float(cls.Params.model_fields[param].default)
-            rows = runs[runs["planner"].astype(str).map(lambda x: x.split("[", 1)[0] == name)].copy()
-            rows["swept"] = rows["params"].fillna("{}").map(lambda p: float(json.loads(p or "{}").get(param, default)))
-            return param, rows
+            rows = runs[labels.map(lambda x: planner_named(x) is cls)].copy()
+            rows["swept"] = rows["planner"].astype(str).map(swept_value)
+            return cls, rows
     return None, runs.iloc[:0].assign(swept=pd.Series(dtype=float))
 
 
@@ -518,13 +516,13 @@ def plot_alpha_sweep(runs, out: Path, baseline: str | None = None, formats=("png
     variant's colour, 95% CI over units), the baseline planner (default: greedy, see
     :func:`~semsearch_cli.planners.base.baseline_of`) as a dashed line with its 95% CI shaded."""
     colors = colors or planner_colors(planner_order(runs["planner"]))
-    param, nsos = swept_rows(runs)
+    cls, nsos = swept_rows(runs)
     nsos = nsos.rename(columns={"swept": "alpha"})
-    swept_name = nsos["planner"].astype(str).iloc[0].split("[", 1)[0] if len(nsos) else ""
-    what = planner_named(swept_name).Params.model_fields[param].description if len(nsos) else None
+    swept_name, param = (cls.name, cls.swept) if cls is not None else ("", "")
+    what = cls.Params.model_fields[param].description if cls is not None else None
     xlabel = f"{param} ({what.split(',')[0]})" if what else str(param)
     if baseline is None:
-        rest = [lab for lab in runs["planner"].astype(str).unique() if lab.split("[", 1)[0] != swept_name]
+        rest = [lab for lab in runs["planner"].astype(str).unique() if planner_named(lab) is not cls]
         baseline = baseline_of(rest) if rest else ""
     goals = sorted(runs["goal"].unique(), key=goal_key)
     fig, axes = _grid(len(goals), 2.0)

@@ -12,7 +12,8 @@ import numpy as np
 import pandas as pd
 
 from ..files import safe_chars
-from ..planners import PLANNERS, Variant
+from ..planners import Variant
+from ..planners.base import planner_named
 from ..runner import file_stem
 from ..runner.store import read_frames
 from ..tasks import FrameRecorder
@@ -98,9 +99,9 @@ def row_variant(loaded, row) -> Variant | None:
     found = next((v for v in loaded.task.variants() if v.label == label), None)
     if found is not None:
         return found
-    name = label.split("[", 1)[0]
-    if name not in PLANNERS:
+    cls = planner_named(label)
+    if cls is None:
         return None
     params = json.loads(str(row.get("params") or "{}") or "{}")
-    v = Variant(name, tuple(sorted(params.items())))
+    v = Variant(cls.name, tuple(sorted(params.items())))
     return v if v.label == label else None

@@ -129,14 +129,16 @@ def check_memory(loaded: Loaded, workers: int) -> None:
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
               progress: Callable[[dict, int, int], None] | None = None, runner: Executor | None = None) -> pd.DataFrame:
     """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
+
     Of the :class:`BatchOptions`, ``workers`` (None: one), ``executor``, ``scheduler`` and
     ``start_method`` say where the runs run (see :func:`make_executor`: rows do not depend on it,
-    and a batch started on one resumes on another), ``trace`` writes each run's decision trace to
-    ``out/traces/`` and ``frames`` its replay's frames to ``out/frames/`` and ``force`` is explained below; ``runner``, an executor the caller made (and
-    entered), e.g. one Dask cluster for every value of a sweep, replaces the executor options. ``progress(row, done, total)`` is called as
-    each run finishes, with the runs finished so far and the runs this batch has to do. The specs
-    are streamed to the executor, never listed whole (a
-    :class:`~semsearch_cli.runner.specs.RunList` of any length costs no memory).
+    and a batch started on one resumes on another); ``trace`` writes each run's decision trace to
+    ``out/traces/``, ``frames`` its replay's frames to ``out/frames/``; ``force`` is below.
+    ``runner``, an executor the caller made (and entered), e.g. one Dask cluster for every value of
+    a sweep, replaces the executor options. ``progress(row, done, total)`` is called as each run
+    finishes, with the runs finished so far and the runs this batch has to do. The specs are
+    streamed to the executor, never listed whole (a :class:`~semsearch_cli.runner.specs.RunList`
+    of any length costs no memory).
 
     The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's
     fingerprint (:attr:`Loaded.fingerprint`); rows of another scenario (or an edited one) in the

@@ -118,7 +118,7 @@ class IndirectGoal(Event):
     those are traced): at ``step`` (``t_s`` s of simulated time), from the pose (``x``, ``y`` m,
     ``heading`` rad), the :class:`~semsearch_cli.planners.Goal` ``goal``; ``p`` the probability
     map of A as it is now (copy what you keep), ``p0`` the outside cell's probability, ``trail``
-    the path so far ((n, 2) m) and ``seen`` the secondary objects seen (class -> (x, y) m)."""
+    the path so far ([(x, y)] m) and ``seen`` the secondary objects seen (class -> (x, y) m)."""
 
     step: int
     t_s: float
@@ -129,7 +129,7 @@ class IndirectGoal(Event):
     new: bool
     p: np.ndarray
     p0: float
-    trail: np.ndarray
+    trail: list
     seen: dict
 
     @property
@@ -285,7 +285,7 @@ class IndirectSearch:
         self.goal = goal
         if self.observer is not None:
             self.observer.see(IndirectGoal(step=st.steps, t_s=st.steps * self.dt, x=st.x, y=st.y, heading=st.heading, goal=goal,
-                                           new=new, p=st.belief.p, p0=st.belief.p0, trail=np.asarray(st.trail),
+                                           new=new, p=st.belief.p, p0=st.belief.p0, trail=st.trail,
                                            seen=dict(self.seen)))
         if math.hypot(goal.x - st.x, goal.y - st.y) < 1e-9:
             xs, ys = np.array([st.x, st.x]), np.array([st.y, st.y])
