@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 from contextlib import nullcontext
 from dataclasses import dataclass
@@ -14,6 +15,7 @@ import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .errors import ScenarioError
+from .world.ground_truth import DuplicateSigns
 from .planners import PLANNERS, expand_variants, load_entry_points
 from .report import build as report_build
 from .report.document import atomic_text, markdown_table
@@ -24,6 +26,8 @@ from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import inside, output_file, output_folder, temp_path
+from . import shipped
+from .shipped import scenario_file
 
 
 @dataclass
@@ -53,7 +57,7 @@ def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=N
     """
     options = options.checked()
     goals, planners = options.goals, options.planners
-    loaded = Loaded.load(Path(scenario))
+    loaded = Loaded.load(scenario_file(scenario))
     if planner_specs is not None:
         loaded = loaded.with_planners(planner_specs)
     if goals:
@@ -101,6 +105,7 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], options: BatchOptions
     planner (:attr:`Planner.baseline`: greedy) beside it: the rows and summary of :func:`run`, plus
     ``plots/alpha_sweep.png``. The swept planner is the scenario's first entry of one that sweeps
     alpha (its other parameters kept), else the built-in one of the scenario's kind."""
+    scenario = scenario_file(scenario)
     sc = load_scenario(scenario)
     answers = TASKS[sc.kind].planner_kind
     sweeping = {n: c for n, c in PLANNERS.items() if c.swept == "alpha" and c.task == answers}
@@ -167,7 +172,7 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
     (resumable, as :func:`run`), then ``sweep.csv``, ``sweep.md`` and ``sweep.png`` compare them.
     Every value is checked before anything runs."""
     options = options.checked()
-    path = Path(scenario)
+    path = scenario_file(scenario)
     data = read_yaml(path)
     loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
     for v, ld in zip(values, loaded):
@@ -212,7 +217,7 @@ def write_summary(runs: pd.DataFrame, out_dir: Path) -> pd.DataFrame:
 
 def record(scenario: str | Path, out: str | Path, cases=None) -> list[tuple[Path, int]]:
     """Write each case's detection log (recorded by patrolling, or read from its CSV) to ``out``."""
-    loaded = Loaded.load(Path(scenario))
+    loaded = Loaded.load(scenario_file(scenario))
     logs = getattr(loaded.task, "logs", None)
     if not logs:
         raise ScenarioError(str(scenario), "objects", "recording needs a scenario with object cases (an objects section)")
@@ -244,6 +249,11 @@ def imported(importer, out: str | Path, *args, **kwargs) -> tuple[Path, list[str
         path, notes = importer(*args, out=work, **kwargs)
         try:
             validate(path)
+        except DuplicateSigns as exc:
+            raise ScenarioError(str(args[-1] if args else out), "", f"{exc.count} sign number(s) appear more than once: "
+                                f"{exc.listed}. Nothing was written: import again with --duplicates keep-first (the "
+                                "first sign of each number is kept) or --duplicates any (every sign is kept; the goal is "
+                                "found at whichever sign carries it)") from None
         except ScenarioError as exc:
             raise ScenarioError(str(out / path.name), exc.field, f"the imported scenario would not validate, so "
                                 f"nothing was written: {exc.message}") from None
@@ -273,7 +283,7 @@ def schema(out: str | Path | None = None) -> Path | None:
 def validate(scenario: str | Path) -> dict:
     """Every check of the loader, plus counts, each goal's shortest path from the scenario's start
     and the episode set (no simulation)."""
-    task = Loaded.load(Path(scenario)).task
+    task = Loaded.load(scenario_file(scenario)).task
     eps = task.episodes
     sp = [e.shortest_m for e in eps]
     return {**task.describe(), "episodes": f"{len(eps)} over {len({str(e.goal) for e in eps})} goals, shortest paths "
@@ -283,7 +293,7 @@ def validate(scenario: str | Path) -> dict:
 def show(scenario: str | Path, out: str | Path) -> Path:
     """Draw a scenario (map, signs or places, start, goals) to a PNG without simulating."""
     out = output_file(out, "--out", (".png", ".pdf", ".svg"))
-    loaded = Loaded.load(Path(scenario))
+    loaded = Loaded.load(scenario_file(scenario))
     return report_build.show(loaded, out)
 
 
@@ -291,7 +301,7 @@ def episodes(scenario: str | Path, out: str | Path) -> tuple[Path, list, str]:
     """Write a scenario's episode set to the CSV ``out`` (episode, goal, start_x, start_y,
     start_heading, room, shortest_m, hash), atomically; returns (file, episodes, set hash).
     ``episodes: {file: that.csv}`` in a scenario runs exactly that set."""
-    loaded = Loaded.load(Path(scenario))
+    loaded = Loaded.load(scenario_file(scenario))
     eps = loaded.task.episodes
     rows = pd.DataFrame([loaded.task.episode_row(e) for e in eps], columns=EPISODE_COLUMNS)
     path = output_file(out, "--out", (".csv",))
@@ -301,6 +311,25 @@ def episodes(scenario: str | Path, out: str | Path) -> tuple[Path, list, str]:
     return path, eps, set_hash(eps)
 
 
+_ROLE = re.compile(r":(?:class|func|meth|attr|mod|data|exc|obj):`(~?)([\w.]+)`")
+
+
+def _plain_doc(text: str) -> str:
+    """A docstring's text for a console: Sphinx roles (``:class:`~a.B```) as their plain names
+    (``B``), double backquotes as single quotes."""
+    text = _ROLE.sub(lambda m: m.group(2).rsplit(".", 1)[-1] if m.group(1) else m.group(2), text)
+    return text.replace("``", "'")
+
+
+def _shown(path: str | Path) -> str:
+    """A path as the user would type it: relative to the working folder when it lies inside it."""
+    p = Path(path)
+    try:
+        return p.relative_to(Path.cwd()).as_posix()
+    except ValueError:
+        return str(p)
+
+
 def planners(scenario: str | Path | None = None) -> list[dict]:
     """Every planner semsearch can run: built-in, from installed packages (entry points) and,
     with ``scenario``, from the files it names; each with its kind of search, where it comes
@@ -308,18 +337,36 @@ def planners(scenario: str | Path | None = None) -> list[dict]:
     load_entry_points()
     own = {}
     if scenario is not None:
-        loaded = Loaded.load(Path(scenario))
+        loaded = Loaded.load(scenario_file(scenario))
         own = {v.name: v.module for v in loaded.task.variants() if v.module}
     out = []
     for name, cls in sorted(PLANNERS.items(), key=lambda kv: (kv[1].task, kv[0])):
         mod = cls.__module__
-        source = (f"file {own[name]}" if name in own else "built-in" if mod.startswith("semsearch_cli.")
+        source = (f"file {_shown(own[name])}" if name in own else "built-in" if mod.startswith("semsearch_cli.")
                   else f"module {mod}")
         if mod.startswith("semsearch_user_planners.") and name not in own:
             continue  # a file some other scenario loaded in this process
-        doc = (cls.__doc__ or "").strip().split("\n\n")[0]
+        doc = _plain_doc((cls.__doc__ or "").strip().split("\n\n")[0])
         params = [{"name": k, "type": getattr(f.annotation, "__name__", str(f.annotation)),
                    "default": None if f.is_required() else f.default, "description": f.description or ""}
                   for k, f in cls.Params.model_fields.items()]
         out.append({"name": name, "kind": cls.task, "source": source, "description": " ".join(doc.split()), "params": params})
     return out
+
+
+def scenarios() -> list[dict]:
+    """The shipped scenarios (package data): each one's ``name`` (what ``semsearch run NAME``
+    takes), ``kind``, ``file`` and ``description`` (its first comment line)."""
+    out = []
+    for name in shipped.names():
+        sc = load_scenario(shipped.path(name))
+        out.append({"name": name, "kind": sc.kind, "file": shipped.path(name), "description": shipped.describe(name)})
+    return out
+
+
+def init(name: str, folder: str | Path, force: bool = False) -> list[Path]:
+    """Copy the shipped scenario ``name`` and the files it names into ``folder``, to edit (see
+    :func:`semsearch_cli.shipped.init`); the copy is validated before this returns."""
+    written = shipped.init(name, output_folder(folder), force)
+    Loaded.load(written[0])
+    return written

@@ -6,6 +6,7 @@ import math
 import signal
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import List, Optional
 
@@ -22,7 +23,8 @@ from .runner import BatchOptions
 from .belief.presence import presence_scores, read_counts
 from .config.base import MAX_SEEDS
 from .config.indirect import IndirectSpec
-from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated
+from .kernels import announce_compiling
+from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated, did_you_mean
 from .report.build import console_tables
 from .world.buildings.numbered import LAYOUTS, SCHEMES
 from .world.buildings.numbered import generate_batch as gen_batch
@@ -74,6 +76,7 @@ def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
     return [int(v) if v.lstrip("-").isdigit() else v for v in items]
 
 
+SCENARIO = typer.Argument(..., help="Scenario YAML file, or a shipped scenario's name (semsearch scenarios lists them).")
 # the batch options of run, sweep-alpha and sweep, declared once (see runner.BatchOptions)
 SEEDS = typer.Option(None, "--seeds", min=1, max=MAX_SEEDS, help="Repeats of each episode per planner variant (default: the scenario's experiment.seeds).")
 WORKERS = typer.Option(None, "--workers", min=1, help="Parallel processes (default: CPU count, at most 4; more than the CPU count needs --oversubscribe).")
@@ -100,7 +103,7 @@ def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe
 
 @app.command()
 def run(
-    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    scenario: Path = SCENARIO,
     seeds: Optional[int] = SEEDS,
     workers: Optional[int] = WORKERS,
     goal: Optional[List[str]] = GOALS,
@@ -122,7 +125,7 @@ def run(
 
 @app.command("sweep-alpha")
 def sweep_alpha(
-    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    scenario: Path = SCENARIO,
     alphas: str = typer.Option("0,0.5,0.8,0.9,1.0", "--alphas", help="Comma-separated alpha values for nsos."),
     seeds: Optional[int] = SEEDS,
     workers: Optional[int] = WORKERS,
@@ -150,7 +153,7 @@ def sweep_alpha(
 
 @app.command()
 def sweep(
-    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    scenario: Path = SCENARIO,
     param: str = typer.Option(..., "--param", help="SECTION.FIELD=V1,V2,... e.g. door_camera.p_misread=0,0.02,0.05,0.1, "
                               "or PLANNER.PARAM=... e.g. nsos.alpha=0.8,0.9,1.0."),
     seeds: Optional[int] = SEEDS,
@@ -179,6 +182,12 @@ def sweep(
     out.print(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv")
 
 
+def _run_name(row: dict) -> str:
+    """A finished run as progress lines name it: planner, goal, episode and seed (as the lines a
+    long run prints about itself, and the rows' columns)."""
+    return f"{row['planner']} goal {row['goal']} episode {row['episode']} seed {row['seed']}"
+
+
 class _Lines:
     """Progress off a terminal (CI logs, nohup, SLURM): one line on stderr every ``every`` s or
     every tenth of the batch, whichever comes first, and a last line with the count."""
@@ -192,8 +201,8 @@ class _Lines:
             self.step = max(1, total // 10)
         if done == total or done % self.step == 0 or now - self.last >= self.every:
             self.last = now
-            err.print(f"runs: {done} of {total} done, {now - self.t0:.0f} s; last {row['planner']} goal {row['goal']} "
-                             f"seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m", highlight=False, soft_wrap=True)
+            err.print(f"runs: {done} of {total} done, {now - self.t0:.0f} s; last {_run_name(row)}: {row['outcome']} "
+                      f"{row['distance_m']:.0f} m", highlight=False, soft_wrap=True)
 
 
 def _with_progress(call):
@@ -221,7 +230,7 @@ def _with_progress(call):
                 if task is None or n == 1:  # a sweep runs one batch per value
                     task = prog.add_task("runs", total=total)
                 prog.update(task, completed=n, description=escape(
-                    f"{row['planner']} goal {row['goal']} seed {row['seed']}: {row['outcome']} {row['distance_m']:.0f} m"))
+                    f"{_run_name(row)}: {row['outcome']} {row['distance_m']:.0f} m"))
 
             return call(tick)
     except ScenarioError as exc:
@@ -339,7 +348,7 @@ def record(
 
 
 @app.command()
-def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
+def validate(scenario: Path = SCENARIO):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""
 
     try:
@@ -349,6 +358,35 @@ def validate(scenario: Path = typer.Argument(..., help="Scenario YAML file.")):
     out.print(f"{scenario}: ok")
     for k, v in info.items():
         out.print(f"  {k}: {v}")
+
+
+@app.command()
+def scenarios():
+    """List the shipped scenarios: `semsearch run NAME` runs one from any folder, and `semsearch
+    init NAME DIR` copies one (with its map) to edit."""
+
+    t = Table(title="shipped scenarios (semsearch run NAME; semsearch init NAME DIR to edit a copy)")
+    for col in ("name", "kind", "description"):
+        t.add_column(col, overflow="fold")
+    for s in api.scenarios():
+        t.add_row(s["name"], s["kind"], s["description"])
+    out.print(t)
+
+
+@app.command()
+def init(
+    name: str = typer.Argument(..., help="A shipped scenario's name (semsearch scenarios)."),
+    folder: str = typer.Argument(..., callback=_path, help="Folder to copy it into (created if needed)."),
+    force: bool = typer.Option(False, "--force", help="Overwrite files of the same names in the folder."),
+):
+    """Copy a shipped scenario and the files it names (map, signs, the JSON Schema) into a folder
+    of yours, with its paths rewritten to the copies, to edit and run."""
+
+    try:
+        written = api.init(name, folder, force)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"wrote {written[0]} and {len(written) - 1} file(s) it names; run it with: semsearch run {written[0]}")
 
 
 @app.command()
@@ -369,7 +407,7 @@ def schema(out_file: Optional[str] = typer.Option(None, "--out", callback=_path,
 
 @app.command()
 def show(
-    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    scenario: Path = SCENARIO,
     out_file: str = typer.Option("map.png", "--out", callback=_path, help="Image to write: .png, .pdf or .svg."),
 ):
     """Draw a scenario: the map with every sign and its number, the start and the goals."""
@@ -467,6 +505,20 @@ def generate_rooms(
     out.print(f"wrote {len(rooms)} rooms of {w:g} x {d:g} m to {path}")
 
 
+DUPLICATES_POLICIES = ("error", "keep-first", "any")
+
+
+def _duplicates(value: str) -> str:
+    if value not in DUPLICATES_POLICIES:
+        raise typer.BadParameter(f"{value!r} is not one of {', '.join(DUPLICATES_POLICIES)}{did_you_mean(value, DUPLICATES_POLICIES)}")
+    return value
+
+
+DUPLICATES = typer.Option("error", "--duplicates", callback=_duplicates,
+                          help="Signs that share a number: error (refuse), keep-first (the first sign of each number) or "
+                               "any (keep every one; the goal is found at whichever carries it). Written into the scenario.")
+
+
 @import_app.command("mobilesim")
 def import_mobilesim(
     map_file: Path = typer.Argument(..., help="MobileSim .map file (walls in mm)."),
@@ -476,11 +528,13 @@ def import_mobilesim(
     start: Optional[str] = typer.Option(None, "--start", help="X,Y in metres (default: the widest free cell)."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
     density_delta: float = typer.Option(2.5, "--density-delta", callback=_finite, min=0.01, max=1e4, help="m^2, segmentation delta (Eq. 4.4)."),
+    duplicates: str = DUPLICATES,
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
         path, notes = api.imported(imp_mobilesim, out_dir, map_file, doors_file, res=resolution, start=_xy(start, "--start"),
-                                   goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta)
+                                   goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta,
+                                   duplicates=duplicates)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
@@ -509,12 +563,13 @@ def import_ros(
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance)."),
     density_delta: float = typer.Option(2.5, "--density-delta", callback=_finite, min=0.01, max=1e4, help="m^2, segmentation delta (Eq. 4.4)."),
     clean: bool = typer.Option(False, "--clean", help="Clean a SLAM map: free space not reachable from the start, and laser fans narrower than the robot, become outside (map.clean)."),
+    duplicates: str = DUPLICATES,
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
         path, notes = api.imported(imp_ros, out_dir, map_file, doors_file, start=_xy(start, "--start"),
                                    goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta,
-                                   clean=clean)
+                                   clean=clean, duplicates=duplicates)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.yaml'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
@@ -528,12 +583,14 @@ def import_kth(
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance, among readable signs)."),
     corridor_types: str = typer.Option(",".join(KTH_CORRIDOR_TYPES), "--corridor-types",
                                        help="Comma-separated space types the robot drives in (untyped spaces joined to several others count too)."),
+    duplicates: str = DUPLICATES,
 ):
     """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
         types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
         path, notes = api.imported(imp_kth, out_dir, xml_file, res=resolution,
-                                   goals=_split([goals], "--goals") if goals is not None else None, corridor_types=types)
+                                   goals=_split([goals], "--goals") if goals is not None else None, corridor_types=types,
+                                   duplicates=duplicates)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}\n" + "\n".join(notes))
@@ -560,7 +617,7 @@ def _main(show_version: bool = typer.Option(False, "--version", callback=_versio
 
 @app.command()
 def episodes(
-    scenario: Path = typer.Argument(..., help="Scenario YAML file."),
+    scenario: Path = SCENARIO,
     out_file: str = typer.Option("episodes.csv", "--out", callback=_path, help="CSV to write."),
 ):
     """Write a scenario's episode set (each start and goal, its shortest path and a content hash)
@@ -584,8 +641,10 @@ def planners_cmd(scenario: Optional[Path] = typer.Argument(None, help="Also list
     except ScenarioError as exc:
         _fail(exc)
     t = Table(title="planners (parameters: name = default, description)")
+    widest = max((len(p["source"]) for p in found), default=0)
     for col in ("name", "kind", "source", "description", "parameters"):
-        t.add_column(col, overflow="fold")
+        # a planner file's path is printed whole where it fits (a folded path cannot be copied)
+        t.add_column(col, overflow="fold", min_width=min(widest, 80) if col == "source" else None)
     for p in found:
         params = "\n".join(f"{q['name']} = {q['default']!r}" + (f": {q['description']}" if q["description"] else "")
                            for q in p["params"]) or "none"
@@ -610,6 +669,10 @@ def main() -> None:
     """The command line. Faults end with one paragraph and a status, never a traceback: Ctrl-C
     (130), SIGTERM (143), a batch stopped by a dead worker (1), a full disk (1)."""
     signal.signal(signal.SIGTERM, _terminate)
+    announce_compiling()
+    # semsearch's own deprecations (a user's planner written against an older API) are shown: the
+    # user's code is what must change, and Python hides DeprecationWarning outside __main__
+    warnings.filterwarnings("default", category=DeprecationWarning, message=".*deprecated since semsearch")
     resume = "finished runs are kept in runs.csv; run the same command again to resume"
     try:
         app()

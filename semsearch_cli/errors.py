@@ -1,6 +1,7 @@
 """User-facing errors: one clear paragraph, exit status 2, never a traceback; and the faults that
 stop a batch (one paragraph too, with the status they end with)."""
 
+import difflib
 import errno
 
 DISK_FULL = (errno.ENOSPC, errno.EDQUOT)  # what a write on a full disk (or quota) raises
@@ -56,3 +57,14 @@ class RunTimeout(BaseException):
 class Terminated(BaseException):
     """SIGTERM, raised in the main thread (like KeyboardInterrupt for SIGINT), so that a batch
     told to stop stops its workers and says what it kept."""
+
+
+def did_you_mean(name: str, valid) -> str:
+    """`` (did you mean 'alpha'?)`` for the valid names nearest a mistyped ``name`` (difflib's
+    similarity ratio at least 0.6, and within 0.1 of the nearest's; at most three), or ``""``
+    when none is near."""
+    scored = sorted(((difflib.SequenceMatcher(None, str(name), str(v)).ratio(), str(v)) for v in valid), reverse=True)
+    near = [v for r, v in scored if r >= 0.6 and r >= scored[0][0] - 0.1][:3]
+    if not near:
+        return ""
+    return " (did you mean " + " or ".join(repr(n) for n in near) + "?)"

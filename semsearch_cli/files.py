@@ -58,7 +58,10 @@ def user_file(path: str | Path, what: str, owner: str | None = None, field: str 
     try:
         st = path.stat()
     except (FileNotFoundError, NotADirectoryError):
-        raise ScenarioError(file, field, f"{where} not found") from None
+        raise ScenarioError(file, field, f"{where} not found" + (f" (looked for {path.resolve()}: a scenario's paths are "
+                                                                 "relative to the folder the scenario is in)" if owner else
+                                                                 f" (looked for {path.resolve()})" if not path.is_absolute()
+                                                                 else "")) from None
     except OSError as exc:
         raise ScenarioError(file, field, f"{where} cannot be read ({exc.strerror})") from None
     if stat.S_ISDIR(st.st_mode):

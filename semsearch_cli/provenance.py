@@ -51,10 +51,12 @@ def code_hash() -> str:
 @functools.cache
 def git_commit() -> str | None:
     """The commit of the checkout the package runs from (``+dirty`` when its files differ from
-    it), or None when it was installed from elsewhere (a wheel, an sdist)."""
+    it); installed from a wheel, the commit the wheel was built from (see setup.py); None when
+    neither is known (built from an sdist or a tarball)."""
     root = PACKAGE.parent
     if not (root / ".git").exists():
-        return None
+        built = PACKAGE / "data" / "build_commit.txt"  # written by setup.py into a wheel built from a checkout
+        return built.read_text().strip() or None if built.is_file() else None
     try:
         head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
         dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--", PACKAGE.name],
@@ -67,7 +69,7 @@ def git_commit() -> str | None:
 
 
 def version_line() -> str:
-    """``semsearch 0.1.0 (code 1a2b..., commit abc...)``: what ``semsearch --version`` prints."""
+    """``semsearch 0.2.0 (code 1a2b..., commit abc...)``: what ``semsearch --version`` prints."""
     commit = git_commit()
     return f"semsearch {__version__} (code {code_hash()}" + (f", commit {commit}" if commit else "") + ")"
 

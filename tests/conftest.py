@@ -27,3 +27,12 @@ def demo_loaded(demo_dir):
 
 def needs_reference():
     return pytest.mark.skipif(not REF.is_dir(), reason=f"the authors' reference maps are not at {REF} (../shared absent)")
+
+
+@pytest.fixture(autouse=True)
+def _console_width(monkeypatch):
+    """Every test sees a console 200 columns wide, whatever the terminal that runs pytest (typer's
+    help and error panels read COLUMNS; the CLI's own tables are 200 wide off a terminal), and
+    the processes a test starts inherit it."""
+    monkeypatch.setenv("COLUMNS", "200")
+    monkeypatch.delenv("LINES", raising=False)

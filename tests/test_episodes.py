@@ -12,6 +12,7 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from semsearch_cli import __version__
 from semsearch_cli.cli import app
 from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks.episodes import region_mask
@@ -198,12 +199,14 @@ def test_meta_json_records_the_provenance(tmp_path):
 
 def test_version_and_the_planner_list():
     res = CliRunner().invoke(app, ["--version"])
-    assert res.exit_code == 0 and res.output.startswith("semsearch 0.1.0 (code ")
-    # a process of its own, as a user runs it (a process registers a planner name from one file only)
+    assert res.exit_code == 0 and res.output.startswith(f"semsearch {__version__} (code ")
+    # a process of its own, as a user runs it (a process registers a planner name from one file only), from the
+    # checkout: the planner file's path is shown relative to the working folder, whatever the clone's path
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "planners",
-                          str(ROOT / "examples" / "custom_planner" / "scenario.yaml")], capture_output=True, text=True)
+                          "examples/custom_planner/scenario.yaml"], capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 0, res.stderr
-    for words in ("nsos", "alpha = 0.9", "straight_on", "my_planner.py", "turn_weight", "ISCG-PN-SM", "lsos"):
+    for words in ("nsos", "alpha = 0.9", "straight_on", "file examples/custom_planner/my_planner.py", "turn_weight",
+                  "ISCG-PN-SM", "lsos"):
         assert words in res.stdout, words
 
 

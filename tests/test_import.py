@@ -309,3 +309,24 @@ def test_import_ros_clean_removes_laser_fans_and_unreachable_space(tmp_path):
     # the building's free space is the demo's, but for cells next to where a ray crossed a wall
     diff = cleaned.free != demo.world.free
     assert diff.sum() <= 0.01 * demo.world.free.sum()
+
+
+def test_duplicate_numbers_refused_with_the_option_to_pass_then_imported_under_each_policy(tmp_path):
+    # sign 1 twice (as the authors' hotel11 carries 343 twice), on opposite walls of one corridor
+    lines = ["0 0 20000 0", "20000 0 20000 2000", "20000 2000 0 2000", "0 2000 0 0"]
+    (tmp_path / "c.map").write_text("LINES\n" + "\n".join(lines) + "\nDATA\n")
+    (tmp_path / "c.doors").write_text("5.0 -0.5 1 90\n10.0 2.5 1 -90\n15.0 -0.5 3 90\n")
+    base = ["import", "mobilesim", str(tmp_path / "c.map"), str(tmp_path / "c.doors"), "--start", "2,1", "--goals", "1"]
+    res = CliRunner().invoke(app, [*base, "--out", str(tmp_path / "refused")])
+    assert res.exit_code == 2
+    assert "1 sign number(s) appear more than once: 1 at (5.05, 0), (10.05, 1.9)" in res.output
+    assert "--duplicates keep-first" in res.output and "--duplicates any" in res.output
+    assert not (tmp_path / "refused" / "scenario.yaml").exists()
+    for policy, kept in (("keep-first", 2), ("any", 3)):
+        out = tmp_path / policy
+        res = CliRunner().invoke(app, [*base, "--out", str(out), "--duplicates", policy])
+        assert res.exit_code == 0, res.output
+        assert yaml.safe_load((out / "scenario.yaml").read_text())["duplicates"] == policy
+        assert len(Loaded.load(out / "scenario.yaml").world.signs.x) == kept
+    res = CliRunner().invoke(app, [*base, "--out", str(tmp_path / "x"), "--duplicates", "anny"])
+    assert res.exit_code == 2 and "did you mean 'any'?" in res.output

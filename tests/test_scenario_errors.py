@@ -50,6 +50,13 @@ def test_unknown_nested_key(demo_dir, tmp_path):
     check_error(scenario_copy(demo_dir, tmp_path, experiment={"seeds": 2, "sedes": 3}), "experiment.sedes", "unknown key")
 
 
+def test_a_mistyped_key_gets_the_nearest_valid_names_and_the_keys_of_its_section(demo_dir, tmp_path):
+    check_error(scenario_copy(demo_dir, tmp_path, experiment={"seeds": 2, "max_distnace": 300}), "experiment.max_distnace",
+                "unknown key 'max_distnace' (did you mean 'max_distance'?)",
+                "valid keys here: base_seed, max_distance, max_steps, out, run_time_limit, seeds")
+    check_error(scenario_copy(demo_dir, tmp_path, belief={"densty_delta": 2.0}), "belief.densty_delta", "did you mean 'density_delta'?")
+
+
 def test_wrong_type(demo_dir, tmp_path):
     check_error(scenario_copy(demo_dir, tmp_path, experiment={"seeds": "many"}), "experiment.seeds", "integer")
 
@@ -60,6 +67,13 @@ def test_missing_field(demo_dir, tmp_path):
 
 def test_missing_image(demo_dir, tmp_path):
     check_error(scenario_copy(demo_dir, tmp_path, map={"image": "nope.png", "resolution": 0.1}), "nope.png", "map.image", "not found")
+
+
+def test_a_missing_file_names_the_resolved_path_and_what_paths_are_relative_to(demo_dir, tmp_path):
+    (tmp_path / "sub").mkdir()
+    p = scenario_copy(demo_dir, tmp_path / "sub", map={"image": "../maps/nope.png", "resolution": 0.1})
+    check_error(p, "map image", "not found", f"(looked for {tmp_path / 'maps' / 'nope.png'}: a scenario's paths are "
+                "relative to the folder the scenario is in)")
 
 
 def test_not_an_image(demo_dir, tmp_path):
@@ -78,10 +92,15 @@ def test_goal_no_sign_carries(demo_dir, tmp_path):
 
 def test_unknown_planner(demo_dir, tmp_path):
     check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "greedy"}, {"name": "astar"}]), "planners[1].name", "valid: bvp, draft, geometric, greedy, nsos")
+    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "nsso"}]), "unknown planner 'nsso' (did you mean 'nsos'?)")
 
 
 def test_unknown_planner_parameter(demo_dir, tmp_path):
-    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "bvp", "windw": 3}]), "planners[0].windw", "unknown parameter")
+    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "bvp", "windw": 3}]), "planners[0].windw", "'bvp' has no parameter 'windw'")
+    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "nsos", "alfa": 0.9}]), "planners[0].alfa",
+                "'nsos' has no parameter 'alfa' (did you mean 'alpha'?); its parameters: alpha = 0.9 (weight of the semantic factor",
+                "hysteresis = 0.01")
+    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "greedy", "alpha": 0.9}]), "it takes no parameters")
 
 
 def test_duplicate_sign_numbers(demo_dir, tmp_path):

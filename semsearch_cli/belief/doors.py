@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 from skimage.morphology import skeletonize
 
+from .. import deprecation
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import (GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, set_joins,
@@ -533,3 +534,10 @@ def _grow(box, other) -> None:
 def _empty() -> Candidates:
     z = np.zeros(0, np.int64)
     return Candidates(z, z.copy(), np.zeros(0), z.copy(), z.copy())
+
+
+DEPRECATED = {"Belief": ("semsearch_cli.belief.DoorBelief", DoorBelief)}  # 0.2.0 -> removed in 0.3.0
+
+
+def __getattr__(name: str):
+    return deprecation.alias(__name__, name, DEPRECATED)

@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal, Union, get_args
 
 import yaml
-from pydantic import Field, Tag, TypeAdapter, ValidationError
+from pydantic import BaseModel, Field, Tag, TypeAdapter, ValidationError
 
-from ..errors import ScenarioError
+from ..errors import ScenarioError, did_you_mean
 from ..files import read_user_text
 from ..registry import Registry
 from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
@@ -130,6 +130,32 @@ def _loc(loc: tuple) -> str:
     return out
 
 
+def _keys_at(model: type[BaseModel], loc: tuple) -> list[str]:
+    """The keys a model takes at pydantic's error location ``loc`` (the mapping that holds the
+    unknown key), following nested models through lists and optional or union fields; ``[]``
+    where the walk cannot tell."""
+    here: Any = model
+    for part in loc:
+        if isinstance(part, int) or _TYPE_PART.match(str(part)):
+            continue
+        fields = getattr(here, "model_fields", None)
+        if not fields or part not in fields:
+            return []
+        here = _model_in(fields[part].annotation)
+        if here is None:
+            return []
+    fields = getattr(here, "model_fields", None)
+    return sorted(f.alias or k for k, f in fields.items()) if fields else []
+
+
+def _model_in(annotation) -> type[BaseModel] | None:
+    """The pydantic model an annotation holds (``X``, ``X | None``, ``list[X]``), or None."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    models = [m for a in get_args(annotation) if (m := _model_in(a)) is not None]
+    return models[0] if len(models) == 1 else None
+
+
 def parse_scenario(data: Any, file: str | Path) -> Scenario:
     """Validate a parsed YAML document; raise :class:`ScenarioError` on the first problem."""
     if not isinstance(data, dict):
@@ -155,7 +181,10 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
             raise ScenarioError(str(file), field, f"give {model.needs} ("
                                 + "; ".join(f"{k}: {c.section}" for k, c in KINDS.items()) + ")") from None
         if err["type"] == "extra_forbidden":
-            msg = "unknown key (check its spelling; `semsearch schema` writes the scenario format)"
+            valid = _keys_at(model, err["loc"][:-1])
+            bad = str(err["loc"][-1])
+            msg = (f"unknown key {bad!r}{did_you_mean(bad, valid)}" + (f"; valid keys here: {', '.join(valid)}" if valid else "")
+                   + " (`semsearch schema` writes the scenario format)")
         elif err["type"] == "missing":
             msg = "required field is missing"
         got = err.get("input")

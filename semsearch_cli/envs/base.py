@@ -1,5 +1,6 @@
 """What every semsearch environment shares: the scenario it loads, the episode a reset draws, the
-reward, the robot-centred window of a grid, and the text charset.
+reward, the action mask (``info["action_mask"]``, int8), the robot-centred window of a grid, and
+the text observation's charset and shared wording (the frame statement, the answer line).
 
 An environment runs the batch's own simulator (the task a scenario builds, its sensors, belief and
 step loop, :class:`~semsearch_cli.tasks.loop.Stepper`); only who makes each decision changes. A
@@ -24,6 +25,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..config import load_scenario
+from .. import shipped as shipped_scenarios
 from ..errors import ScenarioError
 from ..tasks import Task, build_task
 from ..tasks.episodes import Episode, episode_seed
@@ -34,27 +36,21 @@ BIG = 1e6  # bound of the observations' coordinates (m), as config.base.MAX_COOR
 IDLE_ACTIONS = 100  # actions in a row that take no step (the agent choosing where it stands) before the episode is stuck
 TEXT_CHARSET = frozenset(string.ascii_letters + string.digits + string.punctuation + " \n")
 TEXT_LENGTH = 8192
-PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 _TASKS: dict[tuple, Task] = {}  # (resolved path, mtime) -> task: the envs of one process share a loaded scenario
 
 
 def shipped(name: str) -> Path:
-    """The path of a shipped scenario (``configs/<name>.yaml``): in the working folder, else in
-    the checkout semsearch runs from."""
-    for root in (Path.cwd(), PACKAGE_ROOT):
-        p = root / "configs" / f"{name}.yaml"
-        if p.is_file():
-            return p
-    raise ScenarioError(f"configs/{name}.yaml", "scenario", "the shipped scenarios live in the semsearch checkout: "
-                        "run from there, or pass scenario=PATH to gymnasium.make")
+    """The path of a shipped scenario (``hotel``, ``demo``, ...: package data, so a wheel install
+    finds it from any folder; see :mod:`semsearch_cli.shipped`)."""
+    return shipped_scenarios.path(name)
 
 
 def load_task(scenario: str | Path, kind: str) -> Task:
-    """The task of a scenario file (loaded once per process; ``shipped:NAME`` is
-    ``configs/NAME.yaml``, see :func:`shipped`), checked to be of ``kind``."""
+    """The task of a scenario file (loaded once per process; ``shipped:NAME`` or a bare ``NAME``
+    is a shipped scenario, see :func:`shipped`), checked to be of ``kind``."""
     if isinstance(scenario, str) and scenario.startswith("shipped:"):
         scenario = shipped(scenario.split(":", 1)[1])
-    path = Path(scenario).resolve()
+    path = shipped_scenarios.scenario_file(scenario).resolve()
     if not path.is_file():
         raise ScenarioError(str(scenario), "scenario", "no such scenario file")
     key = (str(path), path.stat().st_mtime_ns)
@@ -118,9 +114,56 @@ def text_space() -> gym.spaces.Text:
 
 def clip_text(text: str) -> str:
     """``text`` inside the Text space: characters outside its charset (a label's accents, a tab)
-    as ``?``, at most ``TEXT_LENGTH`` characters."""
+    as ``?``, at most ``TEXT_LENGTH`` characters. A text cut short keeps its last line (the
+    answer line, which names the valid actions) when that line is short enough, the cut marked
+    ``...``."""
     text = "".join(ch if ch in TEXT_CHARSET else "?" for ch in text) or "?"
-    return text if len(text) <= TEXT_LENGTH else text[:TEXT_LENGTH - 4] + "\n..."
+    if len(text) <= TEXT_LENGTH:
+        return text
+    last = text.rsplit("\n", 1)[-1]
+    if len(last) > TEXT_LENGTH // 2:
+        return text[:TEXT_LENGTH - 4] + "\n..."
+    return text[:TEXT_LENGTH - len(last) - 5] + "\n...\n" + last
+
+
+# ---- the text observation's shared wording (read by language models) -----------------------
+FRAME_TEXT = ("Frame: x points east and y north, in metres; distances are straight lines. Every angle is in "
+              "degrees counter-clockwise from east in this fixed map frame (0 east, 90 north, 180 west, -90 "
+              "south), not relative to your heading; a bearing is the direction from you to a thing.")
+
+
+def deg(a: float) -> str:
+    """An angle (rad) as whole degrees in (-180, 180], for the text observation."""
+    d = round(math.degrees(a))
+    return str(-((180 - d) % 360 - 180))
+
+
+def spell(numbers) -> str:
+    """Sorted action numbers in words: ``0, 1 or 64``; runs of three or more as ``4-9``."""
+    runs: list[list[int]] = []
+    for n in (int(v) for v in numbers):
+        if runs and n == runs[-1][1] + 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    items = []
+    for a, b in runs:
+        items += [str(a)] if a == b else [str(a), str(b)] if b == a + 1 else [f"{a}-{b}"]
+    if not items:
+        return "none"
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " or " + items[-1]
+
+
+def answer_line(mask: np.ndarray) -> str:
+    """The text observation's last line: the actions ``mask`` allows, and only those."""
+    return f"Answer with one number: {spell(np.flatnonzero(mask))}."
+
+
+def compass_moves(step: float) -> str:
+    """The primitive actions of :func:`compass_step`, as the text observation offers them."""
+    return ("Moves (a move into a wall leaves you where you are): "
+            + "; ".join(f"[{k}] {step:g} m {d}" for k, d in enumerate(COMPASS))
+            + "; [8] turn 45 deg left (counter-clockwise); [9] turn 45 deg right.")
 
 
 class SearchEnv(gym.Env):
@@ -203,9 +246,11 @@ class SearchEnv(gym.Env):
         st = self.state
         # "episode_index", not "episode": Gymnasium's RecordEpisodeStatistics and Stable-Baselines3
         # keep their episode statistics (a dict) under info["episode"]
+        # the mask as int8, as Gymnasium's own (Taxi) and Discrete.sample(mask) take it;
+        # action_masks() stays bool, as sb3-contrib's MaskablePPO takes it
         return {"episode_index": self.episode.index, "repeat": self.repeat, "goal": str(self.episode.goal),
                 "distance_m": float(st.distance), "steps": int(st.steps), "outcome": self.outcome or "",
-                "shortest_m": float(self.episode.shortest_m)}
+                "shortest_m": float(self.episode.shortest_m), "action_mask": self.action_masks().astype(np.int8)}
 
     # ---- pickling: the arguments, the generator and the actions since the reset ----------
     def __getstate__(self):
@@ -229,4 +274,8 @@ class SearchEnv(gym.Env):
         raise NotImplementedError
 
     def _observe(self):  # pragma: no cover
+        raise NotImplementedError
+
+    def action_masks(self) -> np.ndarray:  # pragma: no cover
+        """(action_space.n,) bool: the actions valid now (``info["action_mask"]`` holds it as int8)."""
         raise NotImplementedError

@@ -9,7 +9,8 @@ Action modes
 ``navigation.replan_every`` metres, and, with ``replan_on_signs``, when a sign reaches
 ``belief.min_reads``) the agent chooses one of the belief's frontier candidates, slots ``0..K-1``
 holding the K nearest (straight-line) nearest first
-(``info["action_mask"]``, also :meth:`action_masks` for sb3-contrib's MaskablePPO); the navigator
+(``info["action_mask"]``, int8 as ``action_space.sample(mask)`` takes it; :meth:`action_masks`, bool,
+for sb3-contrib's MaskablePPO); the navigator
 drives there until the next re-plan. Action ``K`` looks at the nearest wall face no camera has read
 yet (the batch's completeness sweep, what it does when a planner returns None); an action naming an
 empty slot is taken as ``K``. When a chosen candidate has no path the agent is asked again at once
@@ -35,8 +36,10 @@ Observation (``observation_mode="dict"``)
 - ``pose``: float32 (3,): x, y (m), heading (rad).
 
 ``observation_mode="text"`` renders the same as a short text (a ``Text`` space) for language-model
-agents. ``render_mode="rgb_array"`` draws the belief and the path (north up). ``max_distance``
-(m) replaces the scenario's budget, e.g. for shorter training episodes.
+agents: positions and angles in the world frame (x east, y north; degrees counter-clockwise from
+east), the choices numbered ``[n]``, and a last line that names exactly the actions the mask
+allows. ``render_mode="rgb_array"`` draws the belief and the path (north up). ``max_distance`` (m)
+replaces the scenario's budget, e.g. for shorter training episodes.
 """
 
 from __future__ import annotations
@@ -52,7 +55,8 @@ from ..planners import Decision
 from ..tasks.doors import MAX_RETRIES, DoorSearch
 from ..tasks.loop import Stepper
 from ..world.labels import parse_label
-from .base import BIG, COMPASS, SearchEnv, box, clip_text, compass_step, text_space, window
+from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, clip_text, compass_moves, compass_step, deg, text_space,
+                   window)
 
 
 class _Agent:
@@ -215,7 +219,6 @@ class DoorSearchEnv(SearchEnv):
 
     def _info(self) -> dict:
         info = super()._info()
-        info["action_mask"] = self.action_masks()
         info["n_candidates"] = 0 if self.decision is None else len(self.decision[1])
         return info
 
@@ -270,28 +273,34 @@ class DoorSearchEnv(SearchEnv):
         return obs
 
     def _text(self) -> str:
+        """The text observation: the goal, the frame, the pose, the signs read, the choices (each
+        ``[n]``) and an answer line naming exactly the actions :meth:`action_masks` allows."""
         st = self.state
-        lines = [f"Goal: read the door sign {self.episode.goal}.",
-                 f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {math.degrees(st.heading):.0f} deg "
-                 f"(0 east, 90 north); travelled {st.distance:.1f} m."]
+        lines = [f"Goal: read the door sign {self.episode.goal}.", FRAME_TEXT,
+                 f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {deg(st.heading)} deg; travelled {st.distance:.1f} m."]
         signs = self._signs()[:self.S]
         if signs:
-            lines.append("Signs read, nearest first: " + "; ".join(
-                f"{lab} at {math.hypot(dx, dy):.1f} m bearing {math.degrees(math.atan2(dy, dx)):.0f} deg, facing "
-                f"{math.degrees(f):.0f} deg" for _, lab, dx, dy, f in signs) + ".")
+            lines.append("Signs read, nearest first (facing: the direction the sign's face points): " + "; ".join(
+                f"{lab} at {math.hypot(dx, dy):.1f} m, bearing {deg(math.atan2(dy, dx))} deg, facing {deg(f)} deg"
+                for _, lab, dx, dy, f in signs) + ".")
         else:
             lines.append("No sign read yet.")
         if self.action_mode == "macro":
             if self.decision is not None:
+                # the direction of each target is theta_f, the planners' branch direction
+                lines.append("Choices: drive to a frontier target (a point on the edge of the explored area), nearest "
+                             "first, with the direction in which unexplored space goes on beyond it; or look at a wall:")
                 cands = self.decision[1].take(self.slots)
                 xs, ys = self.task.world.frame.to_world(cands.rows, cands.cols)
-                lines.append("Frontier targets, nearest first: " + "; ".join(
-                    f"[{k}] {math.hypot(x - st.x, y - st.y):.1f} m bearing {math.degrees(math.atan2(y - st.y, x - st.x)):.0f} deg, "
-                    f"leading {math.degrees(t):.0f} deg" for k, (x, y, t) in enumerate(zip(xs, ys, cands.theta))) + ".")
-            lines.append(f"Answer with a target's number, or {self.K} to look at the nearest wall not yet read.")
+                dx, dy = xs - st.x, ys - st.y
+                lines += [f"[{k}] {math.hypot(a, b):.1f} m away, bearing {deg(math.atan2(b, a))} deg, unexplored space "
+                          f"towards {deg(t)} deg" for k, (a, b, t) in enumerate(zip(dx, dy, cands.theta))]
+            else:
+                lines.append("Choices:")
+            lines.append(f"[{self.K}] look at the nearest wall face no camera has read yet")
         else:
-            lines.append("Answer with 0-7 to move 0.1 m " + ", ".join(f"{k} {d}" for k, d in enumerate(COMPASS))
-                         + "; 8 to turn left, 9 to turn right (45 deg).")
+            lines.append(compass_moves(self.step_m))
+        lines.append(answer_line(self.action_masks()))
         return clip_text("\n".join(lines))
 
     def render(self):

@@ -45,7 +45,7 @@ from ..geometry import wrap_angle
 from ..planners import Goal
 from ..tasks.indirect import IndirectSearch
 from ..tasks.loop import Stepper
-from .base import BIG, TWO_PI, SearchEnv, box, clip_text, text_space
+from .base import BIG, FRAME_TEXT, TWO_PI, SearchEnv, answer_line, box, clip_text, deg, text_space
 
 HEADINGS = np.radians(np.arange(0, 360, 45))
 
@@ -83,6 +83,7 @@ class IndirectSearchEnv(SearchEnv):
         self._init_args.update(masks=masks, negative=negative, lattice=lattice)
         t = self.task
         self.masks, self.negative = masks, bool(negative) and masks is not None
+        self.lattice = float(lattice)
         self.secondary = list(t.spec.secondary)
         w, h = t.grids[0].room.size
         self.lx = np.arange(lattice / 2, w, lattice)
@@ -151,12 +152,14 @@ class IndirectSearchEnv(SearchEnv):
         return st.distance - d0, out
 
     def action_masks(self) -> np.ndarray:
+        """(action_space.n,) bool. Macro: every heading of the lattice points the robot can stand
+        on in this room; primitive: every action."""
         if self.action_mode == "primitive":
             return np.ones(4, bool)
         return np.repeat(self.standable, 8)
 
     def _info(self) -> dict:
-        return {**super()._info(), "action_mask": self.action_masks(), "room": self.grid.room.name}
+        return {**super()._info(), "room": self.grid.room.name}
 
     def _belief(self) -> np.ndarray:
         b = self.state.belief
@@ -176,23 +179,43 @@ class IndirectSearchEnv(SearchEnv):
         st = self.state
         t_s = st.steps / self.task.spec.camera.fps
         if self.observation_mode == "text":
-            p = self._belief()
-            top = np.argsort(p.ravel())[::-1][:5]
-            xs, ys = self.grid.frame.to_world(*np.unravel_index(top, p.shape))
-            sec = self._secondary()
-            lines = [f"Find the {self.task.spec.target} (view scale {float(self.episode.goal):g} m) in room "
-                     f"{self.grid.room.name}; {t_s:.1f} s of {self.task.spec.time_limit:g} s used.",
-                     f"You are at x {st.x:.2f} m, y {st.y:.2f} m, heading {math.degrees(st.heading):.0f} deg.",
-                     "Seen: " + ("; ".join(f"{cls} at dx {s[1]:.2f} m, dy {s[2]:.2f} m" for cls, s in zip(self.secondary, sec) if s[0])
-                                 or "nothing yet") + ".",
-                     "Likeliest cells: " + "; ".join(f"({x:.2f}, {y:.2f}) m p {p.ravel()[i]:.4f}" for x, y, i in zip(xs, ys, top)) + "."]
-            lines.append(f"Answer with 8 k + h: lattice point k of {self.N} (every {self.lx[0] * 2:g} m, row-major) and "
-                         "heading h x 45 deg." if self.action_mode == "macro" else
-                         "Answer 0 to drive forward, 1 to turn left, 2 to turn right, 3 to wait (one frame).")
-            return clip_text("\n".join(lines))
+            return self._text(t_s)
         return {"belief": self._belief(), "secondary": self._secondary(),
                 "pose": np.array([st.x, st.y, wrap_angle(st.heading)], np.float32),
                 "time": np.array([t_s, float(self.episode.goal)], np.float32)}
+
+    def _text(self, t_s: float) -> str:
+        """The text observation: the goal, the frame, the pose, the objects detected, the five
+        likeliest cells of the target, the choices and an answer line naming exactly the actions
+        :meth:`action_masks` allows (macro: ranges of action numbers)."""
+        st, spec = self.state, self.task.spec
+        p = self._belief()
+        top = np.argsort(p.ravel())[::-1][:5]
+        xs, ys = self.grid.frame.to_world(*np.unravel_index(top, p.shape))
+        seen = [f"{cls} at x {s[1] + st.x:.2f} m, y {s[2] + st.y:.2f} m ({math.hypot(s[1], s[2]):.2f} m away, bearing "
+                f"{deg(math.atan2(s[2], s[1]))} deg)" for cls, s in zip(self.secondary, self._secondary()) if s[0]]
+        lines = [f"Goal: find the {spec.target} in room {self.grid.room.name}; your camera detects it up to "
+                 f"{float(self.episode.goal):g} m away. Time used: {t_s:.1f} s of {spec.time_limit:g} s.",
+                 FRAME_TEXT + " Positions are measured from the room's south-west corner.",
+                 f"You are at x {st.x:.2f} m, y {st.y:.2f} m, heading {deg(st.heading)} deg.",
+                 "Other objects detected: " + ("; ".join(seen) or "none yet") + ".",
+                 f"Likeliest cells of the {spec.target} (cell centre, probability): "
+                 + "; ".join(f"({x:.2f}, {y:.2f}) m {p.ravel()[i]:.4f}" for x, y, i in zip(xs, ys, top)) + "."]
+        if self.action_mode == "macro":
+            nx, ny, a = len(self.lx), len(self.ly), self.lattice
+            lines.append(f"Choices: answer 8 k + h to drive to lattice point k and turn to heading h x 45 deg "
+                         f"(h 0-7: 0 east, 2 north, 4 west, 6 south); point k = i + {nx} j is at "
+                         f"x = {a / 2:g} + {a:g} i m, y = {a / 2:g} + {a:g} j m (i 0-{nx - 1}, j 0-{ny - 1}), and the "
+                         f"points you cannot stand on are left out. You choose again after {spec.replan_every:g} s, "
+                         "on arrival, or when an object is detected.")
+        else:
+            dt = 1.0 / spec.camera.fps
+            turn = f"{spec.robot.turn_rate * dt:.3g} deg"
+            lines.append(f"Choices (each takes one camera frame, {dt:.2f} s): [0] drive {spec.robot.speed * dt:.3g} m "
+                         f"forward, along your heading (not into an obstacle); [1] turn {turn} left (counter-clockwise); "
+                         f"[2] turn {turn} right; [3] wait.")
+        lines.append(answer_line(self.action_masks()))
+        return clip_text("\n".join(lines))
 
     def render(self):
         if self.render_mode != "rgb_array" or self.episode is None:

@@ -41,7 +41,8 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..tasks.loop import Stepper
 from ..tasks.objects import ObjectSearch
-from .base import BIG, COMPASS, SearchEnv, box, clip_text, compass_step, text_space
+from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, clip_text, compass_moves, compass_step, deg,
+                   text_space)
 
 
 class _Feed:
@@ -129,15 +130,12 @@ class ObjectSearchEnv(SearchEnv):
         return st.distance - d0, out
 
     def action_masks(self) -> np.ndarray:
-        """Macro: every place but the one the robot has just looked around at (choosing it again
-        would travel nothing and see nothing new); primitive: every action."""
+        """(action_space.n,) bool. Macro: every place but the one the robot has just looked around
+        at (choosing it again would travel nothing and see nothing new); primitive: every action."""
         m = np.ones(self.action_space.n, bool)
         if self.action_mode == "macro" and self.here is not None:
             m[self.here] = False
         return m
-
-    def _info(self) -> dict:
-        return {**super()._info(), "action_mask": self.action_masks()}
 
     def _places(self) -> np.ndarray:
         st = self.state
@@ -151,20 +149,31 @@ class ObjectSearchEnv(SearchEnv):
     def _observe(self):
         st = self.state
         if self.observation_mode == "text":
-            pl = self._places()
-            lines = [f"Find a {self.request.cls} (request at {self.request.hour:g} h).",
-                     f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {math.degrees(st.heading):.0f} deg; "
-                     f"travelled {st.distance:.1f} m.",
-                     "Places: " + "; ".join(
-                         f"[{k}] {n} at {math.hypot(p[0], p[1]):.1f} m bearing {math.degrees(math.atan2(p[1], p[0])):.0f} deg, "
-                         f"{'seen' if p[2] else 'not seen'}, {p[3]:.0f} past detections ({p[4]:.0f} within an hour of now)"
-                         for k, (n, p) in enumerate(zip(self.names, pl))) + "."]
-            lines.append("Answer with a place's number." if self.action_mode == "macro" else
-                         "Answer with 0-7 to move " + ", ".join(f"{k} {d}" for k, d in enumerate(COMPASS))
-                         + "; 8 to turn left, 9 to turn right (45 deg).")
-            return clip_text("\n".join(lines))
+            return self._text()
         return {"places": self._places(), "hour": np.array([self.request.hour], np.float32),
                 "pose": np.array([st.x, st.y, wrap_angle(st.heading)], np.float32)}
+
+    def _text(self) -> str:
+        """The text observation: the request, the frame, the pose, the places (the choices, each
+        ``[n]``, in the macro mode) and an answer line naming exactly the actions
+        :meth:`action_masks` allows."""
+        st, req, macro = self.state, self.request, self.action_mode == "macro"
+        h = f"{req.hour:g}"
+        lines = [f"Goal: find a {req.cls}; the request was made at hour {h} of the day.", FRAME_TEXT,
+                 f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {deg(st.heading)} deg; travelled {st.distance:.1f} m.",
+                 ("Choices: drive to a place and look around there. " if macro else "")
+                 + f"Places (distance, bearing; whether your camera has had the place in view in this "
+                 f"search; the detections of a {req.cls} there in the recorded log, in all and within an hour of hour {h}):"]
+        for k, (n, p) in enumerate(zip(self.names, self._places())):
+            lines.append(f"{f'[{k}] ' if macro else ''}{n}: {math.hypot(p[0], p[1]):.1f} m, bearing "
+                         f"{deg(math.atan2(p[1], p[0]))} deg, {'viewed' if p[2] else 'not viewed yet'}; "
+                         f"log: {p[3]:.0f} detections, {p[4]:.0f} within the hour")
+        if not macro:
+            lines.append(compass_moves(self.step_m))
+        elif self.here is not None:
+            lines.append(f"[{self.here}] {self.names[self.here]} is left out: you have just looked around there.")
+        lines.append(answer_line(self.action_masks()))
+        return clip_text("\n".join(lines))
 
     def render(self):
         if self.render_mode != "rgb_array" or self.episode is None:

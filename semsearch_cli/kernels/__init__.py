@@ -1,2 +1,42 @@
 """Pure array kernels (numba / numpy / SciPy): grid searches and flood fills, ray casting and
-HIMM, the harmonic potential. They know nothing of robots, tasks or plots."""
+HIMM, the harmonic potential. They know nothing of robots, tasks or plots.
+
+The numba kernels are compiled on their first call and cached on disk (``cache=True``: beside
+their modules, or in numba's user-wide cache when the install is read-only), so compiling is paid
+once per install, not once per process; :func:`announce_compiling` says so while it happens."""
+
+from __future__ import annotations
+
+import sys
+
+from numba.core import event
+
+COMPILING = ("compiling the simulator's numba kernels: this happens once per install, on the first runs "
+             "(about 30 s); later runs load them from numba's cache")
+
+
+class _FirstCompile(event.Listener):
+    """Prints :data:`COMPILING` to stderr when this process first compiles a kernel (a kernel
+    loaded from the cache is not compiled, so nothing is printed once the cache is warm)."""
+
+    def __init__(self, label: str):
+        self.label, self.said = label, False
+
+    def on_start(self, ev: event.Event) -> None:
+        if not self.said:
+            self.said = True
+            print(f"{self.label}{COMPILING}", file=sys.stderr, flush=True)
+
+    def on_end(self, ev: event.Event) -> None:
+        pass
+
+
+_LISTENING: list[_FirstCompile] = []
+
+
+def announce_compiling(label: str = "note: ") -> None:
+    """Say once, on stderr, when this process starts compiling numba kernels (call it before a
+    run; calling it again does nothing)."""
+    if not _LISTENING:
+        _LISTENING.append(_FirstCompile(label))
+        event.register("numba:compile", _LISTENING[0])

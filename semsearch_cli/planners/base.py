@@ -32,8 +32,8 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..belief import DoorBelief, Candidates
-from .. import __version__
-from ..errors import ScenarioError
+from .. import __version__, deprecation
+from ..errors import ScenarioError, did_you_mean
 from ..files import user_file
 from ..provenance import code_hash, files_hash
 from ..registry import Registry
@@ -133,11 +133,25 @@ def register_planner(name: str):
 
     def deco(cls):
         if isinstance(cls, type) and issubclass(cls, Planner) and not cls.task:
-            raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search; subclass DoorPlanner (door "
-                            "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
+            if not callable(getattr(cls, "choose", None)):
+                raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search; subclass DoorPlanner (door "
+                                "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
+            cls = _as_door_planner(cls)
         return PLANNERS.add(name, cls)
 
     return deco
+
+
+def _as_door_planner(cls: type[Planner]) -> type[DoorPlanner]:
+    """A ``Planner`` subclass with ``choose(ctx, cands)``, written against the API before 0.2.0
+    (when ``Planner`` was the door planner's protocol), as a :class:`DoorPlanner`: the same class
+    with DoorPlanner among its bases, under the same name and module, with a DeprecationWarning.
+    Deprecated in 0.2.0; refused from 0.3.0."""
+    deprecation.warn(f"a door planner that subclasses Planner ({cls.__module__}.{cls.__qualname__})",
+                     "subclass DoorPlanner (from semsearch_cli.planners import DoorPlanner); Planner is the base of "
+                     "every kind of planner", stacklevel=4)
+    return type(cls.__name__, (cls, DoorPlanner), {"__module__": cls.__module__, "__qualname__": cls.__qualname__,
+                                                  "__doc__": cls.__doc__})
 
 
 ENTRY_POINT_GROUP = "semsearch.planners"
@@ -266,7 +280,8 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
             load_entry_points()
         valid = sorted(n for n, c in PLANNERS.items() if task is None or c.task == task)
         if name not in PLANNERS:
-            raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}; valid: {', '.join(valid)}")
+            raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}{did_you_mean(name, valid)}; valid: "
+                                f"{', '.join(valid)} (semsearch planners lists them with their parameters)")
         if task is not None and PLANNERS[name].task != task:
             raise ScenarioError(file, f"planners[{i}].name", f"{name!r} answers {PLANNERS[name].task} scenarios, not {task} "
                                 f"ones; valid: {', '.join(valid)}")
@@ -286,13 +301,26 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
             except ValidationError as exc:
                 e = exc.errors()[0]
                 loc = ".".join(str(x) for x in e["loc"])
-                raise ScenarioError(file, f"planners[{i}].{loc}", e["msg"] if e["type"] != "extra_forbidden" else f"unknown parameter for planner {name!r}") from None
+                if e["type"] == "extra_forbidden":
+                    raise ScenarioError(file, f"planners[{i}].{loc}", f"{name!r} has no parameter {loc!r}"
+                                        f"{did_you_mean(loc, PLANNERS[name].Params.model_fields)}; "
+                                        f"{_parameters(PLANNERS[name])}") from None
+                raise ScenarioError(file, f"planners[{i}].{loc}", e["msg"]) from None
             v = Variant(name, p, module)
             key = (v.label, module)  # rows name a variant by its label; a set keeps a big sweep linear
             if key not in seen:
                 seen.add(key)
                 out.append(v)
     return out
+
+
+def _parameters(cls: type[Planner]) -> str:
+    """A planner's parameters as an error lists them: ``its parameters: alpha = 0.9 (...), ...``."""
+    fields = cls.Params.model_fields
+    if not fields:
+        return "it takes no parameters"
+    return "its parameters: " + ", ".join(f"{k} = {f.default!r}" + (f" ({f.description})" if f.description else "")
+                                          for k, f in fields.items())
 
 
 def planner_class(variant: Variant) -> type[Planner]:
@@ -336,3 +364,10 @@ def code_of(variant: Variant) -> dict:
     parts = [out["semsearch"], out["semsearch_code"], own]
     out["hash"] = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     return out
+
+
+DEPRECATED = {"PlanContext": ("semsearch_cli.planners.DoorContext", DoorContext)}  # 0.2.0 -> removed in 0.3.0
+
+
+def __getattr__(name: str):
+    return deprecation.alias(__name__, name, DEPRECATED)

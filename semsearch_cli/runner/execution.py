@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RunTimeout
+from ..kernels import announce_compiling
 from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
 from ..tasks.loop import running
 from .specs import Loaded, RunSpec
@@ -38,6 +39,7 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
     task = loaded.task
     limit = loaded.sc.experiment.run_time_limit
     empty = np.zeros((0, 2), np.float32)
+    announce_compiling()
     running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
     try:
         with wall_clock_limit(limit):

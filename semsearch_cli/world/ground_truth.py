@@ -290,6 +290,17 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     return world
 
 
+class DuplicateSigns(ScenarioError):
+    """Signs that share a number under ``duplicates: error``; ``listed`` names each number with
+    the positions of its signs (an importer turns this into advice on its ``--duplicates``)."""
+
+    def __init__(self, file: str, listed: str, count: int):
+        self.listed, self.count = listed, count
+        super().__init__(file, "doors", f"{count} sign number(s) appear more than once: {listed}. Set duplicates: "
+                         "keep-first (the first sign of each number) or any (the goal is found at whichever sign "
+                         "carries it) in the scenario")
+
+
 def apply_duplicates(doors: list, policy: str, dfile: str) -> tuple[list, dict]:
     """Signs that share a number, under the scenario's ``duplicates`` policy: ``error`` refuses
     them, naming every duplicate with its positions; ``keep-first`` keeps the first sign of each
@@ -301,9 +312,7 @@ def apply_duplicates(doors: list, policy: str, dfile: str) -> tuple[list, dict]:
     dup = {n: xy for n, xy in where.items() if len(xy) > 1}
     if dup and policy == "error":
         listed = "; ".join(f"{n} at " + ", ".join(f"({x:g}, {y:g})" for x, y in xy) for n, xy in dup.items())
-        raise ScenarioError(dfile, "doors", f"{len(dup)} sign number(s) appear more than once: {listed}. Set "
-                            "duplicates: keep-first (the first sign of each number) or any (the goal is found at "
-                            "whichever sign carries it) in the scenario")
+        raise DuplicateSigns(dfile, listed, len(dup))
     if dup and policy == "keep-first":
         seen: set[str] = set()
         kept = []

@@ -24,12 +24,15 @@ def map_image(free: np.ndarray, walls: np.ndarray | None = None) -> np.ndarray:
     return img
 
 
-def scenario_dict(name: str, res: float, start, goals, planners=None, density_delta: float = 2.5, origin=None) -> dict:
-    """The scenario of a building folder, with the experiment defaults (10 seeds, 2000 m)."""
+def scenario_dict(name: str, res: float, start, goals, planners=None, density_delta: float = 2.5, origin=None,
+                  duplicates: str = "error") -> dict:
+    """The scenario of a building folder, with the experiment defaults (10 seeds, 2000 m);
+    ``duplicates`` (signs that share a number: ``error``, ``keep-first``, ``any``) is written only
+    when it is not the default."""
     m = {"image": "map.png", "resolution": res}
     if origin is not None:
         m["origin"] = [round(float(origin[0]), 4), round(float(origin[1]), 4)]
-    return {
+    out = {
         "name": name,
         "map": m,
         "start": {"x": round(float(start[0]), 3), "y": round(float(start[1]), 3), "heading": "random"},
@@ -39,6 +42,9 @@ def scenario_dict(name: str, res: float, start, goals, planners=None, density_de
         "belief": {"density_delta": density_delta},
         "experiment": {"seeds": 10, "base_seed": 0, "max_distance": 2000.0},
     }
+    if duplicates != "error":
+        out["duplicates"] = duplicates
+    return out
 
 
 def fill_box(img: np.ndarray, res: float, x0: float, x1: float, y0: float, y1: float, value: int) -> None:

@@ -79,7 +79,7 @@ def circulation(spaces, types=CORRIDOR_TYPES) -> set[str]:
 
 
 def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None = None, name: str | None = None,
-               density_delta: float = 2.5, corridor_types=CORRIDOR_TYPES) -> tuple[Path, list[str]]:
+               density_delta: float = 2.5, corridor_types=CORRIDOR_TYPES, duplicates: str = "error") -> tuple[Path, list[str]]:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path
     and what happened to the signs (also in the YAML's header)."""
     user_file(xml_path, "KTH floor-plan file")
@@ -185,7 +185,8 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
 
     header = f"imported from {xml_path.name} by `semsearch import kth`\n# " + "\n# ".join(report)
     chosen = goals or spread_goals(main, frame, snapped, start)
-    scen = scenario_dict(name or xml_path.stem, res, start, chosen, None, density_delta, (frame.origin_x, frame.origin_y))
+    scen = scenario_dict(name or xml_path.stem, res, start, chosen, None, density_delta, (frame.origin_x, frame.origin_y),
+                         duplicates)
     path = write_building(out, map_image(free), snapped, scen, header)
     if goals:
         return path, report

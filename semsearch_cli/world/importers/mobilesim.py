@@ -154,9 +154,11 @@ def snap_signs(free: np.ndarray, frame: GridFrame, signs: list[tuple]) -> list[t
 
 def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0.1,
                      start: tuple[float, float] | None = None, goals: list | None = None,
-                     density_delta: float = 2.5, name: str | None = None) -> tuple[Path, list[str]]:
+                     density_delta: float = 2.5, name: str | None = None, duplicates: str = "error") -> tuple[Path, list[str]]:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path
-    and what happened to the signs (see :func:`snap_report`; also in the YAML's header)."""
+    and what happened to the signs (see :func:`snap_report`; also in the YAML's header).
+    ``duplicates`` is the scenario's policy for signs that share a number (``error``,
+    ``keep-first``, ``any``)."""
     segs = read_mobilesim_lines(map_path)
     signs = read_mobilesim_doors(doors_path)
     walls, frame = rasterise(segs, res)
@@ -178,7 +180,7 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
     if not goals:
         goals = spread_goals(free, frame, snapped, start)
     scen = scenario_dict(name or map_path.stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
-                         density_delta, (frame.origin_x, frame.origin_y))
+                         density_delta, (frame.origin_x, frame.origin_y), duplicates)
     header = f"imported from {map_path.name} and {doors_path.name} by `semsearch import mobilesim`\n# " + "\n# ".join(report)
     return write_building(out, map_image(free, walls), snapped, scen, header), report
 

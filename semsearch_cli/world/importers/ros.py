@@ -26,7 +26,7 @@ ROBOT_RADIUS = 0.25  # m: the scenario's robot.radius default, which map.clean u
 
 def import_ros(map_yaml: Path, doors: Path, out: Path, start: tuple[float, float] | None = None,
                goals: list | None = None, name: str | None = None, density_delta: float = 2.5,
-               clean: bool = False) -> tuple[Path, list[str]]:
+               clean: bool = False, duplicates: str = "error") -> tuple[Path, list[str]]:
     """Write ``out/map.yaml`` (+ image), ``out/doors.csv`` and ``out/scenario.yaml``; returns the
     scenario's path and what happened to the signs (also in the YAML's header). With ``clean``,
     the free space is cleaned as ``map.clean`` cleans it (:func:`~.ros.clean_free`; the scenario
@@ -61,7 +61,7 @@ def import_ros(map_yaml: Path, doors: Path, out: Path, start: tuple[float, float
         goals = spread_goals(free, frame, snapped, start)
     copy_ros_map(map_yaml, out)
     scen = scenario_dict(name or Path(map_yaml).stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
-                         density_delta, origin)
+                         density_delta, origin, duplicates)
     scen["map"] = {"ros": "map.yaml", **({"clean": True} if clean else {})}
     header = f"imported from {Path(map_yaml).name} and {Path(doors).name} by `semsearch import ros`\n# " + "\n# ".join(report)
     return write_building(out, None, snapped, scen, header), report

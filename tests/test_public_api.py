@@ -1,0 +1,110 @@
+"""The public API is a contract: its names are pinned here, and a name renamed keeps working for
+at least one minor release with a DeprecationWarning that names its replacement."""
+
+import inspect
+import subprocess
+import sys
+import textwrap
+import warnings
+
+import pytest
+import yaml
+
+import semsearch_cli
+from semsearch_cli import api, belief, planners
+from semsearch_cli.planners import PLANNERS, DoorContext, DoorPlanner, expand_variants
+from semsearch_cli.config import PlannerSpec
+
+# what planner authors import (semsearch_cli.planners.__all__)
+PLANNER_NAMES = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner",
+                 "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner", "Variant", "code_of",
+                 "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class",
+                 "register_planner"]
+# the Python API: each function with its parameters in order
+API = {
+    "run": ["scenario", "options", "progress", "plots", "planner_specs"],
+    "report": ["folders", "out", "formats", "replay"],
+    "sweep_alpha": ["scenario", "alphas", "options", "progress"],
+    "sweep": ["scenario", "param", "values", "options", "progress"],
+    "parse_param": ["text"],
+    "write_summary": ["runs", "out_dir"],
+    "record": ["scenario", "out", "cases"],
+    "imported": ["importer", "out", "args", "kwargs"],
+    "schema_text": [],
+    "schema": ["out"],
+    "validate": ["scenario"],
+    "show": ["scenario", "out"],
+    "episodes": ["scenario", "out"],
+    "planners": ["scenario"],
+    "scenarios": [],
+    "default_out": ["loaded", "out"],
+    "init": ["name", "folder", "force"],
+}
+DEPRECATED = [(planners, "PlanContext", "DoorContext"), (belief, "Belief", "DoorBelief")]
+
+
+def test_the_planner_api_names_are_pinned():
+    assert sorted(planners.__all__) == sorted(PLANNER_NAMES)
+    for name in PLANNER_NAMES:
+        assert getattr(planners, name) is not None
+
+
+def test_the_python_api_functions_and_their_parameters_are_pinned():
+    public = {n for n, f in vars(api).items() if inspect.isfunction(f) and f.__module__ == api.__name__ and not n.startswith("_")}
+    assert public == set(API)
+    for name, params in API.items():
+        assert list(inspect.signature(getattr(api, name)).parameters) == params, name
+
+
+def test_the_version_follows_semantic_versioning():
+    major, minor, patch = (int(x) for x in semsearch_cli.__version__.split("."))
+    assert (major, minor) >= (0, 2)
+
+
+@pytest.mark.parametrize("module, old, new", DEPRECATED)
+def test_a_renamed_name_still_works_with_a_warning_naming_its_replacement(module, old, new):
+    with pytest.warns(DeprecationWarning, match=rf"{module.__name__}\.{old} is deprecated since semsearch 0\.2\.0 .*{new}"):
+        obj = getattr(module, old)
+    assert obj is getattr(module, new)
+    with pytest.raises(AttributeError):
+        getattr(module, "NoSuchName")
+
+
+OLD_PLANNER = '''
+"""A door planner written against the API before 0.2.0: Planner with choose(ctx, cands)."""
+from semsearch_cli.planners import Decision, Planner, PlanContext, register_planner
+
+
+@register_planner("first_candidate")
+class FirstCandidate(Planner):
+    def choose(self, ctx: PlanContext, cands):
+        if len(cands) == 0:
+            return None
+        return Decision(int(cands.rows[0]), int(cands.cols[0]))
+'''
+
+
+def test_a_door_planner_written_against_the_old_api_runs_with_a_warning(tmp_path, demo_dir):
+    (tmp_path / "old_planner.py").write_text(OLD_PLANNER)
+    with pytest.warns(DeprecationWarning) as caught:
+        (v,) = expand_variants([PlannerSpec(name="first_candidate", module="old_planner.py")], task="doors", base=tmp_path)
+    words = " ".join(str(w.message) for w in caught)
+    assert "FirstCandidate" in words and "subclass DoorPlanner" in words and "PlanContext" in words
+    cls = PLANNERS["first_candidate"]
+    assert issubclass(cls, DoorPlanner) and cls.task == "doors" and cls.__name__ == "FirstCandidate"
+
+
+def test_the_command_line_runs_an_old_planner_and_shows_its_warning(tmp_path, demo_dir):
+    (tmp_path / "old_planner.py").write_text(OLD_PLANNER)
+    sc = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    sc["map"]["image"] = str(demo_dir / sc["map"]["image"])
+    sc["doors"] = str(demo_dir / sc["doors"])
+    sc["goals"] = sc["goals"][:1]
+    sc["planners"] = [{"name": "first_candidate", "module": "old_planner.py"}]
+    sc["experiment"] = {"seeds": 1, "max_distance": 300}
+    (tmp_path / "old.yaml").write_text(yaml.safe_dump(sc))
+    res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "run", str(tmp_path / "old.yaml"),
+                          "--workers", "1", "--out", str(tmp_path / "out")], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    assert "DeprecationWarning" in res.stderr and "subclass DoorPlanner" in res.stderr
+    assert "first_candidate" in (tmp_path / "out" / "runs.csv").read_text()

@@ -1,0 +1,96 @@
+"""The shipped scenarios and maps are package data: listed, run by name and copied to edit from
+any folder, and found by a wheel installed outside the checkout (the gym ids too)."""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from semsearch_cli import __version__, shipped
+from semsearch_cli.cli import app
+from semsearch_cli.runner import Loaded
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+
+def test_the_checkouts_configs_and_maps_are_the_shipped_ones():
+    assert (ROOT / "configs").resolve() == shipped.CONFIGS and (ROOT / "maps").resolve() == shipped.MAPS
+    assert {"demo", "hotel", "office", "indirect_quick", "hospital"} <= set(shipped.names())
+
+
+def test_scenarios_lists_each_with_its_kind(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = runner.invoke(app, ["scenarios"])
+    assert res.exit_code == 0, res.output
+    lines = {ln.split("│")[1].strip(): ln.split("│")[2].strip() for ln in res.output.splitlines()
+             if ln.startswith("│") and ln.split("│")[1].strip()}
+    assert lines["hotel"] == "doors" and lines["office"] == "objects" and lines["hospital"] == "chain"
+    assert lines["indirect"] == "indirect" and set(lines) == set(shipped.names())
+
+
+def test_a_shipped_scenario_by_name_from_any_folder_and_a_mistyped_one(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = runner.invoke(app, ["validate", "demo"])
+    assert res.exit_code == 0 and "signs: 24" in res.output, res.output
+    res = runner.invoke(app, ["run", "demo", "--goal", "304", "--seeds", "1", "--workers", "1", "--planner", "greedy"])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "results" / "demo" / "runs.csv").is_file()  # results in the working folder, not the package
+    res = runner.invoke(app, ["run", "hotle"])
+    assert res.exit_code == 2
+    assert "'hotle' is neither a file nor a shipped scenario (did you mean 'hotel'" in " ".join(res.output.split())
+
+
+def test_init_copies_a_scenario_with_its_files_rewritten_to_the_copies(tmp_path):
+    res = runner.invoke(app, ["init", "hotel", str(tmp_path / "mine")])
+    assert res.exit_code == 0, res.output
+    mine = tmp_path / "mine"
+    assert sorted(p.relative_to(mine).as_posix() for p in mine.rglob("*") if p.is_file()) == [
+        "hotel.yaml", "maps/hotel/doors.csv", "maps/hotel/map.png", "scenario.schema.json"]
+    doc = yaml.safe_load((mine / "hotel.yaml").read_text())
+    assert doc["map"]["image"] == "maps/hotel/map.png" and doc["doors"] == "maps/hotel/doors.csv"
+    assert (mine / "hotel.yaml").read_text().startswith("# yaml-language-server: $schema=scenario.schema.json")
+    assert Loaded.load(mine / "hotel.yaml").fingerprint == Loaded.load(shipped.path("hotel")).fingerprint
+    res = runner.invoke(app, ["init", "hotel", str(mine)])
+    assert res.exit_code == 2 and "already exists" in res.output and "--force" in res.output
+    assert runner.invoke(app, ["init", "hotel", str(mine), "--force"]).exit_code == 0
+
+
+def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_and_its_commit(tmp_path):
+    pytest.importorskip("gymnasium")
+    if not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout: the wheel would carry no commit")
+    src = tmp_path / "src"
+    shutil.copytree(ROOT, src, symlinks=True, ignore=shutil.ignore_patterns(
+        ".venv", "venv", "results", "build", "*.egg-info", "__pycache__", ".pytest_cache", ".hypothesis", "site"))
+    wheels = tmp_path / "wheels"
+    built = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(wheels), str(src)],
+                           capture_output=True, text=True)
+    if built.returncode != 0:
+        pytest.skip(f"pip could not build the wheel here (no build backend to be had): {built.stderr[-300:]}")
+    (wheel,) = wheels.glob("semsearch-*.whl")
+    head = subprocess.run(["git", "-C", str(src), "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+    assert wheel.name.startswith(f"semsearch-{__version__}+g{head[:7]}")
+    site = tmp_path / "site"
+    subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)], check=True,
+                   capture_output=True)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    code = ("import gymnasium, semsearch_cli, semsearch_cli.envs\n"
+            "from semsearch_cli.provenance import git_commit\n"
+            "env = gymnasium.make('semsearch/DoorSearch-Hotel-v0')\n"
+            "obs, info = env.reset(seed=0)\n"
+            "print(semsearch_cli.__file__); print(git_commit()); print(env.unwrapped.task.kind)\n")
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=elsewhere, env=env)
+    assert res.returncode == 0, res.stderr
+    where, commit, kind = res.stdout.split()
+    assert Path(where).is_relative_to(site) and commit.split("+")[0] == head and kind == "doors"
+    res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "validate", "kth"],
+                         capture_output=True, text=True, cwd=elsewhere, env=env)
+    assert res.returncode == 0 and "kth: ok" in res.stdout, res.stderr
