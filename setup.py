@@ -5,8 +5,8 @@ version; ``.dirty`` when the package's files differ from the commit) and in
 meta.json's ``commit``). Built from anything else (an sdist, a tarball), the version is the plain
 release."""
 
+import importlib.util
 import re
-import subprocess
 from pathlib import Path
 
 from setuptools import setup
@@ -16,22 +16,16 @@ ROOT = Path(__file__).resolve().parent
 RELEASE = re.search(r'^__version__ = "([^"]+)"', (ROOT / "semsearch_cli" / "__init__.py").read_text(), re.M).group(1)
 
 
-def checkout_commit():
-    """The checkout's commit (``+dirty`` when the package's files differ from it), or None."""
-    if not (ROOT / ".git").exists():
-        return None
-    try:
-        head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
-        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--", "semsearch_cli"],
-                               capture_output=True, text=True, timeout=10)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    if head.returncode != 0:
-        return None
-    return head.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+def _checkout_module():
+    """semsearch_cli/checkout.py, loaded by its path (the package's dependencies are not installed
+    while it builds)."""
+    spec = importlib.util.spec_from_file_location("semsearch_checkout", ROOT / "semsearch_cli" / "checkout.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-COMMIT = checkout_commit()
+COMMIT = _checkout_module().checkout_commit(ROOT / "semsearch_cli")
 
 
 class BuildPy(build_py):

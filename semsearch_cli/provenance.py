@@ -11,12 +11,12 @@ from __future__ import annotations
 import functools
 import hashlib
 import platform
-import subprocess
 import sys
 from importlib import metadata
 from pathlib import Path
 
 from . import __version__
+from .checkout import checkout_commit
 
 PACKAGE = Path(__file__).resolve().parent
 DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "scikit-image", "opencv-python-headless", "matplotlib", "pydantic")
@@ -53,19 +53,10 @@ def git_commit() -> str | None:
     """The commit of the checkout the package runs from (``+dirty`` when its files differ from
     it); installed from a wheel, the commit the wheel was built from (see setup.py); None when
     neither is known (built from an sdist or a tarball)."""
-    root = PACKAGE.parent
-    if not (root / ".git").exists():
-        built = PACKAGE / "data" / "build_commit.txt"  # written by setup.py into a wheel built from a checkout
-        return built.read_text().strip() or None if built.is_file() else None
-    try:
-        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
-        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--", PACKAGE.name],
-                               capture_output=True, text=True, timeout=10)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    if head.returncode != 0:
-        return None
-    return head.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+    if (PACKAGE.parent / ".git").exists():
+        return checkout_commit(PACKAGE)
+    built = PACKAGE / "data" / "build_commit.txt"  # written by setup.py into a wheel built from a checkout
+    return (built.read_text().strip() or None) if built.is_file() else None
 
 
 def version_line() -> str:
