@@ -2,7 +2,10 @@
 alpha figure only for two alphas or more, the replay chosen on the command line."""
 
 import json
+from pathlib import Path
+from types import SimpleNamespace
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,9 +14,11 @@ from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
-from semsearch_cli.report import stats
+from semsearch_cli.report import plots, stats
+from semsearch_cli.report import tables as T
 from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, swept_values, planner_colors, thin_labels
 from semsearch_cli.report.runfiles import load_paths, median_label, stems
+from semsearch_cli.world.ground_truth import Signs
 
 MAGIC = {"png": b"\x89PNG", "pdf": b"%PDF", "svg": b"<?xml"}
 
@@ -211,3 +216,154 @@ def test_path_files_new_stem_then_old(demo_runs, tmp_path):
     np.savez(old / "paths" / f"{stems('greedy', r['goal'], int(r['seed']))[-1]}.npz", path=np.zeros((3, 2)))
     got = load_paths(old, some.drop(columns=["episode"], errors="ignore").iloc[:1])
     assert len(got) == 1 and got[0][1].shape == (3, 2)
+
+
+# ---- figures that agree with their tables, and labels that do not collide (issue: new user) ------
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures the plot functions draw, kept open instead of written (closed after the test)."""
+    figs = []
+    monkeypatch.setattr(plots, "_save", lambda fig, out, formats=("png",), dpi=plots.PNG_DPI: figs.append(fig) or [])
+    yield figs
+    for f in figs:
+        plt.close(f)
+
+
+def has_data(ax) -> bool:
+    return bool(ax.lines or ax.images or ax.collections or ax.patches)
+
+
+def legend_only(ax) -> bool:
+    """A grid cell holding the figure's legend: no frame, no data."""
+    return not ax.axison and ax.get_legend() is not None and not has_data(ax)
+
+
+def test_the_bold_run_is_the_median_or_the_title_says_which_it_is():
+    """An even count has no median run: the lower middle run is drawn and the title gives the
+    table's median beside that run's distance (the issue: "median 137 m" under a table's 226.5)."""
+    from semsearch_cli.report.runfiles import median_panel
+
+    runs = rows([("nsos[alpha=1.0]", 135, s, 1, d) for s, d in enumerate([400.0, 136.8, 316.2, 100.0])])
+    found = [(i, np.full((2, 2), float(i))) for i in runs.index]
+    paths, k, note = median_panel(runs, found, "n=4")
+    table = T.summarise(runs.assign(scenario="s", ratio=1.0, shortest_m=10.0))
+    assert table["median"].iloc[0] == 226.5
+    assert note == "median 226.5 m, n=4\nbold: lower middle run, 136.8 m"
+    assert k == 1 and paths[k][0, 0] == 1.0  # the row at 136.8 m
+    # odd count: the median run itself; a tie in the middle: the run is at the median
+    odd = rows([("g", 1, s, 1, d) for s, d in enumerate([30.0, 10.0, 20.0])])
+    assert median_panel(odd, [(i, np.zeros((2, 2))) for i in odd.index], "n=3")[1:] == (2, "median 20 m, n=3")
+    tie = rows([("g", 1, s, 1, d) for s, d in enumerate([10.0, 20.0, 20.0, 40.0])])
+    assert median_panel(tie, [(i, np.zeros((2, 2))) for i in tie.index], "n=4")[2] == "median 20 m, n=4"
+    # its path file missing: nothing drawn bold, the title names no run
+    assert median_panel(runs, [f for f in found if f[0] != 1], "n=4")[1:] == (-1, "median 226.5 m, n=4")
+
+
+def test_path_panels_leave_no_empty_cell_and_show_every_run(demo_loaded, drawn):
+    w = demo_loaded.world
+    line = lambda k: np.array([[3.0, 10.0 + 0.1 * k], [26.0, 10.0 + 0.1 * k]])  # noqa: E731
+    labels = ["greedy", "bvp", "nsos[alpha=0.8]", "nsos[alpha=0.9]", "nsos[alpha=1.0]"]
+    panels = {lab: ([line(k) for k in range(10)], 4, f"median 25 m, n=10\nbold: lower middle run, {20 + j} m")
+              for j, lab in enumerate(labels)}
+    plots.plot_path_panels(w, panels, [("goal 304", 9.0, 16.0)], "", Path("x.png"))
+    fig = drawn[0]
+    data = [ax for ax in fig.axes if has_data(ax)]
+    assert [ax.get_title() for ax in data] == [f"{lab}: {panels[lab][2]}" for lab in labels]
+    assert all(ax in data or legend_only(ax) for ax in fig.axes) and len(fig.axes) == 6  # the sixth cell: the legend
+    assert all(ax.get_visible() for ax in fig.axes)
+    fig.canvas.draw()
+    above_the_gap = data[3]  # nsos[alpha=0.9], right column, nothing under it: it carries the x axis
+    assert above_the_gap.xaxis.get_major_ticks()[0].label1.get_visible()
+    assert not data[1].xaxis.get_major_ticks()[0].label1.get_visible()
+    faint = [ln for ln in data[0].lines if ln.get_linewidth() == plots.EVERY_RUN_LW]
+    assert len(faint) == 9 and all(ln.get_alpha() >= 0.4 for ln in faint)  # visible, not 0.3 x 0.7 pt
+
+
+def test_boxes_leave_no_empty_cell(drawn):
+    runs = rows([(lab, g, s, 1, 10.0 + s + g) for g in (1, 2, 3) for lab in ("greedy", "bvp") for s in range(4)])
+    runs = runs.assign(scenario="s", shortest_m=5.0)
+    plots.plot_boxes(runs, "s", ["greedy", "bvp"], Path("x.png"))
+    fig = drawn[0]
+    assert sum(has_data(ax) for ax in fig.axes) == 3
+    assert all(has_data(ax) or legend_only(ax) for ax in fig.axes)
+
+
+def test_indirect_panels_leave_no_empty_axes(drawn):
+    order = ["a", "b", "c", "d", "e"]
+    table = pd.DataFrame([{"planner": m, "view_scale": v, "success": 0.5, "ci_low": 0.3, "ci_high": 0.7, "n": 8}
+                          for m in order for v in (1.0, 2.0)])
+    plots.plot_success_by_scale(table, order, {}, [1.0, 2.0], Path("x.png"))
+    fig = drawn[0]
+    assert sum(has_data(ax) for ax in fig.axes) == 5
+    assert all(has_data(ax) or legend_only(ax) for ax in fig.axes)
+    assert all(ax.get_visible() for ax in fig.axes)
+
+
+def test_the_budget_axis_runs_past_the_longest_run(drawn):
+    """A planner that found the goal every time, the last time on the longest run, is drawn
+    reaching 1.0 (the axis used to end at that run, so the curve seemed to stop at 0.9)."""
+    runs = rows([("greedy", 7, s, 1, 10.0 * (s + 1)) for s in range(10)]
+                + [("bvp", 7, s, 1 if s < 9 else 0, 5.0 * (s + 1)) for s in range(10)])
+    curve = budget_curve(runs)
+    longest = runs["distance_m"].max()
+    assert longest == 100.0
+    plots.plot_budget(curve, ["greedy", "bvp"], Path("x.png"))
+    fig = drawn[0]
+    greedy = fig.axes[0]
+    assert all(ax.get_xlim()[1] > longest for ax in fig.axes)
+    right = greedy.get_xlim()[1]
+    step = [ln for ln in greedy.lines if ln.get_color() == PALETTE[0]][-1]
+    x, y = np.asarray(step.get_xdata(), float), np.asarray(step.get_ydata(), float)
+    assert y[-1] == 1.0 and x[-1] == right and x[np.argmax(y == 1.0)] == longest  # reaches 1 at 100 m, then level
+
+
+def stub_world():
+    """A 130 m x 70 m floor (1 m cells) with a corridor whose walls carry three-digit numbers
+    every 2.5 m (the Hotel's density, where a replay wrote "109121"); goal: sign 109."""
+    xs = 40.0 + 2.5 * np.arange(14)
+    num = [str(100 + 3 * k) for k in range(14)] + [str(101 + 3 * k) for k in range(14)]
+    x = np.r_[xs, xs]
+    y = np.r_[np.full(14, 60.0), np.full(14, 56.0)]
+    facing = np.r_[np.full(14, -np.pi / 2), np.full(14, np.pi / 2)]  # top wall faces down, bottom up
+    signs = Signs(tuple(num), np.array([int(n) for n in num]), x, y, facing)
+    frame = SimpleNamespace(origin_x=0.0, origin_y=0.0, width=130, height=70, res=1.0)
+    return SimpleNamespace(frame=frame, signs=signs, start_xy=(45.0, 58.0))
+
+
+def overlapping(texts, renderer):
+    boxes = [t.get_window_extent(renderer) for t in texts]
+    return [(texts[i].get_text(), texts[j].get_text()) for i in range(len(boxes)) for j in range(i)
+            if boxes[i].overlaps(boxes[j])]
+
+
+def test_replay_numbers_do_not_collide_and_the_goal_keeps_its_own():
+    w = stub_world()
+    goal = ("goal 109", float(w.signs.x[3]), float(w.signs.y[3]))
+    frame = {"map": np.full((70, 130), 2, np.uint8), "path": np.array([[40.0, 58.0], [75.0, 58.0]]), "distance": 35.0,
+             "cands": np.zeros((0, 2)), "target": None, "read": list(range(len(w.signs)))}
+    with plt.rc_context(plots.PAPER_RC):
+        fig, draw_frame = plots.replay_figure(w, goal)
+        try:
+            draw_frame(frame, "t")
+            fig.canvas.draw()
+            ax = fig.axes[0]
+            texts = [t for t in ax.texts if t.get_text()]
+            words = [t.get_text() for t in texts]
+            assert overlapping(texts, fig.canvas.get_renderer()) == []
+            assert "goal 109" in words and "109" not in words  # not under its own star
+            assert len(words) - 1 >= 20  # most of the 27 other numbers fit
+        finally:
+            plt.close(fig)
+
+
+def test_the_scenario_figure_writes_no_number_under_a_goal_star(demo_loaded, drawn):
+    w = demo_loaded.world
+    plots.plot_scenario(w, [304, 452], "demo", Path("x.png"))
+    fig = drawn[0]
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    texts = [t for t in ax.texts if t.get_text()]
+    words = [t.get_text() for t in texts]
+    assert {"goal 304", "goal 452"} <= set(words) and "304" not in words and "452" not in words
+    assert len(words) == len(w.signs) - 2 + 2  # every other number is shown
+    assert overlapping(texts, fig.canvas.get_renderer()) == []

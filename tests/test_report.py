@@ -1,5 +1,10 @@
 """Reports rebuilt from rows: statistics agree with pandas, half-finished files work."""
 
+import json
+import os
+import shutil
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -86,7 +91,8 @@ def test_report_with_replay_and_several_folders(demo_dir, tmp_path):
     assert res.exit_code == 0, res.output
     md = (tmp_path / "both" / "report.md").read_text()  # one document over both folders
     assert "; 4 rows from" in md and md.count("## Door search (4 runs)") == 1
-    assert all(f"How {tmp_path / k} was produced" in md for k in ("a", "b"))
+    assert all(f"How ../{k} was produced" in md for k in ("a", "b"))  # relative to the report's folder
+    assert str(tmp_path) not in md
     assert list((tmp_path / "both" / "figures").glob("replay_*.gif"))
 
 
@@ -110,3 +116,82 @@ def test_a_scenario_with_a_numeric_name_runs_and_reports(demo_dir, tmp_path):
     assert res.exit_code == 0 and "Traceback" not in res.output, res.output
     assert (tmp_path / "r" / "figures" / "boxes_50045233.png").is_file()
     assert set(read_runs(tmp_path / "o" / "runs.csv")["scenario"]) == {"50045233"}
+
+
+# ---- no path of the machine in the report; every blank p-value explained (issue: new user) --------
+def test_report_names_no_absolute_path(demo_dir, tmp_path):
+    """report.md and report.html name the results folder, the scenario and the commands relative
+    to the report's folder, also when meta.json holds absolute paths (earlier versions, commands
+    typed with them) and when a folder's scenario is gone (the note)."""
+    out = tmp_path / "res"
+    res = CliRunner().invoke(app, ["run", str(demo_dir / "scenario.yaml"), "--seeds", "1", "--goal", "304", "--workers", "1",
+                                   "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    meta = json.loads((out / "meta.json").read_text())
+    meta["commands"].append(f"semsearch run {demo_dir / 'scenario.yaml'} --out={out} --workers 1")
+    meta["scenario"] = str((demo_dir / "scenario.yaml").resolve())  # as earlier versions wrote it
+    (out / "meta.json").write_text(json.dumps(meta))
+    gone = tmp_path / "gone"
+    shutil.copytree(out, gone)
+    meta["scenario"] = str(tmp_path / "nowhere" / "scenario.yaml")
+    (gone / "meta.json").write_text(json.dumps(meta))
+    base = str(tmp_path.parent.parent)  # the session's temporary folder: demo_dir is under it too
+    assert str(demo_dir).startswith(base)
+    for args, where in (([out], out), ([out, gone, "--out", tmp_path / "both"], tmp_path / "both")):
+        res = CliRunner().invoke(app, ["report", *map(str, args), "--format", "md,html,png", "--no-replay"])
+        assert res.exit_code == 0, res.output
+        for name in ("report.md", "report.html"):
+            text = (where / name).read_text()
+            assert base not in text, name
+    md = (out / "report.md").read_text()
+    assert "rows from `runs.csv`" in md and "## How these rows were produced" in md
+    assert "--out=. --workers 1" in md and "Rebuild this report, from its folder: `semsearch report .`" in md
+    rel = os.path.relpath(demo_dir / "scenario.yaml", out)
+    assert f"| scenario | {Path(rel).as_posix()} |" in md
+    both = (tmp_path / "both" / "report.md").read_text()
+    assert "## How ../res was produced" in both and "`semsearch report ../res ../gone --out .`" in both
+    assert "of ../gone were skipped: the scenario file named in ../gone/meta.json is not available" in both
+
+
+def paired_rows(diffs):
+    """greedy and nsos on one episode, seed by seed: nsos travels greedy's distance plus ``diffs``."""
+    out = []
+    for seed, d in enumerate(diffs):
+        for label, params, dist in (("greedy", "{}", 50.0 + seed), ("nsos[alpha=0.9]", '{"alpha": 0.9}', 50.0 + seed + d)):
+            out.append({"kind": "doors", "scenario": "s", "planner": label, "params": params, "goal": 54, "seed": seed,
+                        "outcome": "found", "success": 1, "distance_m": dist, "shortest_m": 20.0, "ratio": dist / 20,
+                        "spl": 20 / dist, "steps": 10, "decisions": 2, "navigator": "geodesic", "wall_s": 0.1})
+    return pd.DataFrame(out, columns=COLUMNS)
+
+
+@pytest.mark.parametrize("diffs,p,says", [
+    ([0, 0, 0, 0, 0, 7.0], None, "fewer than 2 non-zero paired differences (1): no test"),
+    ([0.0] * 6, 1.0, "every paired difference is 0: p = 1 by convention (nothing to rank)"),
+    ([1.0, -2.0, 3.0, 4.0, 5.0, 6.0], "wilcoxon", ""),
+])
+def test_a_blank_p_value_carries_a_note(tmp_path, diffs, p, says):
+    runs = paired_rows(diffs)
+    row = T.significance(runs).iloc[0]
+    assert row["n_pairs"] == 6 and row["note"] == says
+    if p is None:
+        assert np.isnan(row["p_value"])
+    elif p == "wilcoxon":
+        assert row["p_value"] == pytest.approx(wilcoxon(np.array(diffs)).pvalue)
+    else:
+        assert row["p_value"] == p
+    if says:  # and in the report: the table's row, and the caption saying what a blank means
+        folder = tmp_path / "f"
+        folder.mkdir()
+        runs.to_csv(folder / "runs.csv", index=False)
+        res = CliRunner().invoke(app, ["report", str(folder), "--format", "md", "--no-replay"])
+        assert res.exit_code == 0, res.output
+        md = (folder / "report.md").read_text()
+        line = next(x for x in md.splitlines() if x.startswith("| s | 54 | nsos[alpha=0.9] | greedy | wilcoxon"))
+        assert line.rstrip(" |").endswith(says)
+        assert "A blank p_value or interval is explained in the note column" in md
+
+
+def test_too_few_pairs_and_one_pair():
+    one = T.significance(paired_rows([3.0])).iloc[0]
+    assert one["note"] == "fewer than 2 non-zero paired differences (1): no test; 1 pair: no interval; n < 5: too few units to judge"
+    assert np.isnan(one["p_value"]) and np.isnan(one["diff_lo"])

@@ -133,8 +133,37 @@ def scenario_of(folder: Path, meta: dict) -> Path | None:
     return p if p.is_file() else None
 
 
-def provenance_table(meta: dict) -> pd.DataFrame:
-    """What meta.json says made the rows, one line per fact (for the end of report.md)."""
+def relative(path, base) -> str:
+    """``path`` as the report shows it: relative to the folder ``base`` (``.`` for the folder
+    itself), in forward slashes, so that no absolute path of the machine that wrote the report
+    is in it."""
+    rel = os.path.relpath(os.path.abspath(path), os.path.abspath(base))  # symbolic links kept as named
+    return Path(rel).as_posix()
+
+
+def shown_command(cmd: str, folder) -> str:
+    """A command recorded in meta.json as the report shows it: each argument that is an absolute
+    path (or ``--opt=/abs/path``) made relative to the results ``folder``; the others as typed."""
+    try:
+        words = shlex.split(cmd)
+    except ValueError:
+        return cmd
+    out = []
+    for w in words:
+        key, eq, value = w.partition("=") if w.startswith("-") else ("", "", w)
+        if os.path.isabs(value):
+            value = relative(value, folder)
+        out.append(shlex.quote(key + eq + value))
+    return " ".join(out)
+
+
+def provenance_table(meta: dict, folder=None) -> pd.DataFrame:
+    """What meta.json says made the rows, one line per fact (for the end of report.md); with
+    ``folder`` (the results folder), paths meta.json holds absolute (written by earlier versions)
+    are shown relative to it."""
+    def path(p):
+        return relative(p, folder) if folder is not None and p and os.path.isabs(str(p)) else p
+
     sem = meta.get("semsearch")
     rows = []
     if isinstance(sem, dict):
@@ -144,13 +173,13 @@ def provenance_table(meta: dict) -> pd.DataFrame:
         rows.append(("semsearch", str(sem)))
     for key in ("scenario", "scenario_sha256", "fingerprint"):
         if meta.get(key):
-            rows.append((key, meta[key]))
+            rows.append((key, path(meta[key]) if key == "scenario" else meta[key]))
     if isinstance(meta.get("episodes"), dict):
         rows.append(("episodes", f"{meta['episodes'].get('count')} (set hash {meta['episodes'].get('hash')})"))
     for label, code in (meta.get("planners") or {}).items():
         if isinstance(code, dict):
             what = code.get("source", "")
-            what += f" {code['file']}" if code.get("file") else ""
+            what += f" {path(code['file'])}" if code.get("file") else ""
             what += f" {code['distribution']}" if code.get("distribution") else ""
             rows.append((f"planner {label}", f"code {code.get('hash')} ({what.strip()})"))
     return pd.DataFrame(rows, columns=["what", "value"]).set_index("what")
@@ -182,21 +211,26 @@ class Part:
     runs: pd.DataFrame
     meta: dict
     _loaded: object = field(default=None, repr=False)
+    shown: str = ""  # the folder as the report names it (relative to the report's folder)
 
     def loaded(self, notes: list, what: str):
         """The scenario named in meta.json, loaded (once), or None with a note saying that
-        ``what`` were skipped and why."""
+        ``what`` were skipped and why (the folder named as :attr:`shown`)."""
+        name = self.shown or str(self.folder)
         if self._loaded is None:
             path = scenario_of(self.folder, self.meta)
             if path is None:
-                self._loaded = f"the scenario file named in {self.folder / 'meta.json'} is not available"
+                self._loaded = f"the scenario file named in {'' if name == '.' else name + '/'}meta.json is not available"
             else:
                 try:
                     self._loaded = Loaded.load(path)
                 except ScenarioError as exc:
-                    self._loaded = str(exc)
+                    why = str(exc)
+                    for full in sorted({os.path.abspath(self.folder), str(self.folder)}, key=len, reverse=True):
+                        why = why.replace(full, name)
+                    self._loaded = why
         if isinstance(self._loaded, str):
-            notes.append(f"{what} of {self.folder} were skipped: {self._loaded}.")
+            notes.append(f"{what} of {'these rows' if name == '.' else name} were skipped: {self._loaded}.")
             return None
         return self._loaded
 
@@ -225,7 +259,8 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
         for kind, rows in runs.groupby("kind", sort=False):
             if kind not in SECTIONS:
                 raise ScenarioError(str(folder / "runs.csv"), "kind", f"unknown kind {kind!r}; known: {', '.join(SECTIONS)}")
-            parts_by_kind.setdefault(kind, []).append(Part(folder, rows.reset_index(drop=True), meta))
+            parts_by_kind.setdefault(kind, []).append(Part(folder, rows.reset_index(drop=True), meta,
+                                                           shown=relative(folder, out)))
     if isinstance(replay, ReplayChoice):
         check_replay(replay, parts_by_kind)
     out.mkdir(parents=True, exist_ok=True)
@@ -238,21 +273,29 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     doc.heading(1, title)
     now = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     doc.para(f"semsearch {__version__}, {now}; {total} rows from ",
-             *[x for f in folders for x in (Code(str(f / "runs.csv")), " ")],
-             f"({', '.join(f'{k}: {sum(len(p.runs) for p in ps)}' for k, ps in parts_by_kind.items())}).")
+             *[x for f in folders for x in (Code(relative(f / "runs.csv", out)), " ")],
+             f"({', '.join(f'{k}: {sum(len(p.runs) for p in ps)}' for k, ps in parts_by_kind.items())}). Paths are "
+             "relative to this report's folder.")
     notes: list[str] = []
     for kind, parts in parts_by_kind.items():
         SECTIONS[kind].section(doc, parts, out, formats, replay, notes)
+    here = [relative(f, out) for f in folders]
+    rebuild = "semsearch report " + " ".join(shlex.quote(f) for f in here) + ("" if here == ["."] else " --out .")
     for folder, meta in metas.items():
-        doc.heading(2, f"How {folder} was produced")
+        name = relative(folder, out)
+        doc.heading(2, "How these rows were produced" if name == "." else f"How {name} was produced")
+        if name != ".":
+            doc.para(f"Paths in this section are relative to {name}.")
         if meta.get("commands"):
-            doc.code("\n".join(meta["commands"]))
-        doc.para("Rebuild this report: ", Code("semsearch report " + " ".join(shlex.quote(str(f)) for f in folders)))
+            doc.para("The commands that wrote the rows (an absolute path typed in them shown relative to the "
+                     "results folder):")
+            doc.code("\n".join(shown_command(c, folder) for c in meta["commands"]))
+        doc.para("Rebuild this report, from its folder: ", Code(rebuild))
         scenario = scenario_of(Path(folder), meta)
         if scenario is not None:
-            doc.para("Scenario ", Code(meta["scenario"]), ":")
+            doc.para("Scenario ", Code(relative(scenario, folder)), ":")
             doc.code(scenario.read_text(errors="replace").strip(), "yaml")
-        prov = provenance_table(meta)
+        prov = provenance_table(meta, folder)
         if len(prov):
             doc.para("Provenance (meta.json): the code, the versions and the inputs these rows were made with.")
             doc.table(prov)

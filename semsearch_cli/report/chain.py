@@ -12,7 +12,7 @@ from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import image_formats, planner_colors, plot_chain_stages, plot_path_panels, plot_scenario
-from .runfiles import load_paths, median_label, safe_name, start_points
+from .runfiles import load_paths, median_panel, safe_name, start_points
 
 
 def chain_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -124,10 +124,7 @@ def _path_figures(doc: Document, parts: list, fdir: Path, notes: list, img=("png
                 e = g[g["planner"] == lab]
                 found = load_paths(part.folder, e)
                 if found:
-                    med = median_label(e)
-                    idx = [i for i, _ in found]
-                    panels[lab] = ([p for _, p in found], idx.index(med) if med in idx else -1,
-                                   f"median {float(e.loc[med, 'distance_m']):.0f} m, n={len(e)}")
+                    panels[lab] = median_panel(e, found, f"n={len(e)}")
             if not panels or not stages:
                 continue
             at: dict = {}  # door -> the stages there ("1, 4: 7" when a chain comes back)
@@ -141,7 +138,8 @@ def _path_figures(doc: Document, parts: list, fdir: Path, notes: list, img=("png
             f = fdir / f"chain_paths_{loaded.sc.name}_{safe_name(goal)}.png"
             plot_path_panels(w, panels, stops, "", f, img, colors, start_points(g, w))
             doc.figure(f, f"Chain {goal} ({loaded.sc.name}), one panel per planner: every run faint, the median run "
-                          "(by total distance) bold; stars: the stages' doors, numbered in order")
+                          "(by total distance; with an even number of runs the lower of the two middle runs, the "
+                          "title giving the median and its distance) bold; stars: the stages' doors, numbered in order")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:

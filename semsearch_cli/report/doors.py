@@ -14,7 +14,7 @@ from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import (animate_run, budget_curve, episode_mean, image_formats, swept_values, plot_alpha_sweep, plot_boxes, plot_budget,
                     plot_path_panels, plot_scenario, planner_colors)
-from .runfiles import load_paths, median_label, replay_frames, row_variant, safe_name, start_points, stems
+from .runfiles import load_paths, median_label, median_panel, replay_frames, row_variant, safe_name, start_points, stems
 from .tables import goal_key
 
 
@@ -66,7 +66,10 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
              "per-unit differences. Elsewhere, the two-sided Mann-Whitney U test of each side's unit means. "
              "mean_diff: planner - baseline (m; negative: the planner travels less) with its 95% bootstrap interval "
              "(diff_lo, diff_hi). effect_r: rank-biserial correlation (matched pairs for Wilcoxon), positive when "
-             "the planner travels more than the baseline.")
+             "the planner travels more than the baseline. A blank p_value or interval is explained in the note "
+             "column: with fewer than 2 non-zero paired differences the signed-rank test has nothing to rank (no "
+             "test), and one pair or unit gives no interval; where every paired difference is 0, p = 1 is a "
+             "convention.")
     doc.table(sig.set_index(["scenario", "goal", "planner"]), fmt="{:.3g}")
     if image_formats(formats):
         doc.heading(3, "Figures")
@@ -115,10 +118,7 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
                 found = load_paths(part.folder, e)
                 if not found:
                     continue
-                med = median_label(e)
-                idx = [i for i, _ in found]
-                panels[lab] = ([p for _, p in found], idx.index(med) if med in idx else -1,
-                               f"median {float(e.loc[med, 'distance_m']):.0f} m, n={len(e)}")
+                panels[lab] = median_panel(e, found, f"n={len(e)}")
             if not panels:
                 continue
             value = loaded.task.goal_value(goal)
@@ -126,7 +126,9 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
             f = fdir / f"paths_{loaded.sc.name}_goal{safe_name(goal)}.png"
             plot_path_panels(w, panels, stops, "", f, img, colors, start_points(g, w))
             doc.figure(f, f"Goal {goal} ({loaded.sc.name}), one panel per planner: every run faint, the median run "
-                          "(by distance) bold, its end dotted; the signs near the median run numbered; squares: start"
+                          "(by distance; with an even number of runs there is none, and the lower of the two middle "
+                          "runs is drawn, the title giving the median and its distance) bold, its end dotted; the "
+                          "signs near it numbered; squares: start"
                           f"{'s' if len(start_points(g, w)) > 1 else ''}; star: the goal")
         if replay:
             _replay(doc, loaded, part.folder, rows, fdir, T.planner_order(rows["planner"]), replay)
@@ -144,7 +146,8 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
     """One run as an animated GIF of the belief at its decisions, from the frames ``semsearch run
     --frames`` recorded, else re-simulated (see :func:`replay_frames`): ``choice``
     (planner, goal, episode, seed: the ``--replay`` value, checked against the rows before the
-    report starts), or by default the median run of the most semantic variant for the first goal."""
+    report starts), or by default the median run (:func:`median_label`: the lower middle one for
+    an even number of runs) of the most semantic variant for the first goal."""
     w = loaded.world
     ep = S.episodes(runs)
     if choice is True:
@@ -176,7 +179,7 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
     doc.figure(f, f"Replay of {label}, goal {goal}, episode {episode}, seed {seed} ({row['outcome']}, "
                f"{float(row['distance_m']):.1f} m; frames {how}): "
                "the map as built (white free, black occupied, grey unknown), the candidates and the chosen one, the "
-               "signs read so far (numbered) and the goal (star)")
+               "signs read so far (numbered where the number fits) and the goal (star, its number in its label)")
 
 
 def console(runs: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:

@@ -18,7 +18,7 @@ from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
 from .plots import image_formats, planner_colors, plot_heat, plot_heat_steps, plot_object_bars, plot_path_panels
-from .runfiles import load_paths, median_label, start_points
+from .runfiles import load_paths, median_panel, start_points
 
 def object_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Per case x class x request hour x planner: n, found, success rate, mean, std (ddof 1),
@@ -133,16 +133,15 @@ def _figures(doc, runs, part, fdir: Path, notes: list, img=("png",), colors: dic
             e = runs[(runs["goal"] == label) & (runs["planner"] == lab)]
             found = load_paths(folder, e)
             if found:
-                med = e.loc[median_label(e)]
-                idx = [i for i, _ in found]
-                panels[lab] = ([p for _, p in found], idx.index(med.name) if med.name in idx else -1,
-                               f"median {float(med['distance_m']):.0f} m, {int(e['success'].sum())}/{len(e)} found")
+                panels[lab] = median_panel(e, found, f"{int(e['success'].sum())}/{len(e)} found")
         if panels:
             f = fdir / f"paths_{stem}.png"
             plot_path_panels(world, panels, [], "", f, img, colors, start_points(runs[runs["goal"] == label], world),
                              places=task.places, truth=req.truth)
             doc.figure(f, f"{req.case}: {req.cls} requested at {req.hour:g}:00, one panel per planner: every run faint, "
-                          "the median run (by distance) bold, its end dotted; ringed: the places holding the object")
+                          "the median run (by distance; with an even number of runs the lower of the two middle runs, "
+                          "the title giving the median and its distance) bold, its end dotted; ringed: the places "
+                          "holding the object")
 
 
 def _heat_steps(task, world, log, req, p, out: Path, img=("png",)) -> None:

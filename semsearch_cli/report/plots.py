@@ -106,16 +106,56 @@ def _save(fig, out: Path, formats=("png",), dpi: int = PNG_DPI) -> list[Path]:
 
 
 def _grid(n: int, panel_h: float, cols: int = 2, maps: bool = False, **kw):
-    """``n`` panels, ``cols`` to a row, each :data:`COLUMN_IN` wide and ``panel_h`` tall;
-    unused panels hidden. ``maps``: the panels have a fixed aspect (the layout closes the gaps
-    that leaves). Returns (figure, the n axes)."""
+    """``n`` panels, ``cols`` to a row, each :data:`COLUMN_IN` wide and ``panel_h`` tall; the
+    unused cells of the last row hold no axes (:func:`_legend` may put the legend there).
+    ``maps``: the panels have a fixed aspect (the layout closes the gaps that leaves). Returns
+    (figure, the n axes)."""
     cols = max(1, min(cols, n))
     rows = -(-max(n, 1) // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(COLUMN_IN * cols, panel_h * rows), squeeze=False, **kw)
     fig.set_layout_engine("constrained", compress=maps)
-    for ax in axes.flat[n:]:
-        ax.set_visible(False)
-    return fig, list(axes.flat[:max(n, 1)])
+    for ax in axes.flat[max(n, 1):]:
+        ax.remove()
+    used = list(axes.flat[:max(n, 1)])
+    _label_outer(used)
+    return fig, used
+
+
+def _cell(ax) -> tuple[int, int]:
+    ss = ax.get_subplotspec()
+    return ss.rowspan.start, ss.colspan.start
+
+
+def _label_outer(axes) -> None:
+    """Axes that share x (y) show their tick labels only where no panel of ``axes`` is below
+    (left of) them: :meth:`matplotlib.axes.Axes.label_outer` for a grid whose last row is not
+    full (the panel above an empty cell keeps its x tick labels)."""
+    cells = {_cell(ax) for ax in axes}
+    for ax in axes:
+        r, c = _cell(ax)
+        if len(ax.get_shared_x_axes().get_siblings(ax)) > 1:
+            below = any((rr, c) in cells for rr in range(r + 1, ax.get_subplotspec().get_gridspec().nrows))
+            ax.tick_params(labelbottom=not below)
+            if below:
+                ax.set_xlabel("")
+        if len(ax.get_shared_y_axes().get_siblings(ax)) > 1:
+            left = any((r, cc) in cells for cc in range(c))
+            ax.tick_params(labelleft=not left)
+            if left:
+                ax.set_ylabel("")
+
+
+def _legend(fig, axes, handles, ncol: int, **kw):
+    """The figure's legend: in the free cells of the grid's last row when :func:`_grid` left
+    some (so no cell stays empty), else under the panels."""
+    gs = axes[0].get_subplotspec().get_gridspec()
+    used = {_cell(ax) for ax in axes}
+    free = [c for c in range(gs.ncols) if (gs.nrows - 1, c) not in used]
+    if free and len(axes) > 1:
+        lax = fig.add_subplot(gs[gs.nrows - 1, free[0]:free[-1] + 1])
+        lax.axis("off")
+        return lax.legend(handles=handles, loc="center", ncol=1 if len(free) == 1 else min(ncol, 2), **kw)
+    return fig.legend(handles=handles, loc="outside lower center", ncol=ncol, **kw)
 
 
 def _outer_y(ax) -> None:
@@ -172,69 +212,160 @@ def _map_axes(ax) -> None:
     ax.set_ylabel("y (m)")
 
 
+def _overlap(a, b) -> bool:
+    """Whether boxes ``a`` and ``b`` (cx, cy, width, height) overlap (touching is not)."""
+    return abs(a[0] - b[0]) * 2 < a[2] + b[2] and abs(a[1] - b[1]) * 2 < a[3] + b[3]
+
+
+def thin_boxes(boxes, fixed=()) -> list[int]:
+    """Indices of ``boxes`` (cx, cy, width, height) to draw, in the given order of priority: a box
+    that overlaps a kept one, or one of the ``fixed`` boxes already drawn, is dropped."""
+    drawn = [tuple(map(float, b)) for b in fixed]
+    kept: list[int] = []
+    for i, b in enumerate(boxes):
+        b = tuple(map(float, b))
+        if not any(_overlap(b, d) for d in drawn):
+            kept.append(i)
+            drawn.append(b)
+    return kept
+
+
 def thin_labels(x, y, texts, char_w: float, height: float, fixed=()) -> list[int]:
     """Indices of the labels to draw, in the given order of priority, such that no two boxes
     overlap: label i is a box ``(len(texts[i]) + 1) * char_w`` wide (a character's margin) and
     ``height`` tall centred on (x[i], y[i]) (same units as x, y); a label whose box meets a kept
     one, or one of the ``fixed`` boxes (cx, cy, width, height) already drawn, is dropped."""
-    boxes = [tuple(map(float, b)) for b in fixed]
-    kept: list[int] = []
-    for i, t in enumerate(texts):
-        w = (len(str(t)) + 1) * char_w
-        if all(abs(x[i] - bx) * 2 >= w + bw or abs(y[i] - by) * 2 >= height + bh for bx, by, bw, bh in boxes):
-            kept.append(i)
-            boxes.append((x[i], y[i], w, height))
-    return kept
+    return thin_boxes([(x[i], y[i], (len(str(t)) + 1) * char_w, height) for i, t in enumerate(texts)], fixed)
 
 
-def _sign_labels(ax, world, path: np.ndarray, skip: set, width_in: float, near_m: float, size: float = 6.5,
-                 stops=(), starts=()) -> None:
+CHAR_W = 0.64  # a digit's width (DejaVu Sans: 0.636), in units of the font size
+LINE_H = 1.2  # a line's height, in units of the font size
+LABEL_PAD = 0.5  # room kept between two numbers, in units of the font size
+
+
+def _text_box(ax_, ay_, w: float, h: float, ha: str, va: str) -> tuple[float, float, float, float]:
+    """The box (cx, cy, w, h) of a text ``w`` x ``h`` anchored at (ax_, ay_) with alignment ha, va."""
+    cx = ax_ + {"left": w / 2, "right": -w / 2}.get(ha, 0.0)
+    cy = ay_ + {"bottom": h / 2, "top": -h / 2}.get(va, 0.0)
+    return cx, cy, w, h
+
+
+def _axes_m_per_pt(ax) -> float:
+    """Metres of the map per printed point on ``ax`` (equal aspect) as its figure lays it out."""
+    fig = ax.figure
+    fig.draw_without_rendering()
+    bb = ax.get_window_extent()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    pt = 72.0 / fig.dpi
+    return max(abs(x1 - x0) / max(bb.width * pt, 1e-9), abs(y1 - y0) / max(bb.height * pt, 1e-9))
+
+
+def _sign_labels(ax, world, path: np.ndarray, skip: set, m_per_pt: float, near_m: float, size: float = 6.5,
+                 fixed=()) -> None:
     """Number the signs within ``near_m`` of ``path`` (the others stay unlabelled dots), nearest
-    to the path's end first, dropping labels that would overlap a kept one (or the stops' stars
-    and labels, the starts) at ``width_in``."""
+    to the path's end first, dropping labels that would overlap a kept one or one of the
+    ``fixed`` boxes (the stops' stars and labels, the starts: :func:`thin_boxes`)."""
     s = world.signs
     if not len(s) or not len(path):
         return
     d, _ = cKDTree(path[:: max(1, len(path) // 4000)]).query(np.c_[s.x, s.y])
     idx = [i for i in np.flatnonzero(d <= near_m) if i not in skip]
     idx.sort(key=lambda i: np.hypot(s.x[i] - path[-1, 0], s.y[i] - path[-1, 1]))
-    x0, x1, _, _ = _extent(world)
-    m = (x1 - x0) / (width_in * 72.0)  # metres per point
-    fixed = [(x, y, 10 * m, 10 * m) for _, x, y in stops] + [(x, y, 6 * m, 6 * m) for x, y in starts]
-    fixed += [(x + (5 + 0.31 * 7.5 * len(t)) * m, y + (4 + 3.75) * m, 0.62 * 7.5 * len(t) * m, 9 * m) for t, x, y in stops]
-    _number_signs(ax, world, idx, m, size, fixed)
+    _number_signs(ax, world, idx, m_per_pt, size, fixed)
 
 
-def _number_signs(ax, world, idx, m_per_pt: float, size: float, fixed=None, rotate: bool = False) -> None:
-    """Write the numbers of signs ``idx``, each behind its sign's wall (opposite the way the sign
-    faces: off the corridor and any path in it). With ``fixed`` (boxes already drawn, see
-    :func:`thin_labels`), labels that would overlap are dropped, earlier ones kept first. With
-    ``rotate``, numbers on walls that run left-right are written upright, so that close signs
-    along such a wall do not run into each other."""
+def _number_layout(world, idx, m_per_pt: float, size: float, rotate: bool = False) -> list[dict]:
+    """Where the numbers of signs ``idx`` go: each behind its sign's wall (opposite the way the
+    sign faces), ``gap`` points from the sign. Per sign: text, offset (points), ha, va, rotation
+    and its box (cx, cy, w, h) in metres. With ``rotate``, numbers on walls that run left-right
+    are written upright."""
+    s = world.signs
+    gap = 2.0  # pt between the sign and its number
+    out = []
+    for i in idx:
+        text = str(s.number[i])
+        ux, uy = -np.cos(s.facing[i]), -np.sin(s.facing[i])
+        ha = "left" if ux > 0.4 else "right" if ux < -0.4 else "center"
+        va = "bottom" if uy > 0.4 else "top" if uy < -0.4 else "center"
+        upright = rotate and abs(uy) > 0.7
+        w, h = (len(text) * CHAR_W + LABEL_PAD) * size * m_per_pt, LINE_H * size * m_per_pt
+        if upright:
+            w, h = h, w
+        box = _text_box(s.x[i] + ux * gap * m_per_pt, s.y[i] + uy * gap * m_per_pt, w, h, ha, va)
+        out.append({"i": i, "text": text, "xytext": (ux * gap, uy * gap), "ha": ha, "va": va,
+                    "rotation": 90 if upright else 0, "box": box})
+    return out
+
+
+def _number_signs(ax, world, idx, m_per_pt: float, size: float, fixed=None, rotate: bool = False,
+                  color: str = "#222222") -> list[tuple]:
+    """Write the numbers of signs ``idx`` (:func:`_number_layout`: behind each sign's wall, off
+    the corridor and any path in it). With ``fixed`` (boxes already drawn, see
+    :func:`thin_boxes`), a number that would overlap one of them or a number kept before is
+    written the other way (level instead of upright, with ``rotate``) if that overlaps nothing,
+    else dropped; earlier ones are placed first. Returns the boxes of the numbers written (m)."""
     s = world.signs
     idx = list(idx)
-    texts = [str(s.number[i]) for i in idx]
-    gap = 2.0  # pt between the sign and its number
-    ux, uy = -np.cos(s.facing[idx]), -np.sin(s.facing[idx])
-    w = np.array([len(t) for t in texts]) * 0.62 * size
-    cx = s.x[idx] + ux * (gap + w / 2) * m_per_pt
-    cy = s.y[idx] + uy * (gap + size / 2) * m_per_pt
-    keep = range(len(idx)) if fixed is None else thin_labels(cx, cy, texts, 0.62 * size * m_per_pt, 1.15 * size * m_per_pt, fixed)
-    for k in keep:
-        i = idx[k]
-        ha = "left" if ux[k] > 0.4 else "right" if ux[k] < -0.4 else "center"
-        va = "bottom" if uy[k] > 0.4 else "top" if uy[k] < -0.4 else "center"
-        ax.annotate(texts[k], (s.x[i], s.y[i]), xytext=(ux[k] * gap, uy[k] * gap), textcoords="offset points",
-                    fontsize=size, ha=ha, va=va, color="#222222", path_effects=_HALO, zorder=6,
-                    rotation=90 if rotate and abs(uy[k]) > 0.7 else 0)
+    lay = _number_layout(world, idx, m_per_pt, size, rotate)
+    if fixed is None:
+        chosen = lay
+    else:
+        other = _number_layout(world, idx, m_per_pt, size, False) if rotate else [None] * len(lay)
+        drawn, chosen = [tuple(map(float, b)) for b in fixed], []
+        for d in zip(lay, other):
+            fit = next((c for c in d if c is not None and not any(_overlap(c["box"], b) for b in drawn)), None)
+            if fit is not None:
+                chosen.append(fit)
+                drawn.append(fit["box"])
+    for d in chosen:
+        i = d["i"]
+        ax.annotate(d["text"], (s.x[i], s.y[i]), xytext=d["xytext"], textcoords="offset points", fontsize=size, ha=d["ha"],
+                    va=d["va"], color=color, path_effects=_HALO, zorder=6, rotation=d["rotation"])
+    return [d["box"] for d in chosen]
 
 
-def _stops(ax, stops, size: float = 7.5) -> None:
-    """Goals (or a chain's doors) as yellow stars, labelled."""
-    for lab, x, y in stops:
-        ax.plot(x, y, "*", ms=10, mfc=GOAL_COLOR, mec="black", mew=0.7, zorder=8)
-        ax.annotate(lab, (x, y), xytext=(5, 4), textcoords="offset points", fontsize=size, weight="bold", zorder=9,
-                    path_effects=_HALO)
+STAR_PT = 10.0  # a stop's star marker (points)
+STAR_BOX_PT = 9.0  # the box a star takes from labels (its points reach 10 pt across; labels may touch them)
+# where a stop's label may go, in order of preference: (dx, dy) points, ha, va
+STOP_LABEL_AT = ((5, 4, "left", "bottom"), (-5, 4, "right", "bottom"), (5, -4, "left", "top"), (-5, -4, "right", "top"),
+                 (7, 0, "left", "center"), (-7, 0, "right", "center"), (0, 7, "center", "bottom"), (0, -7, "center", "top"),
+                 (0, 18, "center", "bottom"), (0, -18, "center", "top"), (5, 18, "left", "bottom"), (-5, 18, "right", "bottom"),
+                 (5, -18, "left", "top"), (-5, -18, "right", "top"))
+
+
+def place_stop_labels(stops, m_per_pt: float, avoid=(), size: float = 7.5) -> list[tuple]:
+    """Where each stop's label goes: the first of :data:`STOP_LABEL_AT` whose box meets none of
+    the ``avoid`` boxes (cx, cy, w, h; m), the stars and the labels placed before; else the one
+    meeting the fewest. Returns per stop (dx, dy, ha, va, label box)."""
+    stars = [(x, y, STAR_BOX_PT * m_per_pt, STAR_BOX_PT * m_per_pt) for _, x, y in stops]
+    taken = [tuple(map(float, b)) for b in avoid] + stars
+    out = []
+    for text, x, y in stops:
+        w, h = len(str(text)) * 0.66 * size * m_per_pt, LINE_H * size * m_per_pt  # bold: a little wider
+        best = None
+        for dx, dy, ha, va in STOP_LABEL_AT:
+            box = _text_box(x + dx * m_per_pt, y + dy * m_per_pt, w, h, ha, va)
+            hits = sum(_overlap(box, b) for b in taken)
+            if best is None or hits < best[0]:
+                best = (hits, (dx, dy, ha, va, box))
+            if hits == 0:
+                break
+        out.append(best[1])
+        taken.append(best[1][4])
+    return out
+
+
+def _stops(ax, stops, m_per_pt: float, avoid=(), size: float = 7.5) -> list[tuple]:
+    """Goals (or a chain's doors) as yellow stars, labelled beside them where the label meets no
+    ``avoid`` box (:func:`place_stop_labels`). Returns the boxes drawn (stars and labels, m)."""
+    placed = place_stop_labels(stops, m_per_pt, avoid, size)
+    boxes = []
+    for (lab, x, y), (dx, dy, ha, va, box) in zip(stops, placed):
+        ax.plot(x, y, "*", ms=STAR_PT, mfc=GOAL_COLOR, mec="black", mew=0.7, zorder=8)
+        ax.annotate(lab, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=size, weight="bold", zorder=9,
+                    ha=ha, va=va, path_effects=_HALO)
+        boxes += [(x, y, STAR_BOX_PT * m_per_pt, STAR_BOX_PT * m_per_pt), box]
+    return boxes
 
 
 def _starts(ax, starts) -> None:
@@ -253,6 +384,15 @@ def _places(ax, places: dict, truth=(), size: float = 7.5) -> None:
         ax.plot(x, y, "o", ms=10, mfc="none", mec="black", mew=1.4, zorder=7)
 
 
+EVERY_RUN_LW = 0.9  # every run's path in the small multiples (pt)
+
+
+def every_run_alpha(n: int) -> float:
+    """The opacity of each of ``n`` runs drawn over one another: where all of them pass the
+    colour is nearly solid, where one passes it still shows (at least 0.4)."""
+    return float(np.clip(4.0 / max(1, n), 0.4, 0.7))
+
+
 @_paper
 def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=("png",), colors: dict | None = None,
                      starts=None, places: dict | None = None, truth=(), route=None, near_m: float = 3.0) -> list[Path]:
@@ -263,9 +403,12 @@ def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=
     world : World
         The ground truth (map light, walls dark; signs as grey dots).
     panels : {label: (paths, median, note)}
-        Per planner: every run's path (list of (n, 2) float arrays, m), drawn faint; the index of
-        its median run in that list, drawn bold, with the signs within ``near_m`` m of it numbered
-        (labels that would overlap are dropped); a note for the panel's title. ``{}`` draws the map alone.
+        Per planner: every run's path (list of (n, 2) float arrays, m), drawn faint
+        (:func:`every_run_alpha`); the index of the run to draw bold in that list (its median run,
+        :func:`~semsearch_cli.report.runfiles.median_panel`), with the signs within ``near_m`` m of
+        it numbered (labels that would overlap are dropped); a note for the panel's title, one or
+        two lines (a second line makes the legend say the title names the bold run). ``{}``
+        draws the map alone. The legend takes the grid's free cell when there is one.
     stops : list of (text, x, y)
         The goal(s), or a chain's doors, starred and labelled.
     starts : list of (x, y), optional
@@ -278,7 +421,8 @@ def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=
     n = max(1, len(panels))
     fr = world.frame
     aspect = fr.height / fr.width
-    fig, axes = _grid(n, COLUMN_IN * aspect + 0.45, maps=True, sharex=True, sharey=True)
+    two_lines = any("\n" in note for _, _, note in panels.values())
+    fig, axes = _grid(n, COLUMN_IN * aspect + (0.6 if two_lines else 0.45), maps=True, sharex=True, sharey=True)
     starts = [world.start_xy] if starts is None else starts
     items = list(panels.items()) or [("", ([], -1, ""))]
     s = world.signs
@@ -290,26 +434,23 @@ def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=
         if route is not None:
             ax.plot(route[:, 0], route[:, 1], ":", c="black", lw=0.9, zorder=3)
         c = colors.get(lab, "black")
-        faint = float(np.clip(3.0 / max(1, len(paths)), 0.2, 0.5))
         for k, p in enumerate(paths):
             if k != median:
-                ax.plot(p[:, 0], p[:, 1], "-", c=c, lw=0.7, alpha=faint, zorder=3)
+                ax.plot(p[:, 0], p[:, 1], "-", c=c, lw=EVERY_RUN_LW, alpha=every_run_alpha(len(paths)), zorder=3)
         if 0 <= median < len(paths):
             p = paths[median]
             ax.plot(p[:, 0], p[:, 1], "-", c=c, lw=1.5, zorder=4, solid_capstyle="round")
             ax.plot(p[-1, 0], p[-1, 1], "o", c=c, mec="black", mew=0.5, ms=4, zorder=5)
-            if len(s) and places is None:
-                _sign_labels(ax, world, p, stop_signs, COLUMN_IN, near_m, stops=stops, starts=starts)
         if places:
             _places(ax, places, truth)
         _starts(ax, starts)
-        _stops(ax, stops)
         if lab:
             ax.set_title(f"{lab}: {note}" if note else lab, color="black")
         _map_axes(ax)
-        ax.label_outer()
-    handles = [Line2D([], [], c="0.35", lw=0.6, alpha=0.5, label="every run"),
-               Line2D([], [], c="0.35", lw=1.5, label="median run (dot: its end)"),
+    _label_outer(axes)
+    handles = [Line2D([], [], c="0.35", lw=EVERY_RUN_LW, alpha=every_run_alpha(10), label="every run"),
+               Line2D([], [], c="0.35", lw=1.5, label="median run (dot: its end)" if not two_lines else
+                      "bold: the run its title names (dot: its end)"),
                Line2D([], [], ls="", marker="s", ms=4.5, mfc="white", mec="black", label="start" + ("s" if len(starts) > 1 else "")),
                Line2D([], [], ls="", marker="*", ms=9, mfc=GOAL_COLOR, mec="black", label="goal")]
     if not stops:
@@ -322,17 +463,25 @@ def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=
         handles.append(Line2D([], [], ls="", marker="o", ms=8, mfc="none", mec="black", mew=1.4, label="target at the request"))
     if route is not None:
         handles.append(Line2D([], [], ls=":", c="black", lw=0.9, label="patrol route"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 5 if n > 1 else 3), handlelength=1.6,
-               columnspacing=1.0)
+    _legend(fig, axes, handles, ncol=min(len(handles), 5 if n > 1 else 3), handlelength=1.6, columnspacing=1.0)
     if title:
         fig.suptitle(title)
+    # labels last, sized by the panels as laid out: the goals', then the numbers of the signs near
+    # the bold run that meet no label already drawn
+    m = _axes_m_per_pt(axes[0])
+    start_boxes = [(x, y, 6 * m, 6 * m) for x, y in starts]
+    for ax, (lab, (paths, median, note)) in zip(axes, items):
+        drawn = _stops(ax, stops, m, start_boxes)
+        if 0 <= median < len(paths) and len(s) and places is None:
+            _sign_labels(ax, world, paths[median], stop_signs, m, near_m, fixed=drawn + start_boxes)
     return _save(fig, out, formats)
 
 
 @_paper
 def plot_scenario(world, goals, title: str, out: Path, formats=("png",)) -> list[Path]:
     """The ground-truth map with every sign (dot, facing tick, number behind its wall), the start
-    and the goals, two columns wide (every number is shown, at 5.5 pt)."""
+    and the goals, two columns wide (every number is shown, at 5.5 pt; a goal's in its star's
+    label, placed where it covers no other number when there is such a place)."""
     width = 2 * COLUMN_IN
     fr = world.frame
     fig, ax = plt.subplots(figsize=(width, width * fr.height / fr.width + 0.6), layout="constrained")
@@ -340,16 +489,18 @@ def plot_scenario(world, goals, title: str, out: Path, formats=("png",)) -> list
     s = world.signs
     ax.quiver(s.x, s.y, np.cos(s.facing), np.sin(s.facing), color=PALETTE[0], scale=80, width=0.0012, zorder=3)
     ax.scatter(s.x, s.y, s=4, c=PALETTE[0], lw=0, zorder=4, label=f"door signs ({len(s)}), facing; number behind the wall")
-    x0, x1, _, _ = _extent(world)
-    _number_signs(ax, world, range(len(s)), (x1 - x0) / (width * 72.0), 5.5, rotate=True)
-    stops = [(f"goal {g}", float(s.x[s.index_of(g)]), float(s.y[s.index_of(g)])) for g in goals if s.index_of(g) >= 0]
-    _stops(ax, stops)
     _starts(ax, [world.start_xy])
     ax.plot([], [], "s", ms=4.5, mfc="white", mec="black", ls="", label="start")
     ax.plot([], [], "*", ms=9, mfc=GOAL_COLOR, mec="black", ls="", label="goals")
     _map_axes(ax)
     ax.set_title(title)
     fig.legend(loc="outside lower center", ncol=3)
+    m = _axes_m_per_pt(ax)  # labels last, sized by the map as laid out
+    at = [s.index_of(g) for g in goals]
+    stops = [(f"goal {g}", float(s.x[i]), float(s.y[i])) for g, i in zip(goals, at) if i >= 0]
+    # a goal's own number is in its star's label: not written again under the star
+    numbers = _number_signs(ax, world, [i for i in range(len(s)) if i not in set(at)], m, 5.5, rotate=True)
+    _stops(ax, stops, m, numbers + [(*world.start_xy, 6 * m, 6 * m)])
     return _save(fig, out, formats)
 
 
@@ -413,13 +564,30 @@ def budget_curve(runs: pd.DataFrame, budgets=None, confidence: float = 0.95) -> 
     return pd.DataFrame(out, columns=["goal", "planner", "budget_m", "n", "successes", "rate", "lo", "hi"])
 
 
+BUDGET_PAD = 0.08  # the budget axis runs this share past the longest run
+
+
+def budget_limit(longest: float) -> float:
+    """The right end of a budget axis whose longest run is ``longest`` m: a little past it, so
+    that a last step (the longest run finding the goal) shows as a level, not as the frame."""
+    return longest * (1 + BUDGET_PAD) if longest > 0 else 1.0
+
+
+def _to_limit(e: pd.DataFrame, right: float) -> pd.DataFrame:
+    """A planner's budget curve (rows by budget ascending) carried on at its last rate to ``right``."""
+    if not len(e) or float(e["budget_m"].iloc[-1]) >= right:
+        return e
+    return pd.concat([e, e.iloc[[-1]].assign(budget_m=right)], ignore_index=True)
+
+
 @_paper
 def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), colors: dict | None = None,
                 shortest: dict | None = None, unit_word: str = "repeats") -> list[Path]:
     """Success rate against the distance budget (:func:`budget_curve`) as small multiples: a row
-    per goal (shared budget axis), a column per planner. Each panel draws its planner's step
-    curve with the 95% band, the other planners' curves thin grey behind it (so none hides
-    another), and the shortest path dotted."""
+    per goal (shared budget axis, running :data:`BUDGET_PAD` past the goal's longest run, each
+    curve carried on to its end, so that a last step shows), a column per planner. Each panel
+    draws its planner's step curve with the 95% band, the other planners' curves thin grey behind
+    it (so none hides another), and the shortest path dotted."""
     colors = colors or planner_colors(order)
     goals = list(dict.fromkeys(curve["goal"]))
     labels = [p for p in order if (curve["planner"] == p).any()]
@@ -429,13 +597,14 @@ def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), c
                              sharey=True, layout="constrained")
     for r, g in enumerate(goals):
         d = curve[curve["goal"] == g]
+        right = budget_limit(float(d["budget_m"].max()))
         for j, lab in enumerate(labels):
             ax = axes[r, j]
             for other in labels:
                 if other != lab:
-                    e = d[d["planner"] == other]
+                    e = _to_limit(d[d["planner"] == other], right)
                     ax.step(e["budget_m"], e["rate"], where="post", c="0.75", lw=0.6, zorder=1)
-            e = d[d["planner"] == lab]
+            e = _to_limit(d[d["planner"] == lab], right)
             if len(e):
                 c = colors[lab]
                 ax.fill_between(e["budget_m"], e["lo"].fillna(e["rate"]), e["hi"].fillna(e["rate"]), step="post", color=c,
@@ -443,7 +612,7 @@ def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), c
                 ax.step(e["budget_m"], e["rate"], where="post", c=c, lw=1.2, zorder=3)
             if shortest and g in shortest and np.isfinite(shortest[g]):
                 ax.axvline(shortest[g], c="black", ls=":", lw=0.7, zorder=4)
-            ax.set_xlim(0, float(d["budget_m"].max()))
+            ax.set_xlim(0, right)
             ax.set_ylim(-0.03, 1.03)
             ax.set_yticks([0, 0.5, 1], ["0", ".5", "1"])
             ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(3, integer=True))
@@ -457,7 +626,7 @@ def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), c
     handles = [Line2D([], [], c="0.3", lw=1.2, label="the panel's planner: found within b"), Patch(color="0.3", alpha=0.25, lw=0,
                label=f"its 95% CI over {unit_word}"), Line2D([], [], c="0.75", lw=0.6, label="the other planners"),
                Line2D([], [], c="black", ls=":", lw=0.7, label="shortest path (mean over episodes)")]
-    fig.legend(handles=handles, loc="outside lower center", ncol=4, handlelength=1.6, columnspacing=1.0)
+    fig.legend(handles=handles, loc="outside lower center", ncol=4 if cols >= 4 else 2, handlelength=1.6, columnspacing=1.0)
     return _save(fig, out, formats)
 
 
@@ -505,7 +674,7 @@ def plot_boxes(runs, scenario: str, order: list, out: Path, formats=("png",), co
     handles = [Patch(facecolor="0.85", edgecolor="0.3", label="quartiles, median; whiskers 1.5 IQR"),
                Line2D([], [], marker="D", ms=3.2, mfc="0.6", mec="black", c="black", label=f"mean, 95% CI over {unit_word}"),
                Line2D([], [], c="black", ls="--", lw=0.8, label="shortest path (mean over episodes)")]
-    fig.legend(handles=handles, loc="outside lower center", ncol=2, handlelength=1.6, columnspacing=1.0)
+    _legend(fig, axes, handles, ncol=2, handlelength=1.6, columnspacing=1.0)
     return _save(fig, out, formats)
 
 
@@ -564,7 +733,7 @@ def plot_alpha_sweep(runs, out: Path, baseline: str | None = None, formats=("png
         handles.append(Line2D([], [], c=colors.get(baseline, "black"), ls="--", label=f"{baseline} (n={'/'.join(map(str, n_b))})"))
     handles.append(Patch(color="0.6", alpha=0.4, label=f"95% CI over {stats.unit_kind(runs)}"))
     handles.append(Line2D([], [], c="0.5", lw=0.6, label="the shortest path (ratio 1)"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=4, handlelength=1.6, columnspacing=1.0)
+    _legend(fig, axes, handles, ncol=4, handlelength=1.6, columnspacing=1.0)
     return _save(fig, out, formats)
 
 
@@ -597,19 +766,28 @@ def plot_sweep(table, param: str, out: Path, formats=("png",)) -> list[Path]:
 
 
 # ---- replays (GIF) ------------------------------------------------------------------------------
+REPLAY_NUMBER_PT = 6.5  # the signs' numbers in a replay
 @_paper
 def animate_run(world, frames: list, title: str, out: Path, goal=None, fps: int = 5) -> None:
-    """A GIF replay. Per frame: the map the robot has built (free white, occupied black, unknown
-    grey), its path so far, the candidates and the chosen one, and the signs read so far, numbered;
-    the goal (``(text, x, y)``) starred and labelled throughout.
+    """A GIF replay. Per frame (:func:`draw_replay_frame`): the map the robot has built (free
+    white, occupied black, unknown grey), its path so far, the candidates and the chosen one, and
+    the signs read so far, numbered where the numbers fit; the goal (``(text, x, y)``) starred and
+    labelled throughout.
 
     frames : list of dict with ``map`` ((h, w) uint8: 0 occupied, 1 unknown, 2 free), ``path``
     ((n, 2) m), ``distance`` (m), ``cands`` ((k, 2) m), ``target`` ((x, y) or None) and ``read``
     (list of int: indices into ``world.signs`` of the signs read so far)."""
+    fig, draw_frame = replay_figure(world, goal)
+    _animate(fig, lambda k: draw_frame(frames[k], title), len(frames), out, fps)
+
+
+def replay_figure(world, goal=None):
+    """The figure of a replay (two columns wide, its legend under the map) and a function
+    ``draw_frame(frame, title)`` that draws one frame on it (:func:`draw_replay_frame`), the
+    goal's label in the same place in every frame: where it hides the fewest sign numbers."""
     fr = world.frame
     width = 2 * COLUMN_IN
     fig, ax = plt.subplots(figsize=(width, width * fr.height / fr.width + 0.55), layout="constrained")
-    ext = _extent(world)
     legend = [Line2D([], [], c=PALETTE[1], lw=1.2, label="path"),
               Line2D([], [], ls="", marker="o", ms=4, c=PALETTE[0], label="candidates"),
               Line2D([], [], ls="", marker="o", ms=8, mfc="none", mec=PALETTE[1], mew=1.5, label="chosen"),
@@ -617,35 +795,61 @@ def animate_run(world, frames: list, title: str, out: Path, goal=None, fps: int 
               Line2D([], [], ls="", marker=".", ms=5, c="#8a2be2", label="signs read"),
               Line2D([], [], ls="", marker="*", ms=9, mfc=GOAL_COLOR, mec="black", label="goal")]
     fig.legend(handles=legend, loc="outside lower center", ncol=6, handlelength=1.2, columnspacing=0.8)
+    ext = _extent(world)
+    ax.set_xlim(ext[0], ext[1])
+    ax.set_ylim(ext[2], ext[3])
+    ax.set_aspect("equal")
+    ax.set_title("replay")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    m = _axes_m_per_pt(ax)
+    goal_sign = _sign_at(world, goal)
+    everyone = [b["box"] for b in _number_layout(world, [i for i in range(len(world.signs)) if i != goal_sign], m,
+                                                 REPLAY_NUMBER_PT, True)]
 
-    def draw(k):
+    def draw_frame(f: dict, title: str) -> None:
         ax.clear()
-        f = frames[k]
-        ax.imshow(f["map"], cmap="gray", vmin=0, vmax=2, extent=ext, interpolation="nearest")
-        read = f.get("read", [])
-        if read:
-            sg = world.signs
-            ax.scatter(sg.x[read], sg.y[read], s=8, c="#8a2be2", lw=0, zorder=3)
-            for i in read:  # the number behind the sign's wall, off the corridor
-                ux, uy = -np.cos(sg.facing[i]), -np.sin(sg.facing[i])
-                ax.annotate(str(sg.number[i]), (sg.x[i], sg.y[i]), xytext=(2.5 * ux, 2.5 * uy), textcoords="offset points",
-                            fontsize=6.5, color="#4b0f8a", ha="left" if ux > 0.4 else "right" if ux < -0.4 else "center",
-                            va="bottom" if uy > 0.4 else "top" if uy < -0.4 else "center", path_effects=_HALO, zorder=4)
-        ax.plot(f["path"][:, 0], f["path"][:, 1], "-", c=PALETTE[1], lw=1.2, zorder=4)
-        if len(f["cands"]):
-            ax.scatter(f["cands"][:, 0], f["cands"][:, 1], s=12, c=PALETTE[0], lw=0, zorder=5)
-        if f["target"] is not None:
-            ax.plot(*f["target"], "o", mfc="none", mec=PALETTE[1], ms=8, mew=1.5, zorder=5)
-        ax.plot(f["path"][-1, 0], f["path"][-1, 1], "o", c=PALETTE[2], mec="black", ms=5, zorder=6)
-        if goal is not None:
-            _stops(ax, [goal])
-        ax.set_title(f"{title}; {f['distance']:.0f} m, {len(read)} signs read")
-        ax.set_xlim(ext[0], ext[1])
-        ax.set_ylim(ext[2], ext[3])
-        ax.set_xticks([])
-        ax.set_yticks([])
+        draw_replay_frame(ax, world, f, title, goal, m, everyone)
 
-    _animate(fig, draw, len(frames), out, fps)
+    return fig, draw_frame
+
+
+def _sign_at(world, stop) -> int:
+    """The index of the sign at a stop ``(text, x, y)``, or -1."""
+    s = world.signs
+    if stop is None or not len(s):
+        return -1
+    d = np.hypot(s.x - stop[1], s.y - stop[2])
+    return int(np.argmin(d)) if d.min() < 1e-6 else -1
+
+
+def draw_replay_frame(ax, world, f: dict, title: str, goal, m_per_pt: float, avoid=()) -> None:
+    """One frame of :func:`animate_run` on ``ax``: the map as built, the path, the candidates and
+    the chosen one, the robot, the signs read (numbered upright on walls that run left-right, in
+    the order they were read, a number that would overlap one kept before, the goal's star or its
+    label left out; the goal's own number is in its label) and the goal, its label placed where it
+    meets the fewest ``avoid`` boxes."""
+    ext = _extent(world)
+    ax.imshow(f["map"], cmap="gray", vmin=0, vmax=2, extent=ext, interpolation="nearest")
+    read = list(f.get("read", []))
+    drawn = _stops(ax, [goal], m_per_pt, avoid) if goal is not None else []
+    if read:
+        sg = world.signs
+        ax.scatter(sg.x[read], sg.y[read], s=8, c="#8a2be2", lw=0, zorder=3)
+        goal_sign = _sign_at(world, goal)
+        _number_signs(ax, world, [i for i in read if i != goal_sign], m_per_pt, REPLAY_NUMBER_PT, fixed=drawn, rotate=True,
+                      color="#4b0f8a")
+    ax.plot(f["path"][:, 0], f["path"][:, 1], "-", c=PALETTE[1], lw=1.2, zorder=4)
+    if len(f["cands"]):
+        ax.scatter(f["cands"][:, 0], f["cands"][:, 1], s=12, c=PALETTE[0], lw=0, zorder=5)
+    if f["target"] is not None:
+        ax.plot(*f["target"], "o", mfc="none", mec=PALETTE[1], ms=8, mew=1.5, zorder=5)
+    ax.plot(f["path"][-1, 0], f["path"][-1, 1], "o", c=PALETTE[2], mec="black", ms=5, zorder=6)
+    ax.set_title(f"{title}; {f['distance']:.0f} m, {len(read)} signs read")
+    ax.set_xlim(ext[0], ext[1])
+    ax.set_ylim(ext[2], ext[3])
+    ax.set_xticks([])
+    ax.set_yticks([])
 
 
 def _animate(fig, draw, n: int, out: Path, fps: int, dpi: int = 130) -> None:
@@ -721,8 +925,7 @@ def plot_object_bars(table, order: list, out: Path, formats=("png",), colors: di
     n = table.groupby("planner")["n"].agg(["min", "max"])
     labels = [f"{lab} (n={n.loc[lab, 'min']}" + (f"-{n.loc[lab, 'max']}" if n.loc[lab, "max"] != n.loc[lab, "min"] else "") + ")"
               for lab in order]
-    fig.legend(handles=[Patch(color=colors[lab], label=t) for lab, t in zip(order, labels)], loc="outside lower center",
-               ncol=min(3, len(order)))
+    _legend(fig, axes, [Patch(color=colors[lab], label=t) for lab, t in zip(order, labels)], ncol=min(3, len(order)))
     return _save(fig, out, formats)
 
 
@@ -815,17 +1018,18 @@ def plot_success_by_scale(table, order: list, paper: dict, paper_scales, out: Pa
         ax.set_yticks([0, 25, 50, 75, 100])
         ax.grid(alpha=0.3, lw=0.5)
     for ax in axes.flat[len(order):]:
-        ax.set_visible(False)
+        ax.remove()
+    used = list(axes.flat[:len(order)])
     for ax in axes[:, 0]:
         ax.set_ylabel("success (%)")
-    for j in range(cols):  # the lowest visible panel of each column carries the x label
-        col = [ax for ax in axes[:, j] if ax.get_visible()]
+    for j in range(cols):  # the lowest panel of each column carries the x label
+        col = [ax for ax in axes[:, j] if ax in used]
         col[-1].set_xlabel("view scale (m)")
         col[-1].xaxis.set_tick_params(labelbottom=True)
     handles = [Line2D([], [], c="0.3", marker="o", ms=3, label="ours"),
                Patch(color="0.3", alpha=0.2, lw=0, label="its 95% interval"),
                Line2D([], [], c="0.55", ls="--", marker="s", ms=2.5, label="the paper's Table 3")]
-    fig.legend(handles=handles, loc="outside lower center", ncol=3)
+    _legend(fig, used, handles, ncol=3)
     return _save(fig, out, formats)
 
 
@@ -858,9 +1062,9 @@ def plot_rooms(rooms: list, title: str, out: Path, formats=("png",)) -> list[Pat
         ax.set_yticks([])
         ax.axis("off")  # the room's own outline is the frame
     for ax in axes.ravel()[n:]:
-        ax.axis("off")
+        ax.remove()
     handles, labels = axes.ravel()[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=min(5, len(labels)))
+    _legend(fig, list(axes.ravel()[:n]), handles, ncol=min(5, len(labels)))
     fig.suptitle(title)
     return _save(fig, out, formats)
 

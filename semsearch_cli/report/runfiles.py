@@ -56,9 +56,38 @@ def safe_name(goal) -> str:
 
 
 def median_label(rows: pd.DataFrame):
-    """The row label of the (lower) median run by distance, ties by seed (as :func:`.tables.median_run`)."""
+    """The row label of the run drawn as a group's median: the median run by distance when their
+    count is odd; when it is even there is no median run (the median is the mean of the two middle
+    distances, both equally near it) and it is the shorter of the two middle runs. Ties by seed,
+    then episode."""
     s = rows.assign(_ep=episodes(rows)).sort_values(["distance_m", "seed", "_ep"], kind="stable")
     return s.index[(len(s) - 1) // 2]
+
+
+def metres(x: float) -> str:
+    """A distance as the report's tables print it (two decimals), trailing zeros dropped:
+    ``226.5``, ``339.85``, ``137``."""
+    return f"{float(x):.2f}".rstrip("0").rstrip(".")
+
+
+def median_panel(rows: pd.DataFrame, found: list, count: str) -> tuple[list, int, str]:
+    """One panel of :func:`~semsearch_cli.report.plots.plot_path_panels` for a group of runs:
+    (their paths, the index among them of the run drawn bold (:func:`median_label`; -1 when its
+    path file is missing), the title's note). The note gives the median distance as the tables
+    print it, then ``count`` (``"n=10"``); when the run drawn is not at the median (an even
+    number of runs: the median is the mean of the two middle distances) a second line says which
+    run it is and its distance, ``"bold: lower middle run, 137 m"``.
+
+    rows : the group's rows; found : [(row label, path)] (:func:`load_paths` of ``rows``)."""
+    label = median_label(rows)
+    idx = [i for i, _ in found]
+    k = idx.index(label) if label in idx else -1
+    d = pd.to_numeric(rows["distance_m"], errors="coerce")
+    med, run = metres(d.median()), metres(d[label])
+    note = f"median {med} m, {count}"
+    if k >= 0 and run != med:
+        note += f"\nbold: lower middle run, {run} m"
+    return [p for _, p in found], k, note
 
 
 def start_points(rows: pd.DataFrame, world) -> list[tuple[float, float]]:

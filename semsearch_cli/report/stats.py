@@ -198,7 +198,8 @@ def paired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confiden
     Returns
     -------
     dict
-        ``unit`` (``"episodes"`` or ``"repeats"``), ``n_pairs``, ``unpaired``; ``mean_diff``
+        ``unit`` (``"episodes"`` or ``"repeats"``), ``n_pairs``, ``unpaired``, ``n_nonzero`` (the
+        differences that are not zero, which the signed-rank test ranks); ``mean_diff``
         (mean of d, in the unit of ``value``) with ``diff_lo``, ``diff_hi`` from :func:`mean_ci`
         over the pairs; ``p_value`` of the two-sided Wilcoxon signed-rank test
         (``scipy.stats.wilcoxon``, zero differences dropped): 1.0 when every difference is zero,
@@ -216,6 +217,7 @@ def paired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confiden
     out = {"unit": unit_kind(both), "n_pairs": len(d), "unpaired": len(ma) + len(mb) - 2 * len(common)}
     out["mean_diff"], out["diff_lo"], out["diff_hi"] = mean_ci(d, np.arange(len(d)), confidence)
     nz = d[d != 0]
+    out["n_nonzero"] = len(nz)
     if len(d) == 0:
         p, r = NAN, NAN
     elif len(nz) == 0:

@@ -194,6 +194,30 @@ def _trials(d: pd.DataFrame) -> set:
     return set(zip(S.episodes(d), pd.to_numeric(d["seed"], errors="coerce")))
 
 
+def _blanks(r: dict) -> list[str]:
+    """Why a comparison (:func:`.stats.paired` or :func:`.stats.unpaired`) leaves its p-value or
+    its interval blank, or sets p by convention, in words for the ``note`` column."""
+    out = []
+    if "n_pairs" in r:  # paired
+        if r["n_pairs"] == 0:
+            return ["no shared units: no test, no interval"]
+        if r.get("n_nonzero", 0) == 0:
+            out.append("every paired difference is 0: p = 1 by convention (nothing to rank)")
+        elif pd.isna(r["p_value"]):
+            out.append(f"fewer than 2 non-zero paired differences ({r['n_nonzero']}): no test")
+        few = r["n_pairs"] < 2
+    else:
+        if min(r["n_a"], r["n_b"]) == 0:
+            return ["no units on one side: no test, no interval"]
+        if pd.isna(r["p_value"]):
+            out.append("no test")
+        few = min(r["n_a"], r["n_b"]) < 2
+    if pd.isna(r["diff_lo"]):
+        out.append(("1 pair" if "n_pairs" in r else "1 unit on a side") + ": no interval" if few else
+                   "no interval (the bootstrap is degenerate)")
+    return out
+
+
 def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "distance_m") -> pd.DataFrame:
     """Per goal, each planner variant against a baseline on ``value`` (m).
 
@@ -206,7 +230,10 @@ def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "
     each side's unit means (:func:`.stats.unpaired`). Either way ``mean_diff`` = variant -
     baseline with its 95% bootstrap interval (negative: the variant travels less) and ``effect_r``
     is positive when the variant travels more. ``n_baseline`` and ``n`` count units; ``note``
-    flags fewer than ``MIN_N`` units (pairs), too few for the test to mean much."""
+    says why a p-value or an interval is blank (fewer than 2 non-zero paired differences: the
+    signed-rank test has nothing to rank; one pair or unit: no interval; no shared units), that p
+    is 1 by convention when every paired difference is 0, and flags fewer than ``MIN_N`` units
+    (pairs), too few for the test to mean much."""
     rows = []
     for (scen, goal), g in runs.groupby(["scenario", "goal"]):
         order = planner_order(g["planner"])
@@ -227,7 +254,7 @@ def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "
                 row |= {"test": "mann-whitney, unpaired", "n_pairs": np.nan, "n_baseline": r["n_b"], "n": r["n_a"]}
                 small = min(r["n_a"], r["n_b"])
             row |= {k: r[k] for k in ("mean_diff", "diff_lo", "diff_hi", "p_value", "effect_r")}
-            row["note"] = f"n < {MIN_N}: too few units to judge" if small < MIN_N else ""
+            row["note"] = "; ".join(_blanks(r) + ([f"n < {MIN_N}: too few units to judge"] if 0 < small < MIN_N else []))
             rows.append(row)
     out = pd.DataFrame(rows, columns=SIGNIFICANCE)
     return out.round({"mean_diff": 3, "diff_lo": 3, "diff_hi": 3, "effect_r": 3})
