@@ -1,19 +1,19 @@
-"""Build hook (the rest of the build is pyproject.toml): a wheel built from a git checkout
-carries the commit it was built from, in its version (``0.2.0+g8b23c9a``, a PEP 440 local
-version; ``.dirty`` when the package's files differ from the commit) and in
-``semsearch_cli/data/build_commit.txt``, which results' provenance reads (``semsearch --version``,
-meta.json's ``commit``). Built from anything else (an sdist, a tarball), the version is the plain
-release."""
+"""Build hook (the rest of the build is pyproject.toml): a wheel or an sdist built from a git
+checkout carries the commit it was built from, in ``semsearch_cli/data/build_commit.txt``, which
+``semsearch --version`` and results' provenance (meta.json's ``commit``) read once the package is
+installed outside the checkout. A wheel built from such an sdist (``python -m build``) keeps it.
+The version itself stays the plain release (``0.2.0``): package indexes refuse local versions
+such as ``0.2.0+g8b23c9a``."""
 
 import importlib.util
-import re
 from pathlib import Path
 
 from setuptools import setup
 from setuptools.command.build_py import build_py
+from setuptools.command.sdist import sdist
 
 ROOT = Path(__file__).resolve().parent
-RELEASE = re.search(r'^__version__ = "([^"]+)"', (ROOT / "semsearch_cli" / "__init__.py").read_text(), re.M).group(1)
+STAMP = Path("semsearch_cli") / "data" / "build_commit.txt"
 
 
 def _checkout_module():
@@ -25,23 +25,35 @@ def _checkout_module():
     return module
 
 
-COMMIT = _checkout_module().checkout_commit(ROOT / "semsearch_cli")
+def build_commit():
+    """The checkout's commit, or the one an sdist made from a checkout carries, or None."""
+    commit = _checkout_module().checkout_commit(ROOT / "semsearch_cli")
+    if commit is None and (ROOT / STAMP).is_file():
+        commit = (ROOT / STAMP).read_text().strip() or None
+    return commit
+
+
+COMMIT = build_commit()
 
 
 class BuildPy(build_py):
-    """build_py that also writes the commit into the built package (not into the checkout)."""
+    """build_py that also writes the commit into the built package (never into the checkout)."""
 
     def run(self):
         super().run()
         if COMMIT and not getattr(self, "editable_mode", False):
-            (Path(self.build_lib) / "semsearch_cli" / "data" / "build_commit.txt").write_text(COMMIT + "\n")
+            (Path(self.build_lib) / STAMP).write_text(COMMIT + "\n")
 
 
-def version():
-    if not COMMIT:
-        return RELEASE
-    sha, _, dirty = COMMIT.partition("+")
-    return f"{RELEASE}+g{sha[:7]}" + (".dirty" if dirty else "")
+class Sdist(sdist):
+    """sdist that also writes the commit into the source tree it packs."""
+
+    def make_release_tree(self, base_dir, files):
+        super().make_release_tree(base_dir, files)
+        if COMMIT:
+            target = Path(base_dir) / STAMP
+            target.unlink(missing_ok=True)  # a hard link to a checkout's file, if any: never write through it
+            target.write_text(COMMIT + "\n")
 
 
-setup(version=version(), cmdclass={"build_py": BuildPy})
+setup(cmdclass={"build_py": BuildPy, "sdist": Sdist})

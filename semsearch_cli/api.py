@@ -251,7 +251,7 @@ def imported(importer, out: str | Path, *args, **kwargs) -> tuple[Path, list[str
             validate(path)
         except DuplicateSigns as exc:
             raise ScenarioError(str(args[-1] if args else out), "", f"{exc.count} sign number(s) appear more than once: "
-                                f"{exc.listed}. Nothing was written: import again with --duplicates keep-first (the "
+                                f"{exc.listed} (positions after snapping onto the walls). Nothing was written: import again with --duplicates keep-first (the "
                                 "first sign of each number is kept) or --duplicates any (every sign is kept; the goal is "
                                 "found at whichever sign carries it)") from None
         except ScenarioError as exc:
@@ -356,7 +356,7 @@ def planners(scenario: str | Path | None = None) -> list[dict]:
 
 def scenarios() -> list[dict]:
     """The shipped scenarios (package data): each one's ``name`` (what ``semsearch run NAME``
-    takes), ``kind``, ``file`` and ``description`` (its first comment line)."""
+    takes), ``kind``, ``file`` and ``description`` (:func:`semsearch_cli.shipped.describe`)."""
     out = []
     for name in shipped.names():
         sc = load_scenario(shipped.path(name))
@@ -367,6 +367,6 @@ def scenarios() -> list[dict]:
 def init(name: str, folder: str | Path, force: bool = False) -> list[Path]:
     """Copy the shipped scenario ``name`` and the files it names into ``folder``, to edit (see
     :func:`semsearch_cli.shipped.init`); the copy is validated before this returns."""
-    written = shipped.init(name, output_folder(folder), force)
+    written = shipped.init(name, output_folder(folder, "DIR"), force)
     Loaded.load(written[0])
     return written

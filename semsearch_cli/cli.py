@@ -331,7 +331,7 @@ def presence(
 
 @app.command()
 def record(
-    scenario: Path = typer.Argument(..., help="Object-search scenario YAML file."),
+    scenario: Path = typer.Argument(..., help="Object-search scenario YAML file, or a shipped scenario's name (semsearch scenarios)."),
     out_dir: str = typer.Option("logs", "--out", callback=_path, help="Folder for the detection logs (one CSV per case)."),
     cases: Optional[List[str]] = typer.Option(None, "--case", help="Only these cases (repeat or comma-separate)."),
 ):

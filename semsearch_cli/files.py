@@ -58,8 +58,8 @@ def user_file(path: str | Path, what: str, owner: str | None = None, field: str 
     try:
         st = path.stat()
     except (FileNotFoundError, NotADirectoryError):
-        raise ScenarioError(file, field, f"{where} not found" + (f" (looked for {path.resolve()}: a scenario's paths are "
-                                                                 "relative to the folder the scenario is in)" if owner else
+        raise ScenarioError(file, field, f"{where} not found" + (f" (looked for {path.resolve()}; a scenario's relative "
+                                                                 "paths are read from the folder the scenario is in)" if owner else
                                                                  f" (looked for {path.resolve()})" if not path.is_absolute()
                                                                  else "")) from None
     except OSError as exc:

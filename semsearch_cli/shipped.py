@@ -10,6 +10,7 @@ files it names into a folder of the user's, to edit."""
 
 from __future__ import annotations
 
+import filecmp
 import re
 import shutil
 from pathlib import Path
@@ -22,6 +23,7 @@ from .files import atomic_text
 DATA = Path(__file__).resolve().parent / "data"
 CONFIGS = DATA / "configs"
 MAPS = DATA / "maps"
+NAME = r"[A-Za-z0-9_-]+"  # a shipped scenario's name: no folder, no suffix
 
 
 def names() -> list[str]:
@@ -30,36 +32,47 @@ def names() -> list[str]:
 
 
 def describe(name: str) -> str:
-    """A shipped scenario's header comment (what it is), as one paragraph, or ``""``."""
+    """What a shipped scenario is: its header comment up to the first line that ends a sentence,
+    as one line (``""`` without one)."""
     lines = []
     for line in path(name).read_text().splitlines():
         if not line.startswith("#"):
             break
-        if "yaml-language-server" not in line:
-            lines.append(line.lstrip("#").strip())
-    return " ".join(lines)
+        if "yaml-language-server" in line:
+            continue
+        lines.append(line.lstrip("#").strip())
+        if lines[-1].endswith("."):
+            break
+    return re.sub(r"\s*Regenerate with scripts/\S+$", "", " ".join(lines))
 
 
-def path(name: str) -> Path:
-    """The file of the shipped scenario ``name``, or a :class:`ScenarioError` listing them."""
+def path(name: str, where: str = "<command line>") -> Path:
+    """The file of the shipped scenario ``name``, or a :class:`ScenarioError` (naming ``where``
+    the name was given) listing them."""
     p = CONFIGS / f"{name}.yaml"
-    if not p.is_file() or "/" in name or name.startswith("."):
-        raise ScenarioError("<command line>", "scenario", f"{name!r} is neither a file nor a shipped scenario"
+    if not re.fullmatch(NAME, name) or not p.is_file():
+        raise ScenarioError(where, "scenario", f"{name!r} is neither a scenario file nor a shipped scenario"
                             f"{did_you_mean(name, names())}; shipped: {', '.join(names())} (semsearch scenarios)")
     return p
 
 
 def is_name(text: str | Path) -> bool:
     """Whether a scenario argument reads as a shipped scenario's name rather than a path: no
-    folder, no suffix, and no file of that name in the working folder."""
-    s = str(text)
-    return bool(re.fullmatch(r"[A-Za-z0-9_-]+", s)) and not Path(s).exists()
+    folder, no suffix, and no file of that name (a folder of that name does not count)."""
+    return bool(re.fullmatch(NAME, str(text))) and not Path(text).is_file()
 
 
-def scenario_file(scenario: str | Path) -> Path:
-    """A scenario argument as a file's path: the path itself, or the shipped scenario it names
-    (:func:`is_name`)."""
-    return path(str(scenario)) if is_name(scenario) else Path(scenario)
+def scenario_file(scenario: str | Path, where: str = "<command line>") -> Path:
+    """A scenario argument as a file's path: the file itself, or the shipped scenario it names
+    (:func:`is_name`). A name that is also ``NAME.yaml`` in the working folder (a copy made by
+    ``semsearch init NAME .``) is refused as ambiguous, naming both."""
+    if not is_name(scenario):
+        return Path(scenario)
+    own = Path(f"{scenario}.yaml")
+    if own.is_file() and str(scenario) in names():
+        raise ScenarioError(where, "scenario", f"{str(scenario)!r} is both a shipped scenario and {own} in this folder: give "
+                            f"the file, {own}, to run your copy; the shipped one runs by its name from any other folder")
+    return path(str(scenario), where)
 
 
 def _named_files(doc, base: Path) -> set[str]:
@@ -94,11 +107,16 @@ def init(name: str, dest: str | Path, force: bool = False) -> list[Path]:
     schema = CONFIGS / "scenario.schema.json"
     copies[schema] = dest / schema.name
     target = dest / f"{name}.yaml"
-    clash = [p for p in [target, *copies.values()] if p.exists()] if not force else []
+    # a file already there with the same bytes (a map two scenarios share) is no clash
+    todo = {s: d for s, d in copies.items() if not (d.is_file() and filecmp.cmp(s, d, shallow=False))}
+    clash = [p for p in [target, *todo.values()] if p.exists()] if not force else []
     if clash:
-        raise ScenarioError(str(clash[0]), "", "already exists: choose an empty folder, or pass --force to overwrite")
-    for s, d in copies.items():
-        d.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(s, d)
-    atomic_text(target, text)
+        raise ScenarioError(str(clash[0]), "", "already exists: choose another folder, or pass --force to overwrite")
+    try:
+        for s, d in todo.items():
+            d.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(s, d)
+        atomic_text(target, text)
+    except OSError as exc:
+        raise ScenarioError(str(dest), "", f"cannot copy {name} into it: {exc.strerror or exc}") from None
     return [target, *copies.values()]

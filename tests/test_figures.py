@@ -16,8 +16,8 @@ from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
 from semsearch_cli.report import plots, stats
 from semsearch_cli.report import tables as T
-from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, swept_values, planner_colors, thin_labels
-from semsearch_cli.report.runfiles import load_paths, median_label, stems
+from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, swept_values, planner_colors, thin_boxes
+from semsearch_cli.report.runfiles import load_paths, median_label, median_panel, stems
 from semsearch_cli.world.ground_truth import Signs
 
 MAGIC = {"png": b"\x89PNG", "pdf": b"%PDF", "svg": b"<?xml"}
@@ -127,10 +127,11 @@ def test_budget_curve_counts_episodes_as_units():
     assert c["goal"].tolist() == [7, 9]
 
 
-def test_thin_labels_drops_overlaps_in_order():
+def test_thin_boxes_drops_overlaps_in_order():
     x, y = np.array([0.0, 0.5, 3.0, 0.0]), np.array([0.0, 0.0, 0.0, 2.0])
-    assert thin_labels(x, y, ["12", "13", "14", "15"], char_w=0.3, height=1.0) == [0, 2, 3]
-    assert thin_labels(x, y, ["12", "13", "14", "15"], 0.3, 1.0, fixed=[(0.5, 0.0, 1.0, 1.0)]) == [2, 3]
+    boxes = [(x[i], y[i], 0.9, 1.0) for i in range(4)]  # a two-digit number and its margin: 3 x 0.3 wide
+    assert thin_boxes(boxes) == [0, 2, 3]
+    assert thin_boxes(boxes, fixed=[(0.5, 0.0, 1.0, 1.0)]) == [2, 3]
 
 
 def test_planner_colours_are_fixed_and_colour_blind_safe():
@@ -241,7 +242,6 @@ def legend_only(ax) -> bool:
 def test_the_bold_run_is_the_median_or_the_title_says_which_it_is():
     """An even count has no median run: the lower middle run is drawn and the title gives the
     table's median beside that run's distance (the issue: "median 137 m" under a table's 226.5)."""
-    from semsearch_cli.report.runfiles import median_panel
 
     runs = rows([("nsos[alpha=1.0]", 135, s, 1, d) for s, d in enumerate([400.0, 136.8, 316.2, 100.0])])
     found = [(i, np.full((2, 2), float(i))) for i in runs.index]

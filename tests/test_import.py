@@ -319,7 +319,7 @@ def test_duplicate_numbers_refused_with_the_option_to_pass_then_imported_under_e
     base = ["import", "mobilesim", str(tmp_path / "c.map"), str(tmp_path / "c.doors"), "--start", "2,1", "--goals", "1"]
     res = CliRunner().invoke(app, [*base, "--out", str(tmp_path / "refused")])
     assert res.exit_code == 2
-    assert "1 sign number(s) appear more than once: 1 at (5.05, 0), (10.05, 1.9)" in res.output
+    assert "1 sign number(s) appear more than once: 1 at (5.05, 0), (10.05, 1.9) (positions after snapping onto the walls)" in res.output
     assert "--duplicates keep-first" in res.output and "--duplicates any" in res.output
     assert not (tmp_path / "refused" / "scenario.yaml").exists()
     for policy, kept in (("keep-first", 2), ("any", 3)):

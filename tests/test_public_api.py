@@ -10,6 +10,8 @@ import yaml
 
 import semsearch_cli
 from semsearch_cli import api, belief, planners
+from semsearch_cli.belief import doors as belief_doors
+from semsearch_cli.planners import base as planners_base
 
 # what planner authors import (semsearch_cli.planners.__all__)
 PLANNER_NAMES = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner",
@@ -36,7 +38,8 @@ API = {
     "default_out": ["loaded", "out"],
     "init": ["name", "folder", "force"],
 }
-DEPRECATED = [(planners, "PlanContext", "DoorContext"), (belief, "Belief", "DoorBelief")]
+DEPRECATED = [(planners, "PlanContext", "DoorContext"), (planners_base, "PlanContext", "DoorContext"),
+              (belief, "Belief", "DoorBelief"), (belief_doors, "Belief", "DoorBelief")]
 
 
 def test_the_planner_api_names_are_pinned():

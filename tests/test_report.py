@@ -135,9 +135,16 @@ def test_report_names_no_absolute_path(demo_dir, tmp_path):
     shutil.copytree(out, gone)
     meta["scenario"] = str(tmp_path / "nowhere" / "scenario.yaml")
     (gone / "meta.json").write_text(json.dumps(meta))
+    broken = tmp_path / "broken"  # a scenario whose map has gone: its error names where the map was looked for
+    shutil.copytree(demo_dir, broken)
+    (broken / "map.png").unlink()
+    lost = tmp_path / "lost"
+    shutil.copytree(out, lost)
+    meta["scenario"] = str(broken / "scenario.yaml")
+    (lost / "meta.json").write_text(json.dumps(meta))
     base = str(tmp_path.parent.parent)  # the session's temporary folder: demo_dir is under it too
     assert str(demo_dir).startswith(base)
-    for args, where in (([out], out), ([out, gone, "--out", tmp_path / "both"], tmp_path / "both")):
+    for args, where in (([out], out), ([out, gone, lost, "--out", tmp_path / "both"], tmp_path / "both")):
         res = CliRunner().invoke(app, ["report", *map(str, args), "--format", "md,html,png", "--no-replay"])
         assert res.exit_code == 0, res.output
         for name in ("report.md", "report.html"):
@@ -149,7 +156,8 @@ def test_report_names_no_absolute_path(demo_dir, tmp_path):
     rel = os.path.relpath(demo_dir / "scenario.yaml", out)
     assert f"| scenario | {Path(rel).as_posix()} |" in md
     both = (tmp_path / "both" / "report.md").read_text()
-    assert "## How ../res was produced" in both and "`semsearch report ../res ../gone --out .`" in both
+    assert "## How ../res was produced" in both and "`semsearch report ../res ../gone ../lost --out .`" in both
+    assert "map image ../broken/map.png not found (looked for ../broken/map.png;" in " ".join(both.split())
     assert "of ../gone were skipped: the scenario file named in ../gone/meta.json is not available" in both
 
 

@@ -72,8 +72,8 @@ def test_missing_image(demo_dir, tmp_path):
 def test_a_missing_file_names_the_resolved_path_and_what_paths_are_relative_to(demo_dir, tmp_path):
     (tmp_path / "sub").mkdir()
     p = scenario_copy(demo_dir, tmp_path / "sub", map={"image": "../maps/nope.png", "resolution": 0.1})
-    check_error(p, "map image", "not found", f"(looked for {tmp_path / 'maps' / 'nope.png'}: a scenario's paths are "
-                "relative to the folder the scenario is in)")
+    check_error(p, "map image", "not found", f"(looked for {tmp_path / 'maps' / 'nope.png'}; a scenario's relative "
+                "paths are read from the folder the scenario is in)")
 
 
 def test_not_an_image(demo_dir, tmp_path):

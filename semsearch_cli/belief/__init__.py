@@ -1,9 +1,10 @@
 from .. import deprecation
+from . import doors
 from .doors import DoorBelief, Candidates
 
 __all__ = ["DoorBelief", "Candidates"]
 
-DEPRECATED = {"Belief": ("semsearch_cli.belief.DoorBelief", DoorBelief)}  # 0.2.0 -> removed in 0.3.0
+DEPRECATED = doors.DEPRECATED  # Belief (0.2.0 -> removed in 0.3.0)
 
 
 def __getattr__(name: str):

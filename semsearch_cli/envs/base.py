@@ -42,7 +42,7 @@ _TASKS: dict[tuple, Task] = {}  # (resolved path, mtime) -> task: the envs of on
 def shipped(name: str) -> Path:
     """The path of a shipped scenario (``hotel``, ``demo``, ...: package data, so a wheel install
     finds it from any folder; see :mod:`semsearch_cli.shipped`)."""
-    return shipped_scenarios.path(name)
+    return shipped_scenarios.path(name, "gymnasium.make(..., scenario=)")
 
 
 def load_task(scenario: str | Path, kind: str) -> Task:
@@ -50,7 +50,7 @@ def load_task(scenario: str | Path, kind: str) -> Task:
     is a shipped scenario, see :func:`shipped`), checked to be of ``kind``."""
     if isinstance(scenario, str) and scenario.startswith("shipped:"):
         scenario = shipped(scenario.split(":", 1)[1])
-    path = shipped_scenarios.scenario_file(scenario).resolve()
+    path = shipped_scenarios.scenario_file(scenario, "gymnasium.make(..., scenario=)").resolve()
     if not path.is_file():
         raise ScenarioError(str(scenario), "scenario", "no such scenario file")
     key = (str(path), path.stat().st_mtime_ns)

@@ -11,8 +11,8 @@ import sys
 
 from numba.core import event
 
-COMPILING = ("compiling the simulator's numba kernels: this happens once per install, on the first runs "
-             "(about 30 s); later runs load them from numba's cache")
+COMPILING = ("compiling the simulator's numba kernels, once per install (a few seconds: 6 s on a 2-core "
+             "machine); later runs load them from numba's cache")
 
 
 class _FirstCompile(event.Listener):

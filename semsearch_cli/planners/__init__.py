@@ -8,6 +8,7 @@ search).
 """
 
 from .. import deprecation
+from . import base
 from .base import (PLANNERS, Decision, DoorContext, DoorPlanner, NoParams, Planner, Variant, code_of, expand_variants, load_entry_points,
                    load_planner_file, planner_class, register_planner)
 from .doors import bvp, draft, greedy, nsos  # noqa: F401  (registration side effect)
@@ -17,7 +18,7 @@ from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 __all__ = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner",
            "Variant", "code_of", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class", "register_planner"]
 
-DEPRECATED = {"PlanContext": ("semsearch_cli.planners.DoorContext", DoorContext)}  # 0.2.0 -> removed in 0.3.0
+DEPRECATED = base.DEPRECATED  # PlanContext (0.2.0 -> removed in 0.3.0)
 
 
 def __getattr__(name: str):

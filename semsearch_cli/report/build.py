@@ -10,6 +10,7 @@ import datetime
 import hashlib
 import json
 import os
+import re
 import shlex
 import sys
 import time
@@ -31,6 +32,7 @@ from .stats import episodes
 from .tables import goal_key, planner_order
 from .document import Code, Document, atomic_text
 
+ABSOLUTE = re.compile(r"(?<![\w.])/[^\s:;,()'\"]+")  # an absolute path in a message (a report names none)
 ALL_FORMATS = ("md", "csv", "png", "pdf", "svg", "html")  # png, pdf, svg: every figure (GIF replays stay GIF)
 
 
@@ -228,7 +230,8 @@ class Part:
                     why = str(exc)
                     for full in sorted({os.path.abspath(self.folder), str(self.folder)}, key=len, reverse=True):
                         why = why.replace(full, name)
-                    self._loaded = why
+                    # any other absolute path (a map that has gone, where it was looked for): relative to the folder
+                    self._loaded = ABSOLUTE.sub(lambda m: os.path.relpath(m.group(0), self.folder), why)
         if isinstance(self._loaded, str):
             notes.append(f"{what} of {'these rows' if name == '.' else name} were skipped: {self._loaded}.")
             return None

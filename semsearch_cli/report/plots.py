@@ -230,14 +230,6 @@ def thin_boxes(boxes, fixed=()) -> list[int]:
     return kept
 
 
-def thin_labels(x, y, texts, char_w: float, height: float, fixed=()) -> list[int]:
-    """Indices of the labels to draw, in the given order of priority, such that no two boxes
-    overlap: label i is a box ``(len(texts[i]) + 1) * char_w`` wide (a character's margin) and
-    ``height`` tall centred on (x[i], y[i]) (same units as x, y); a label whose box meets a kept
-    one, or one of the ``fixed`` boxes (cx, cy, width, height) already drawn, is dropped."""
-    return thin_boxes([(x[i], y[i], (len(str(t)) + 1) * char_w, height) for i, t in enumerate(texts)], fixed)
-
-
 CHAR_W = 0.64  # a digit's width (DejaVu Sans: 0.636), in units of the font size
 LINE_H = 1.2  # a line's height, in units of the font size
 LABEL_PAD = 0.5  # room kept between two numbers, in units of the font size
