@@ -147,7 +147,7 @@ def _as_door_planner(cls: type[Planner]) -> type[DoorPlanner]:
     (when ``Planner`` was the door planner's protocol), as a :class:`DoorPlanner`: the same class
     with DoorPlanner among its bases, under the same name and module, with a DeprecationWarning.
     Deprecated in 0.2.0; refused from 0.3.0."""
-    deprecation.warn(f"a door planner that subclasses Planner ({cls.__module__}.{cls.__qualname__})",
+    deprecation.warn(f"a door planner that subclasses Planner ({cls.__qualname__})",
                      "subclass DoorPlanner (from semsearch_cli.planners import DoorPlanner); Planner is the base of "
                      "every kind of planner", stacklevel=4)
     return type(cls.__name__, (cls, DoorPlanner), {"__module__": cls.__module__, "__qualname__": cls.__qualname__,
