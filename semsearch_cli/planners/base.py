@@ -125,11 +125,18 @@ class DoorPlanner(Planner):
 
 
 PLANNERS = Registry("planner", Planner, names=True)  # name -> class
+MAX_NAME = 64  # characters in a planner's name (it names files: paths/, traces/, frames/)
+PLANNER_NAME = re.compile(rf"[A-Za-z0-9][A-Za-z0-9_.+\-]{{0,{MAX_NAME - 1}}}")
 
 
 def register_planner(name: str):
     """Class decorator adding a planner to the registry under ``name`` (must be new); the class
     subclasses one kind's protocol (:class:`DoorPlanner`, ``ObjectPlanner``, ``IndirectPlanner``)."""
+
+    if not isinstance(name, str) or not PLANNER_NAME.fullmatch(name):
+        raise TypeError(f"planner name {str(name)[:80]!r}: a name holds only letters, digits and . _ + - (at most "
+                        f"{MAX_NAME} characters, starting with a letter or digit); [ ] = , would read as a variant's "
+                        "label, such as nsos[alpha=0.9]")
 
     def deco(cls):
         if isinstance(cls, type) and issubclass(cls, Planner) and not cls.task:

@@ -30,7 +30,7 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
     reused: they are moved to ``runs.superseded.csv`` (appended, so nothing is lost), said so on
     standard error, and their runs run again."""
     runs_csv = out / "runs.csv"
-    done = run_rows(read_runs(runs_csv))
+    done = run_rows(read_runs(runs_csv, as_written=True))
     fp = loaded.fingerprint
     foreign = len(done) and ("fingerprint" not in done.columns or (done["fingerprint"].astype(str) != fp).any())
     if foreign and not force:
@@ -42,14 +42,14 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
         while (out / f"runs.{n}.csv.bak").exists():
             n += 1
         runs_csv.rename(out / f"runs.{n}.csv.bak")
-        done = run_rows(read_runs(runs_csv))
+        done = run_rows(read_runs(runs_csv, as_written=True))
     if codes and len(done):
         stale = done["planner"].isin(list(codes)) & (done["code"].astype(str) != done["planner"].map(codes))
         if stale.any():
             names = ", ".join(sorted({str(p) for p in done.loc[stale, "planner"]}))
             _supersede(out, lambda rows: rows["planner"].astype(str).isin(done.loc[stale, "planner"].astype(str)),
                        f"were made by other code ({names}: the planner's file or semsearch changed since)")
-            done = run_rows(read_runs(runs_csv))
+            done = run_rows(read_runs(runs_csv, as_written=True))
     if len(done):
         moved = _moved_episodes(loaded, done)
         if moved.any():
@@ -58,7 +58,7 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
                                                    index=rows.index),
                        "belong to episodes whose start is no longer the one at their index (the goals or the "
                        "episode set changed)")
-            done = run_rows(read_runs(runs_csv))
+            done = run_rows(read_runs(runs_csv, as_written=True))
     return done
 
 
@@ -76,7 +76,7 @@ def _supersede(out: Path, which, why: str) -> None:
     """Move the rows ``which(rows)`` selects (a run's stage rows with it) from runs.csv to the end
     of runs.superseded.csv (nothing is lost), then replace runs.csv atomically; say so on stderr."""
     runs_csv, side = out / "runs.csv", out / "runs.superseded.csv"
-    rows = read_runs(runs_csv)
+    rows = read_runs(runs_csv, as_written=True)  # rewritten as they were written (a goal 4.50 stays 4.50)
     moved = which(rows)
     old = rows[moved]
     header = pd.read_csv(side, nrows=0).columns.tolist() if side.is_file() and side.stat().st_size else None

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config import Scenario, all_fields, load_scenario, parse_scenario
+from ..errors import ScenarioError
 from ..files import safe_chars
 from ..planners import Variant
 from ..tasks import Task, build_task
@@ -49,6 +50,20 @@ def file_stem(label: str, goal, seed=None, episode=None) -> str:
     return safe_chars(stem)
 
 
+def check_file_stems(task: Task, file: str) -> None:
+    """Refuse a scenario two of whose planner variants, or two of whose goals, would share the
+    files of a run (paths/, traces/, frames/ name them by :func:`file_stem`): a planner of one's
+    own named ``nsos_alpha0.9`` beside nsos at alpha 0.9, goals ``2512/2`` and ``2512_2``."""
+    for field, items, stem in (("planners", [v.label for v in task.variants()], lambda x: file_stem(x, "")),
+                               ("goals", [str(g) for g in task.goals], lambda x: file_stem("", x))):
+        seen: dict[str, str] = {}
+        for item in items:
+            other = seen.setdefault(stem(item), item)
+            if other != item:
+                raise ScenarioError(file, field, f"{other!r} and {item!r} would write their runs' files under one name "
+                                    f"({stem(item)}); rename one of them")
+
+
 @dataclass
 class Loaded:
     """A scenario with its task (world, goals, shortest paths, logs), built once per process."""
@@ -65,7 +80,9 @@ class Loaded:
         path = Path(path)
         sc = load_scenario(path) if data is None else parse_scenario(data, path)
         world = build_world(sc, path.parent, str(path))
-        return cls(path, sc, build_task(sc, world, path))
+        task = build_task(sc, world, path)
+        check_file_stems(task, str(path))
+        return cls(path, sc, task)
 
     @property
     def world(self) -> World:

@@ -18,11 +18,17 @@ from ..metrics import CAUSES, COLUMNS
 from ..files import temp_path
 
 
-def read_runs(path: Path) -> pd.DataFrame:
+def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     """runs.csv as a DataFrame (empty with the columns when absent). A torn last line (a write
     cut by power loss or a full disk, even inside a quoted field) is left out; a file that is not
     a runs.csv written by semsearch is a :class:`ScenarioError`. ``stage`` and ``map`` are read as
-    text (empty for a run's own row)."""
+    text (empty for a run's own row).
+
+    ``as_written``: a run's key columns (``planner``, ``params``, ``goal``) as the text that was
+    written, never a number or a missing value: a goal labelled ``4.50``, ``1e3`` or ``NA`` is that
+    label. A batch resumes (and moves rows aside) by these, so no label can make a run count
+    twice or be rewritten; without it, pandas reads them as it reads any column (``4.5``, NaN),
+    as the rows the API returns always have."""
     if path.is_dir():
         raise ScenarioError(str(path), "", "is a folder, not a runs.csv; move it away or write into another folder with --out")
     if not path.is_file() or path.stat().st_size == 0:
@@ -31,9 +37,12 @@ def read_runs(path: Path) -> pd.DataFrame:
     data = data[: data.rfind(b"\n") + 1]  # whole lines only
     bad = "not a runs.csv written by semsearch; move it away or write into another folder with --out"
     try:
+        text = dict.fromkeys(KEY_TEXT, str) if as_written else {}
+        na = dict(keep_default_na=False, na_values={c: MISSING for c in [*COLUMNS, *LATER] if c not in KEY_TEXT}) \
+            if as_written else {}
         df = pd.read_csv(io.BytesIO(data), dtype={"stage": str, "map": str, "message": str, "kind": str, "scenario": str,
-                                                  "fingerprint": str, "code": str, "room": str, "cause": str},
-                         encoding="utf-8")  # a scenario may be named 50045233
+                                                  "fingerprint": str, "code": str, "room": str, "cause": str, **text},
+                         encoding="utf-8", **na)  # a scenario may be named 50045233
     except (ValueError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
         raise ScenarioError(str(path), "", f"{bad} ({type(exc).__name__})") from None
     if "kind" not in df.columns and "wall_s" in df.columns:
@@ -62,6 +71,8 @@ def read_runs(path: Path) -> pd.DataFrame:
 LATER = {"episode": 0, "start_x": float("nan"), "start_y": float("nan"), "start_heading": float("nan"), "room": "",
          "cause": None, "soft_spl": float("nan"), "left_m": float("nan"), "fingerprint": "", "code": ""}
 TEXT = ["stage", "map", "message", "room", "cause", "code"]
+KEY_TEXT = ("planner", "params", "goal")  # read as written: never a number, never missing
+MISSING = ["", "nan", "NaN", "NA", "N/A", "null", "None", "<NA>"]  # what pandas reads as missing in the other columns
 NUMBERS = ["episode", "seed", "start_x", "start_y", "start_heading", "success", "distance_m", "shortest_m", "ratio", "spl",
            "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s"]
 

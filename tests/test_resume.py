@@ -1,0 +1,94 @@
+"""Resume is exact: a run is keyed by the text its row was written with, so however a goal label
+is written (4.50, 1e3, NA, K202, 2.10), running a batch again into its folder runs nothing and
+leaves the rows as they were. (The batch alone: summaries and reports of such labels are their
+own concern.)"""
+
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from semsearch_cli.config.base import sign_label
+from semsearch_cli.planners import register_planner
+from semsearch_cli.runner import BatchOptions, Loaded, expand, run_batch
+
+# labels a spreadsheet or a person writes that a CSV reader takes for numbers or for missing values
+TRICKY = ["4.50", "2.10", "1e3", "NA", "nan", "N/A", "None", "null", "inf", "-0.0", "1.0e2", "K202", "24D", "2.14"]
+LABELS = st.one_of(st.sampled_from(TRICKY), st.from_regex(r"[1-9][0-9]{0,2}\.[0-9]0", fullmatch=True),
+                   st.from_regex(r"[1-9]e[1-9]", fullmatch=True), st.from_regex(r"[A-Z][0-9]{1,3}", fullmatch=True))
+
+
+def _text(runs_csv: Path) -> pd.DataFrame:
+    """runs.csv as the text it holds, cell by cell."""
+    return pd.read_csv(runs_csv, dtype=str, keep_default_na=False)
+
+
+def _scenario(demo_dir: Path, folder: Path, labels: list[str]) -> Path:
+    """The demo building with its first signs relabelled ``labels``, which are also its goals."""
+    shutil.copy(demo_dir / "map.png", folder / "map.png")
+    lines = (demo_dir / "doors.csv").read_text().splitlines()
+    rows = [",".join([lab, *r.split(",")[1:]]) for lab, r in zip(labels, lines[1:])] + lines[1 + len(labels):]
+    (folder / "doors.csv").write_text("\n".join([lines[0], *rows]) + "\n")
+    sc = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    sc.update(map={**sc["map"], "image": "map.png"}, doors="doors.csv", goals=list(labels), planners=[{"name": "greedy"}],
+              experiment={"seeds": 1, "max_distance": 120.0})
+    path = folder / "scenario.yaml"
+    path.write_text(yaml.safe_dump(sc))
+    return path
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(st.lists(LABELS, min_size=1, max_size=3, unique_by=lambda s: str(sign_label(s))))
+def test_running_again_runs_nothing_and_leaves_the_rows(demo_dir, labels):
+    if any(isinstance(sign_label(lab), int) for lab in labels):  # a whole number may be another sign's
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        path = _scenario(demo_dir, folder, labels)
+        out = folder / "out"
+        loaded = Loaded.load(path)
+        run_batch(loaded, expand(loaded, 1), out, BatchOptions(workers=1))
+        first = _text(out / "runs.csv")
+        assert sorted(first["goal"]) == sorted(str(sign_label(lab)) for lab in labels)
+        run_batch(Loaded.load(path), expand(loaded, 1), out, BatchOptions(workers=1))
+        again = _text(out / "runs.csv")
+        assert len(again) == len(first) == len(labels)
+        assert again.drop(columns="wall_s").equals(first.drop(columns="wall_s"))  # nothing ran again or was rewritten
+        assert not again[["planner", "goal", "episode", "seed"]].duplicated().any()
+
+
+def test_a_planner_name_that_reads_as_a_variant_label_is_refused():
+    for name in ("nsos[alpha=0.9]", "a,b", "with space", "x" * 65, ""):
+        with pytest.raises(TypeError, match="a name holds only letters, digits and"):
+            register_planner(name)
+
+
+SAME_FILES = '''
+from semsearch_cli.planners import Decision, DoorPlanner, register_planner
+
+
+@register_planner("nsos_alpha0.9")
+class Clash(DoorPlanner):
+    def choose(self, ctx, cands):
+        return None
+'''
+
+
+def test_two_variants_that_would_share_their_runs_files_are_refused_when_the_scenario_loads(demo_dir, tmp_path):
+    (tmp_path / "clash.py").write_text(SAME_FILES)
+    sc = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    sc.update(map={**sc["map"], "image": str(demo_dir / "map.png")}, doors=str(demo_dir / "doors.csv"),
+              planners=[{"name": "nsos", "alpha": 0.9}, {"name": "nsos_alpha0.9", "module": "clash.py"}])
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(sc))
+    res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "validate", str(tmp_path / "s.yaml")],
+                         capture_output=True, text=True)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert ("field 'planners': 'nsos[alpha=0.9]' and 'nsos_alpha0.9' would write their runs' files under one name"
+            in " ".join(res.stderr.split())), res.stderr
