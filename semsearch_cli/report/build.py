@@ -213,12 +213,17 @@ class Part:
     runs: pd.DataFrame
     meta: dict
     _loaded: object = field(default=None, repr=False)
-    shown: str = ""  # the folder as the report names it (relative to the report's folder)
+    home: Path | None = None  # the report's folder: the paths the report names are relative to it
+
+    @property
+    def shown(self) -> str:
+        """The folder as the report names it: relative to the report's folder."""
+        return relative(self.folder, self.home) if self.home is not None else str(self.folder)
 
     def loaded(self, notes: list, what: str):
         """The scenario named in meta.json, loaded (once), or None with a note saying that
         ``what`` were skipped and why (the folder named as :attr:`shown`)."""
-        name = self.shown or str(self.folder)
+        name = self.shown
         if self._loaded is None:
             path = scenario_of(self.folder, self.meta)
             if path is None:
@@ -227,11 +232,9 @@ class Part:
                 try:
                     self._loaded = Loaded.load(path)
                 except ScenarioError as exc:
-                    why = str(exc)
-                    for full in sorted({os.path.abspath(self.folder), str(self.folder)}, key=len, reverse=True):
-                        why = why.replace(full, name)
-                    # any other absolute path (a map that has gone, where it was looked for): relative to the folder
-                    self._loaded = ABSOLUTE.sub(lambda m: os.path.relpath(m.group(0), self.folder), why)
+                    # an absolute path in the message (a map that has gone, where it was looked for): relative
+                    # to the report's folder, as every path the report names
+                    self._loaded = ABSOLUTE.sub(lambda m: relative(m.group(0), self.home or self.folder), str(exc))
         if isinstance(self._loaded, str):
             notes.append(f"{what} of {'these rows' if name == '.' else name} were skipped: {self._loaded}.")
             return None
@@ -262,8 +265,7 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
         for kind, rows in runs.groupby("kind", sort=False):
             if kind not in SECTIONS:
                 raise ScenarioError(str(folder / "runs.csv"), "kind", f"unknown kind {kind!r}; known: {', '.join(SECTIONS)}")
-            parts_by_kind.setdefault(kind, []).append(Part(folder, rows.reset_index(drop=True), meta,
-                                                           shown=relative(folder, out)))
+            parts_by_kind.setdefault(kind, []).append(Part(folder, rows.reset_index(drop=True), meta, home=out))
     if isinstance(replay, ReplayChoice):
         check_replay(replay, parts_by_kind)
     out.mkdir(parents=True, exist_ok=True)

@@ -133,7 +133,10 @@ def _path_figures(doc: Document, parts: list, fdir: Path, notes: list, img=("png
             stops = []
             for door, ks in at.items():
                 i = w.signs.index_of(door)
-                label = ", ".join(str(k) for k, _ in ks) + ": " + " / ".join(dict.fromkeys(lab for _, lab in ks))
+                by_label: dict = {}  # what is sought there -> its stages ("1: 12/laptop@11; 3: 12")
+                for k, lab in ks:
+                    by_label.setdefault(lab, []).append(str(k))
+                label = "; ".join(f"{', '.join(k)}: {lab}" for lab, k in by_label.items())
                 stops.append((label, float(w.signs.x[i]), float(w.signs.y[i])))
             f = fdir / f"chain_paths_{loaded.sc.name}_{safe_name(goal)}.png"
             plot_path_panels(w, panels, stops, "", f, img, colors, start_points(g, w))

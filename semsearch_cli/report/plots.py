@@ -463,7 +463,10 @@ def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=
     m = _axes_m_per_pt(axes[0])
     start_boxes = [(x, y, 6 * m, 6 * m) for x, y in starts]
     for ax, (lab, (paths, median, note)) in zip(axes, items):
-        drawn = _stops(ax, stops, m, start_boxes)
+        bold = paths[median] if 0 <= median < len(paths) else np.zeros((0, 2))
+        # a stop's label keeps off the starts and the bold run (sampled every ~2 pt of the map)
+        trail = [(x, y, 2 * m, 2 * m) for x, y in bold[:: max(1, len(bold) // 400)]]
+        drawn = _stops(ax, stops, m, start_boxes + trail)
         if 0 <= median < len(paths) and len(s) and places is None:
             _sign_labels(ax, world, paths[median], stop_signs, m, near_m, fixed=drawn + start_boxes)
     return _save(fig, out, formats)
@@ -491,7 +494,8 @@ def plot_scenario(world, goals, title: str, out: Path, formats=("png",)) -> list
     at = [s.index_of(g) for g in goals]
     stops = [(f"goal {g}", float(s.x[i]), float(s.y[i])) for g, i in zip(goals, at) if i >= 0]
     # a goal's own number is in its star's label: not written again under the star
-    numbers = _number_signs(ax, world, [i for i in range(len(s)) if i not in set(at)], m, 5.5, rotate=True)
+    goal_signs = set(at)
+    numbers = _number_signs(ax, world, [i for i in range(len(s)) if i not in goal_signs], m, 5.5, rotate=True)
     _stops(ax, stops, m, numbers + [(*world.start_xy, 6 * m, 6 * m)])
     return _save(fig, out, formats)
 
@@ -881,8 +885,9 @@ def plot_heat(world, heat: np.ndarray, places: dict, truth, goals, title: str, o
 @_paper
 def plot_object_bars(table, order: list, out: Path, formats=("png",), colors: dict | None = None) -> list[Path]:
     """The thesis' Figure 5.12: per case, the mean distance per request hour and planner with its
-    95% CI (columns ``mean``, ``mean_lo``, ``mean_hi``); where some runs did not find the object,
-    the bar is hatched and the share that did is written above it."""
+    95% CI (columns ``mean``, ``mean_lo``, ``mean_hi``; no bar where there is no interval, as
+    with one run); where some runs did not find the object, the bar is hatched and the share that
+    did is written above it."""
     colors = colors or planner_colors(order)
     cases = list(dict.fromkeys(table["case"]))
     fig, axes = _grid(len(cases), 2.2, sharey=True)
@@ -896,8 +901,11 @@ def plot_object_bars(table, order: list, out: Path, formats=("png",), colors: di
             mean = np.array([float(s["mean"].get(h, np.nan)) for h in hours])
             lo = np.array([float(s["mean_lo"].get(h, np.nan)) if "mean_lo" in s else np.nan for h in hours])
             hi = np.array([float(s["mean_hi"].get(h, np.nan)) if "mean_hi" in s else np.nan for h in hours])
-            err = np.nan_to_num(np.vstack([mean - lo, hi - mean]))
-            bars = ax.bar(xs, mean, width, yerr=err, capsize=1.5, color=colors[lab], error_kw=dict(lw=0.7))
+            bars = ax.bar(xs, mean, width, color=colors[lab])
+            ci = np.isfinite(lo) & np.isfinite(hi) & (hi > lo)  # an interval only where there is one (n >= 2, spread)
+            if ci.any():
+                ax.errorbar(xs[ci], mean[ci], yerr=np.vstack([mean - lo, hi - mean])[:, ci], fmt="none", ecolor="black",
+                            capsize=1.5, lw=0.7)
             for bar, x, m, h in zip(bars, xs, mean, hours):
                 if h in s.index:
                     rate = float(s.loc[h, "success_rate"])
@@ -917,7 +925,10 @@ def plot_object_bars(table, order: list, out: Path, formats=("png",), colors: di
     n = table.groupby("planner")["n"].agg(["min", "max"])
     labels = [f"{lab} (n={n.loc[lab, 'min']}" + (f"-{n.loc[lab, 'max']}" if n.loc[lab, "max"] != n.loc[lab, "min"] else "") + ")"
               for lab in order]
-    _legend(fig, axes, [Patch(color=colors[lab], label=t) for lab, t in zip(order, labels)], ncol=min(3, len(order)))
+    handles = [Patch(color=colors[lab], label=t) for lab, t in zip(order, labels)]
+    handles += [Patch(facecolor="white", edgecolor="0.3", hatch="////", label="not found in every run (% found above)"),
+                Line2D([], [], c="black", lw=0.7, marker="_", ms=4, label="95% CI of the mean (where n > 1)")]
+    _legend(fig, axes, handles, ncol=min(3, len(handles)))
     return _save(fig, out, formats)
 
 
