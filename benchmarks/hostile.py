@@ -1,14 +1,25 @@
-"""Hostile inputs, as a user would meet them: every case of ``tests/hostile_inputs.py`` run as a
-real ``semsearch`` process with a time limit, classified, and tabulated by category.
+"""Hostile inputs, as a user would meet them: every case of a catalogue run as a real ``semsearch``
+process with a time limit and a cap on its memory, classified, and tabulated by category. The
+catalogues: ``issue14`` (``tests/hostile_inputs.py``, the first reviews), ``release`` (``tests/
+hostile_release.py``, the surfaces the last release added, issue 35: its categories are labels,
+episodes, output, frames, planners, commands) or ``all`` (both; the release's categories are then
+shown as ``release: <category>``, apart from the first catalogue's of the same name).
 
 Usage:
-  python benchmarks/hostile.py [--timeout 120] [--jobs 2] [--only CATEGORY] [--md FILE] [--csv FILE]
+  python benchmarks/hostile.py [--catalogue {issue14,release,all}] [--timeout 120] [--jobs 2]
+                               [--memory 4] [--only CATEGORY] [--md FILE] [--csv FILE]
 
 Outcomes: ``refused`` (exit 2, no traceback), ``accepted`` (exit 0), ``traceback`` (a Python
 traceback on stderr, whatever the status), ``other`` (another status) and ``hang`` (killed at the
 time limit); ``warnings`` counts cases that printed a numpy, OpenCV or libpng warning (a defect:
 the user should see one paragraph). A case accepted where it should be refused is ``garbage accepted``; one refused
-where it should be accepted is ``wrongly refused``. Exits 1 when any case is a defect.
+where it should be accepted is ``wrongly refused``. A case whose output lacks a text of its
+``says`` (the field, flag or file it must name) is a defect too; its message then begins
+``does not say '...'``. Exits 1 when any case is a defect.
+
+Each case's process may take at most ``--memory`` GB of address space (a damaged file that asks
+for 10**9 frames ends in a MemoryError, a defect, not in the machine's memory), and sees a
+console 200 columns wide (as the tests do: paths and fields are not broken across lines).
 """
 
 from __future__ import annotations
@@ -28,20 +39,28 @@ import pandas as pd
 from output import emit
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests.hostile_inputs import build_cases  # noqa: E402
+from tests import hostile_inputs, hostile_release  # noqa: E402
 
 from semsearch_cli.report.document import markdown_table  # noqa: E402
 
-CLI = [sys.executable, "-c", "from semsearch_cli.cli import main; main()"]
+CATALOGUES = {"issue14": hostile_inputs.build_cases, "release": hostile_release.build_cases}
 
 
-def run_case(case, timeout: float, cwd: Path) -> dict:
+def cli(memory_gb: float) -> list[str]:
+    """The command line, in a process whose address space is capped at ``memory_gb`` GB."""
+    cap = int(memory_gb * 2**30)
+    return [sys.executable, "-c", f"import resource; resource.setrlimit(resource.RLIMIT_AS, ({cap}, {cap})); "
+            "from semsearch_cli.cli import main; main()"]
+
+
+def run_case(case, timeout: float, cwd: Path, memory_gb: float = 4.0, category: str | None = None) -> dict:
     t0 = time.perf_counter()
     # a session of its own, so that a hang is killed with every process it started
-    p = subprocess.Popen(CLI + case.args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd, errors="replace",
-                         start_new_session=True)
+    p = subprocess.Popen(cli(memory_gb) + case.args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd,
+                         errors="replace", start_new_session=True, env={**os.environ, "COLUMNS": "200"})
+    out = ""
     try:
-        _, err = p.communicate(timeout=timeout)
+        out, err = p.communicate(timeout=timeout)
         status = p.returncode
         outcome = ("traceback" if "Traceback (most recent call last)" in err else
                    "refused" if status == 2 else "accepted" if status == 0 else "other")
@@ -53,28 +72,46 @@ def run_case(case, timeout: float, cwd: Path) -> dict:
         or (case.expect == "accept" and outcome == "refused")
     lines = [ln for ln in err.strip().splitlines() if ln.strip()]
     warned = any(w in ln for ln in lines for w in ("Warning:", "[ WARN", "libpng", "RuntimeWarning"))
-    defect = defect or warned
-    return {"garbage": case.expect == "refuse" and outcome == "accepted", "wrong_refusal": case.expect == "accept" and outcome == "refused","category": case.category, "case": case.name, "expect": case.expect, "outcome": outcome, "status": status,
-            "defect": defect, "warned": warned, "issue_14": case.issue, "seconds": round(time.perf_counter() - t0, 2),
-            "message": " ".join(" ".join(lines[-3:]).split())[:300]}
+    said = " ".join((out + " " + err).split())  # the console wraps long lines
+    unsaid = [s for s in case.says if s not in said] if outcome in ("refused", "accepted") else []
+    seconds = time.perf_counter() - t0
+    within = getattr(case, "within", None)  # a refusal that must come before any work (a release case)
+    slow = within is not None and seconds > within
+    defect = defect or warned or bool(unsaid) or slow
+    message = " ".join(" ".join(lines[-3:]).split())
+    if unsaid:
+        message = f"does not say {', '.join(map(repr, unsaid))}: {message}"
+    if slow:
+        message = f"took {seconds:.1f} s, more than {within:g} s: {message}"
+    return {"garbage": case.expect == "refuse" and outcome == "accepted", "wrong_refusal": case.expect == "accept" and outcome == "refused",
+            "category": category or case.category, "case": case.name, "expect": case.expect, "outcome": outcome, "status": status,
+            "defect": defect, "warned": warned, "issue_14": case.issue, "seconds": round(seconds, 2),
+            "message": message[:300]}
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--catalogue", choices=["issue14", "release", "all"], default="all",
+                    help="tests/hostile_inputs.py (issue14), tests/hostile_release.py (release) or both")
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--only", default=None, help="one category")
+    ap.add_argument("--memory", type=float, default=4.0, help="GB of address space each case's process may take")
+    ap.add_argument("--only", default=None, help="one category (as the table shows it, or as its catalogue names it)")
     ap.add_argument("--md", type=Path)
     ap.add_argument("--csv", type=Path)
     a = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
-        cases = [c for c in build_cases(root / "cases") if a.only in (None, c.category)]
+        cases = []  # (case, the category the table shows)
+        for name, build in CATALOGUES.items():
+            if a.catalogue in (name, "all"):
+                shown = (lambda c: f"release: {c.category}") if a.catalogue == "all" and name == "release" else (lambda c: c.category)
+                cases += [(c, shown(c)) for c in build(root / "cases" / name) if a.only in (None, c.category, shown(c))]
         work = root / "cwd"  # the working folder: nothing may be written here but results/
         work.mkdir()
         t0 = time.perf_counter()
         with ThreadPoolExecutor(a.jobs) as pool:
-            rows = list(pool.map(lambda c: run_case(c, a.timeout, work), cases))
+            rows = list(pool.map(lambda cc: run_case(cc[0], a.timeout, work, a.memory, cc[1]), cases))
         stray = sorted(p.name for p in work.iterdir() if p.name != "results")
         wall = time.perf_counter() - t0
     df = pd.DataFrame(rows)

@@ -166,6 +166,19 @@ def parse_param(text: str) -> tuple[str, list]:
     return name.strip(), values
 
 
+def _load_value(path: Path, data: dict, param: str, value) -> Loaded:
+    """The scenario with ``param`` set to ``value``; a value its field refuses is blamed on
+    ``--param`` (the file is not at fault)."""
+    try:
+        return Loaded.load(path, with_param(data, param, value, path))
+    except ScenarioError as exc:
+        if exc.file == str(path) and exc.field and (exc.field == param or exc.field.startswith(param + ".")
+                                                     or param.endswith("." + exc.field.split(".")[-1])):
+            raise ScenarioError("<command line>", "--param", f"{param}={str(value).lower() if isinstance(value, bool) else value} "
+                                f"({exc.field} of the scenario): {exc.message}") from None
+        raise
+
+
 def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions = BatchOptions(), progress=None) -> SweepOutput:
     """Run a scenario once per value of one parameter (see
     :func:`~semsearch_cli.config.with_param`): each value's rows go to ``out/<param>=<value>/``
@@ -174,7 +187,7 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
     options = options.checked()
     path = scenario_file(scenario)
     data = read_yaml(path)
-    loaded = [Loaded.load(path, with_param(data, param, v, path)) for v in values]
+    loaded = [_load_value(path, data, param, v) for v in values]
     for v, ld in zip(values, loaded):
         _typed(param, v, ld)
     out_dir = Path(options.out) if options.out else inside(Path("results"), f"{loaded[0].sc.name}-sweep-{param}")

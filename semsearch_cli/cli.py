@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import signal
 import sys
 import time
@@ -21,7 +22,7 @@ from . import api
 from .provenance import version_line
 from .runner import BatchOptions
 from .belief.presence import presence_scores, read_counts
-from .config.base import MAX_SEEDS
+from .config.base import MAX_SEEDS, sign_label
 from .config.indirect import IndirectSpec
 from .kernels import announce_compiling
 from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated, did_you_mean
@@ -40,6 +41,11 @@ from .files import atomic_text, output_file, output_folder
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 import_app = typer.Typer(no_args_is_help=True, help="Convert maps from other tools into scenarios.")
 app.add_typer(import_app, name="import")
+# a standard stream the shell closed (``>&-``) is None here: given /dev/null so that nothing fails on
+# it, and a closed standard output is refused by main() (the command's output would be lost)
+CLOSED = [name for name in ("stdout", "stderr") if getattr(sys, name) is None]
+for _name in CLOSED:
+    setattr(sys, _name, open(os.devnull, "w"))
 # markup off: file names, planner names and goals are printed as they are, never read as [style] tags
 out = Console(markup=False) if sys.stdout.isatty() else Console(markup=False, width=200)
 err = Console(stderr=True, markup=False) if sys.stderr.isatty() else Console(stderr=True, markup=False, width=200)
@@ -66,14 +72,21 @@ def _finite(value: Optional[float]) -> Optional[float]:
     return value
 
 
-def _split(values: Optional[List[str]], flag: str) -> Optional[list]:
-    """Repeated or comma-separated values of ``flag`` (numbers as int); None when not given."""
+def _split(values: Optional[List[str]], flag: str, labels: bool = True) -> Optional[list]:
+    """Repeated or comma-separated values of ``flag``, None when not given: sign labels in their
+    canonical form (:func:`~semsearch_cli.config.base.sign_label`: ``148`` and ``148.0`` are the
+    number 148) when ``labels``, else text (planner labels, case names)."""
     if values is None or values == []:
         return None
     items = [v.strip() for s in values for v in s.split(",") if v.strip()]
     if not items:
         raise ScenarioError("<command line>", flag, f"no values in {' '.join(map(repr, values))}; give one or more, comma-separated")
-    return [int(v) if v.lstrip("-").isdigit() else v for v in items]
+    if not labels:
+        return items
+    try:
+        return [sign_label(v) for v in items]
+    except ValueError as exc:
+        raise ScenarioError("<command line>", flag, str(exc)) from None
 
 
 SCENARIO = typer.Argument(..., help="Scenario YAML file, or a shipped scenario's name (semsearch scenarios lists them).")
@@ -84,7 +97,7 @@ GOALS = typer.Option(None, "--goal", help="Only these goals (repeat or comma-sep
 PLANNERS = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate).")
 TRACE = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl.")
 FRAMES = typer.Option(False, "--frames", help="Also write each run's replay frames to frames/<run>.npz: the report then replays any run from them, without re-running it.")
-FORCE = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak.")
+FORCE = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak, its runs' paths, traces and frames in runs.<n>.bak/.")
 OVERSUBSCRIBE = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O).")
 EXECUTOR = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers).")
 SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask).")
@@ -93,7 +106,7 @@ SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, 
 def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames=False) -> BatchOptions:
     """The batch options of the command line (a bad --goal or --planner list exits with status 2)."""
     try:
-        goals, planners = _split(goal, "--goal"), _split(planner, "--planner")
+        goals, planners = _split(goal, "--goal"), _split(planner, "--planner", labels=False)
     except ScenarioError as exc:
         _fail(exc)
     return BatchOptions(seeds=seeds, goals=goals, planners=planners, out=out_dir, workers=workers,
@@ -340,7 +353,7 @@ def record(
     with `record: path/to/log.csv` in its case."""
 
     try:
-        written = api.record(scenario, output_folder(out_dir), _split(cases, "--case"))
+        written = api.record(scenario, output_folder(out_dir), _split(cases, "--case", labels=False))
     except ScenarioError as exc:
         _fail(exc)
     for f, n in written:
@@ -674,6 +687,10 @@ def main() -> None:
     # user's code is what must change, and Python hides DeprecationWarning outside __main__
     warnings.filterwarnings("default", category=DeprecationWarning, message=".*deprecated since semsearch")
     resume = "finished runs are kept in runs.csv; run the same command again to resume"
+    if "stdout" in CLOSED:
+        err.print("error: standard output is closed (>&-); give it a file, or /dev/null to discard what semsearch prints",
+                  highlight=False, soft_wrap=True)
+        sys.exit(2)
     try:
         app()
     except (KeyboardInterrupt, Terminated, BatchStopped) as exc:

@@ -117,6 +117,20 @@ def output_folder(out: str | Path, flag: str = "--out") -> Path:
     return out
 
 
+def check_outputs(folder: Path, files: tuple[str, ...] = (), folders: tuple[str, ...] = (), flag: str = "--out") -> None:
+    """Before anything is written into ``folder``: each of ``files`` that exists there is a file,
+    each of ``folders`` a folder; a :class:`ScenarioError` for ``flag`` naming the first that is
+    not (a command would otherwise stop half-way, its runs done and its report not written)."""
+    for names, want_dir in ((files, False), (folders, True)):
+        for name in names:
+            p = Path(folder) / name
+            if (p.exists() or p.is_symlink()) and (p.is_dir() != want_dir or not (p.is_dir() or p.is_file())):
+                what = "a folder" if p.is_dir() else "a file" if p.is_file() else "neither a file nor a folder"
+                raise ScenarioError("<command line>", flag, f"{p} is {what}, where semsearch writes its "
+                                    f"{'folder' if want_dir else 'file'} {name}; move it away, or write into another "
+                                    "folder")
+
+
 def output_file(path: str | Path, flag: str, suffixes: tuple[str, ...]) -> Path:
     """``path`` for a file to write, its folder created: refused (a :class:`ScenarioError` for
     ``flag``) when empty, a folder, of a type not among ``suffixes``, or in a folder that cannot

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import os
 import platform
+import stat
 import sys
 from importlib import metadata
 from pathlib import Path
@@ -27,17 +29,48 @@ DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "scikit-image", "opencv-pyt
 NOT_RUN = ("report/", "cli.py", "api.py")
 
 
+def regular_bytes(path: str | Path) -> bytes | None:
+    """The bytes of ``path`` when it is a regular file this process can read (a symlink to one
+    counts), else None: a folder, a pipe (FIFO), a socket or a device, a dangling or looping
+    symlink, a file without read permission. Never waits on a pipe: one is refused by its status
+    before it is opened, and the open does not wait (``O_NONBLOCK``) and is checked again through
+    its descriptor, so one swapped in between is refused too."""
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except (OSError, ValueError):  # ValueError: a NUL in the name
+        return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            return fh.read()
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+
+
 def files_hash(root: Path, skip: tuple = (), recursive: bool = True) -> str:
     """sha256 (16 hex digits) of the Python files under ``root`` (in its subfolders too when
     ``recursive``; paths relative to it and bytes, in path order), leaving out those whose
-    relative path starts with one of ``skip``."""
+    relative path starts with one of ``skip``.
+
+    Only regular files that can be read count (:func:`regular_bytes`): whatever else is named
+    ``*.py`` beside a user's planner file (a folder ``junk.py``, a dangling symlink, a pipe, a
+    socket, a file without read permission) is left out, as Python could not import it either;
+    a pipe is never read, so it cannot hang a run."""
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py") if recursive else root.glob("*.py")):
         rel = f.relative_to(root).as_posix()
         if rel.startswith(skip) or "/." in "/" + rel:
             continue
+        data = regular_bytes(f)
+        if data is None:
+            continue
         h.update(rel.encode() + b"\0")
-        h.update(f.read_bytes())
+        h.update(data)
     return h.hexdigest()[:16]
 
 

@@ -71,6 +71,25 @@ def demo_base(root: Path) -> tuple[dict, Path]:
     return base, d
 
 
+def check_outcome(case: Case, res, cwd: Path) -> None:
+    """The outcome a case must have, from typer's ``CliRunner`` result ``res`` of a command run in
+    the empty working folder ``cwd``: no traceback; a refusal exits 2 with an error naming what
+    ``case.says``; an acceptance exits 0; nothing written into ``cwd`` unless accepted."""
+    assert res.exception is None or isinstance(res.exception, SystemExit), f"{type(res.exception).__name__}: {res.exception}"
+    text = " ".join(res.output.split())
+    assert "Traceback" not in text
+    if case.expect == "refuse":
+        assert res.exit_code == 2, text
+        assert "error" in text.lower() or "invalid value" in text.lower(), text
+    elif case.expect == "accept":
+        assert res.exit_code == 0, text
+    else:
+        assert res.exit_code in (0, 2), text
+    for s in case.says:
+        assert s in text, f"{s!r} not in: {text}"
+    assert list(cwd.iterdir()) == [] or case.expect == "accept", sorted(p.name for p in cwd.iterdir())
+
+
 def build_cases(root: Path) -> list[Case]:
     """Every case, its files written under ``root``."""
     root.mkdir(parents=True, exist_ok=True)

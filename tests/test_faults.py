@@ -117,7 +117,7 @@ def test_sigterm_to_the_group_ends_with_a_paragraph_and_status_143(demo_dir, tmp
 def test_a_full_disk_keeps_every_whole_run_and_cuts_the_torn_one(tmp_path):
     path = tmp_path / "runs.csv"
     w = store.RowWriter(path)
-    w.write([{"planner": "greedy", "goal": 1, "episode": 0, "seed": 0, "outcome": "found", "wall_s": 0.1}])
+    w.write([{"planner": "greedy", "goal": 1, "episode": 0, "seed": 0, "outcome": "found", "distance_m": 10.0, "wall_s": 0.1}])
     size = path.stat().st_size
 
     class Full:  # the file, but half of a write reaches the disk, then the disk is full
@@ -134,9 +134,9 @@ def test_a_full_disk_keeps_every_whole_run_and_cuts_the_torn_one(tmp_path):
 
     w.fh = Full(w.fh)
     with pytest.raises(OSError):
-        w.write([{"planner": "greedy", "goal": 1, "episode": 0, "seed": s, "outcome": "found", "wall_s": 0.1} for s in (1, 2)])
+        w.write([{"planner": "greedy", "goal": 1, "episode": 0, "seed": s, "outcome": "found", "distance_m": 10.0, "wall_s": 0.1} for s in (1, 2)])
     assert path.stat().st_size == size  # the torn run is gone, the whole one kept
-    w.write([{"planner": "greedy", "goal": 1, "episode": 0, "seed": 3, "outcome": "found", "wall_s": 0.1}])  # and writing goes on
+    w.write([{"planner": "greedy", "goal": 1, "episode": 0, "seed": 3, "outcome": "found", "distance_m": 10.0, "wall_s": 0.1}])  # and writing goes on
     w.close()
     assert list(read_runs(path)["seed"]) == [0, 3]
 

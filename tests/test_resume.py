@@ -92,3 +92,36 @@ def test_two_variants_that_would_share_their_runs_files_are_refused_when_the_sce
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert ("field 'planners': 'nsos[alpha=0.9]' and 'nsos_alpha0.9' would write their runs' files under one name"
             in " ".join(res.stderr.split())), res.stderr
+
+
+GREEDY_AS = '''
+from semsearch_cli.planners import register_planner
+from semsearch_cli.planners.doors.greedy import Greedy
+
+
+@register_planner({name!r})
+class Mine(Greedy):
+    """Greedy, under a name of the user's."""
+'''
+_DRAWN = iter(range(10 ** 6))  # a fresh prefix per example: a name registers once per process
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(st.from_regex(r"[A-Za-z0-9._+-]{1,40}", fullmatch=True), st.sampled_from(["K202", "4.50", "NA", "2.10"]))
+def test_a_users_planner_under_any_valid_name_resumes_exactly(demo_dir, name, label):
+    name = f"u{next(_DRAWN)}{name}"
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        path = _scenario(demo_dir, folder, [label])
+        (folder / "mine.py").write_text(GREEDY_AS.format(name=name))
+        sc = yaml.safe_load(path.read_text())
+        sc["planners"] = [{"name": "greedy"}, {"name": name, "module": "mine.py"}]
+        path.write_text(yaml.safe_dump(sc))
+        out = folder / "out"
+        loaded = Loaded.load(path)
+        run_batch(loaded, expand(loaded, 1), out, BatchOptions(workers=1))
+        first = _text(out / "runs.csv")
+        assert sorted(first["planner"]) == sorted(["greedy", name]) and set(first["goal"]) == {label}
+        run_batch(Loaded.load(path), expand(loaded, 1), out, BatchOptions(workers=1))
+        again = _text(out / "runs.csv")
+        assert again.drop(columns="wall_s").equals(first.drop(columns="wall_s"))

@@ -7,10 +7,10 @@ array too big for memory or a loop that never ends."""
 from __future__ import annotations
 
 import re
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal, Union, get_args
 
 import numpy as np
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
 # upper bounds shared by the sections (m): far beyond any building, short of an array that fills memory
 MAX_RANGE = 50.0  # a sensor's range
@@ -22,29 +22,70 @@ Coord = Annotated[float, Field(ge=-MAX_COORD, le=MAX_COORD)]
 Angle = Annotated[float, Field(ge=-3600.0, le=3600.0, description="degrees")]
 
 
-_WHOLE = re.compile(r"-?[0-9]+")
+MAX_LABEL = 64  # characters of a sign's label (a goal, a room): longer is not a label but a file name too long
+MAX_LABEL_DIGITS = 18  # digits of a whole-number label: it is kept as a 64-bit integer
+_WHOLE = re.compile(r"[-+]?[0-9]+(?:\.0*)?", re.ASCII)  # 148, 148.0 (a spreadsheet's column of numbers)
 
 
 def sign_label(value):
-    """A sign's label in its one canonical form, wherever it was written: a whole number (``148``,
-    ``"148"`` in YAML or a CSV, ``148.0`` from a spreadsheet column of numbers) is an int, anything
-    else (``K202``, ``24D``, ``2.14``) stripped text. A goal is then matched to its sign however
-    either was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV."""
+    """A sign's label in its one canonical form, wherever it was written (a scenario, a doors or
+    episodes CSV, ``--goal``, an importer): a whole number (``148``, ``"148"`` in YAML or a CSV,
+    ``148.0`` or ``"148.0"`` from a spreadsheet column of numbers) is an int, anything else
+    (``K202``, ``24D``, ``2.14``, ``NA``) stripped text. A goal is then matched to its sign however
+    either was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV.
+
+    Bounds (a ``ValueError`` naming them): at most ``MAX_LABEL`` (64) characters, printable, not
+    empty; a whole number has at most ``MAX_LABEL_DIGITS`` (18) digits. Digits are ASCII ``0-9``
+    only: ``30²`` or ``٣٠`` is a text label with no number, never the number 30."""
     if isinstance(value, bool):
         return str(value).lower()
-    if isinstance(value, (int, np.integer)):
-        return int(value)
     if isinstance(value, (float, np.floating)):
-        return int(value) if float(value).is_integer() else repr(float(value))
-    text = str(value).strip()
-    return int(text) if _WHOLE.fullmatch(text) else text
+        if not np.isfinite(value):
+            raise ValueError(f"a label must be a finite number or text, got {value!r}")
+        value = int(value) if float(value).is_integer() else repr(float(value))
+    if isinstance(value, (int, np.integer)):
+        if len(str(abs(int(value)))) > MAX_LABEL_DIGITS:
+            raise ValueError(f"a whole-number label has at most {MAX_LABEL_DIGITS} digits, got {len(str(abs(int(value))))}")
+        return int(value)
+    text = str(value)
+    if len(text) > 4 * MAX_LABEL:  # before any work on it: a 60,000-character label is refused at once
+        raise ValueError(f"a label has at most {MAX_LABEL} characters, got {len(text)}")
+    text = text.strip()
+    if not text:
+        raise ValueError("a label cannot be empty")
+    if len(text) > MAX_LABEL:
+        raise ValueError(f"a label has at most {MAX_LABEL} characters, got {len(text)}: {text[:20]}...")
+    if not text.isprintable():
+        raise ValueError(f"a label holds only printable characters (no tab, newline or control character), got {text!r}")
+    if _WHOLE.fullmatch(text):
+        return sign_label(int(text.split(".")[0]))
+    return text
 
 
 Label = Annotated[Union[int, str], BeforeValidator(sign_label)]
 
 
+def _takes(annotation, types) -> bool:
+    """Whether a field's type admits ``types`` (itself, or inside a union, a list or Annotated)."""
+    types = types if isinstance(types, tuple) else (types,)
+    return annotation in types or any(_takes(a, types) for a in get_args(annotation))
+
+
 class Strict(BaseModel):
+    """A section: unknown keys, NaN and infinity refused, and a yes/no/true/false refused where a
+    number belongs (pydantic reads True as 1: ``starts: yes`` would draw one start)."""
+
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _numbers_as_written(cls, value, info):
+        f = cls.model_fields[info.field_name]
+        if isinstance(value, bool) and not _takes(f.annotation, bool):
+            raise ValueError("expected a number or text, not yes/no (a YAML boolean: yes, no, on, off, true, false)")
+        if isinstance(value, str) and "_" in value and _takes(f.annotation, (int, float)) and not _takes(f.annotation, str):
+            raise ValueError("expected a number, written without underscores")
+        return value
 
 
 class MapSpec(Strict):

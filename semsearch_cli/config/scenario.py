@@ -174,7 +174,7 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
         same = [e for e in errs if _loc(e["loc"]).startswith(_loc(err["loc"]))]
         err = max(same, key=lambda e: (len(e["loc"]), not e["type"].endswith("_type")))
         field = _loc(err["loc"])
-        msg = err["msg"]
+        msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden" and len(err["loc"]) == 1 and field in all_fields():
             raise ScenarioError(str(file), field, f"a {kind} scenario does not take {field}; remove it") from None
         if err["type"] == "missing" and field == model.section:
@@ -193,15 +193,50 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
         raise ScenarioError(str(file), field, msg) from None
 
 
+class ScenarioLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` whose plain numbers are the ones a reader sees: YAML 1.1's decimal
+    integers and floats (``1.5``, ``1.0e+3``, ``.5``; ``1e3`` stays text, as before), ``0x``
+    integers and ``.inf``/``.nan`` (refused by the models). Its other numbers are text: ``1_5``
+    (15 with the underscore dropped), ``1:30`` (sexagesimal 90), ``010`` (octal 8) and ``0b11``, so
+    a mistyped number is an error naming its field, never another number. Everything else
+    ``yaml.safe_dump`` writes reads back as it was."""
+
+
+ScenarioLoader.yaml_implicit_resolvers = {
+    first: [(tag, rx) for tag, rx in resolvers if tag not in ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float")]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+ScenarioLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:int", re.compile(r"^(?:[-+]?(?:0|[1-9][0-9]*)|[-+]?0x[0-9a-fA-F]+)$"), list("-+0123456789"))
+ScenarioLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^(?:(?:[-+]?[0-9]+\.[0-9]*|\.[0-9]+)(?:[eE][-+][0-9]+)?|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
+    list("-+0123456789."))
+
+
+def _construct_int(loader, node):
+    text = loader.construct_scalar(node)
+    if len(text) > 64:  # no number of a scenario has so many digits: text, which its field refuses naming its bound
+        return text
+    return int(text, 16) if "x" in text else int(text)
+
+
+ScenarioLoader.add_constructor("tag:yaml.org,2002:int", _construct_int)
+
+
+def load_yaml_text(text: str) -> Any:
+    """Plain YAML data of ``text`` (:class:`ScenarioLoader`: numbers as written, no Python tags)."""
+    return yaml.load(text, Loader=ScenarioLoader)  # noqa: S506 (a SafeLoader subclass)
+
+
 def read_yaml(path: str | Path, what: str = "file", owner: str | None = None, field: str = "") -> Any:
     """A YAML file's contents; a file that is missing, not a file, not UTF-8 text (see
     :func:`~semsearch_cli.files.read_user_text`) or not YAML is a :class:`ScenarioError` naming the
     file (or ``owner`` and ``field``, the scenario that named it) and the line. Only plain YAML
-    is read (``yaml.safe_load``: a ``!!python`` tag is refused, never executed)."""
+    is read (:class:`ScenarioLoader`, a ``yaml.SafeLoader``: a ``!!python`` tag is refused, never
+    executed; ``1_5`` is text, not 15)."""
     path = Path(path)
     text = read_user_text(path, what, owner, field)
     try:
-        return yaml.safe_load(text)
+        return load_yaml_text(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""

@@ -13,12 +13,23 @@ that finds the target. ``terminated`` when the target is found or the search has
 (``info["outcome"]``: found, stuck, not_found; also stuck after 100 actions in a row that take
 no step of the loop); ``truncated`` at the scenario's budget
 (``experiment.max_distance`` and the step limit; for indirect search its time limit).
+
+Arguments are checked where they enter, each against its range, and refused with a ``ValueError``
+that names the argument and the range (as Gymnasium's own environments refuse theirs), never
+taken on silently nor left to fail deep inside: the constructors' arguments
+(:func:`check_number`, :func:`check_flag`, :func:`check_choice`), ``reset``'s ``seed`` and
+``options`` (:func:`check_options`; ``episode`` in 0..E-1 for a set of E episodes, ``repeat`` in
+0..2^32-1, no other key) and every action (:func:`check_action`: an integer of the action space,
+a Python ``int``, a numpy integer or a 0-d integer array; not a ``bool``, a float, a string or
+None). ``success_bonus`` lies in 0..1e6.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import string
+from collections.abc import Mapping
 from pathlib import Path
 
 import gymnasium as gym
@@ -26,7 +37,7 @@ import numpy as np
 
 from ..config import load_scenario
 from .. import shipped as shipped_scenarios
-from ..errors import ScenarioError
+from ..errors import ScenarioError, did_you_mean
 from ..tasks import Task, build_task
 from ..tasks.episodes import Episode, episode_seed
 from ..world.ground_truth import build_world
@@ -36,6 +47,7 @@ BIG = 1e6  # bound of the observations' coordinates (m), as config.base.MAX_COOR
 IDLE_ACTIONS = 100  # actions in a row that take no step (the agent choosing where it stands) before the episode is stuck
 TEXT_CHARSET = frozenset(string.ascii_letters + string.digits + string.punctuation + " \n")
 TEXT_LENGTH = 8192
+MAX_REPEAT = 2**32 - 1  # the largest repeat reset(options=) names: one numpy seed word (the batch's seeds are 0..999,999)
 _TASKS: dict[tuple, Task] = {}  # (resolved path, mtime) -> task: the envs of one process share a loaded scenario
 
 
@@ -62,6 +74,103 @@ def load_task(scenario: str | Path, kind: str) -> Task:
     if task.kind != kind:
         raise ScenarioError(str(path), "kind", f"a {task.kind} scenario; this environment runs {kind} scenarios")
     return task
+
+
+# ---- checking what comes in: arguments, reset options, actions --------------------------------
+def _show(value) -> str:
+    """A value as a message quotes it (at most 60 characters)."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _num(x) -> str:
+    """A bound as a message writes it: an int whole (4294967295), a float short (1e+06, 0.05)."""
+    return str(x) if isinstance(x, int) else f"{x:g}"
+
+
+def _scalar(value):
+    """A numpy scalar or 0-d array as the Python number it holds; anything else as it is."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 or isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def check_number(name: str, value, lo: float | None = None, hi: float | None = None, *, integer: bool = False,
+                 above: bool = False, unit: str = "", note: str = "") -> int | float:
+    """``value`` as a Python int (``integer``) or a finite float in ``lo..hi`` (``lo`` excluded
+    with ``above``; None: no bound), or a ``ValueError`` naming ``name`` and the range (and
+    ``note``, what the range is, in brackets).
+
+    Python and numpy numbers and 0-d arrays are taken; a ``bool`` (``True`` reads as 1), a string
+    (``"3"``), None, NaN and infinity are not, nor a float for an integer (``2.5`` would be cut to
+    2 without a word; ``2.0`` is refused too, as ``Discrete`` refuses it)."""
+    v = _scalar(value)
+    if integer:
+        ok = isinstance(v, int) and not isinstance(v, bool)
+        what = "an integer"
+    else:
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        what = "a finite number"
+    u = f" {unit}" if unit else ""
+    if lo is not None and hi is not None:
+        what += f" above {_num(lo)} and at most {_num(hi)}{u}" if above else f" from {_num(lo)} to {_num(hi)}{u}"
+    elif lo is not None:
+        what += f" {'above' if above else 'at least'} {_num(lo)}{u}"
+    elif hi is not None:
+        what += f" at most {_num(hi)}{u}"
+    if ok:
+        ok = (lo is None or (v > lo if above else v >= lo)) and (hi is None or v <= hi)
+    if not ok:
+        raise ValueError(f"{name} must be {what}{f' ({note})' if note else ''}, not {_show(value)}")
+    return int(v) if integer else float(v)
+
+
+def check_flag(name: str, value) -> bool:
+    """``value`` (a bool or a numpy bool) as a bool, or a ``ValueError`` naming ``name``: a string
+    such as ``"no"`` would read as True."""
+    v = _scalar(value)
+    if not isinstance(v, bool):
+        raise ValueError(f"{name} must be True or False, not {_show(value)}")
+    return v
+
+
+def check_choice(name: str, value, choices) -> str | None:
+    """``value`` if it is one of ``choices`` (strings, and None where None is a choice), else a
+    ``ValueError`` naming ``name`` and the choices."""
+    if (value is None or isinstance(value, str)) and value in choices:
+        return value
+    names = [repr(c) for c in choices]
+    raise ValueError(f"{name} must be {', '.join(names[:-1])} or {names[-1]}, not {_show(value)}"
+                     + (did_you_mean(value, [c for c in choices if c is not None]) if isinstance(value, str) else ""))
+
+
+def check_options(options, keys) -> dict:
+    """``reset``'s ``options`` (None or a mapping whose keys are among ``keys``) as a dict, or a
+    ``ValueError`` naming ``options`` (and the unknown key) with the valid keys."""
+    valid = ", ".join(repr(k) for k in keys)
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise ValueError(f"options must be a dict (keys {valid}) or None, not {_show(options)}")
+    for k in options:
+        if k not in keys:
+            raise ValueError(f"options has an unknown key {_show(k)}"
+                             f"{did_you_mean(k, keys) if isinstance(k, str) else ''}; valid keys: {valid}")
+    return dict(options)
+
+
+def check_action(space: gym.spaces.Discrete, action) -> int:
+    """``action`` as the int it is, if ``space`` (a ``Discrete``) contains it, else a ``ValueError``
+    naming ``action`` and the range. As ``space.contains``: a Python int, a numpy integer or a 0-d
+    integer array; unlike it, never a ``bool`` (``True`` is an int to Python, but an agent that
+    answers a bool has a bug, not an action) and never an int too big for int64 (it overflows in
+    ``contains``)."""
+    a = _scalar(action)
+    lo, hi = int(space.start), int(space.start) + int(space.n) - 1
+    if not (isinstance(a, int) and not isinstance(a, bool) and lo <= a <= hi):
+        raise ValueError(f"action must be an integer from {lo} to {hi} (the action space, Discrete({space.n}); "
+                         f"info['action_mask'] marks those valid now), not {_show(action)}")
+    return a
 
 
 def window(a: np.ndarray, r: int, c: int, radius: int, out: np.ndarray) -> np.ndarray:
@@ -173,17 +282,19 @@ class SearchEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
     kind = ""
+    reset_keys: tuple = ("episode", "repeat")  # the keys reset(options=) takes
     env_name = ""  # the id: semsearch/<env_name>-v0
     shipped: dict = {}  # building -> a shipped config: semsearch/<env_name>-<building>-v0
 
     def __init__(self, scenario: str | Path, action_mode: str = "macro", observation_mode: str = "dict",
                  render_mode: str | None = None, success_bonus: float = SUCCESS_BONUS):
-        if action_mode not in ("macro", "primitive"):
-            raise ValueError(f"action_mode must be 'macro' or 'primitive', not {action_mode!r}")
-        if observation_mode not in ("dict", "text"):
-            raise ValueError(f"observation_mode must be 'dict' or 'text', not {observation_mode!r}")
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None")
+        if not isinstance(scenario, (str, os.PathLike)):
+            raise ValueError(f"scenario must be a scenario file's path or a shipped scenario's name, not {_show(scenario)}")
+        check_choice("action_mode", action_mode, ("macro", "primitive"))
+        check_choice("observation_mode", observation_mode, ("dict", "text"))
+        check_choice("render_mode", render_mode, (*self.metadata["render_modes"], None))
+        # a bonus below 0 would punish finding the target; 1e6 is past any building's metres
+        success_bonus = check_number("success_bonus", success_bonus, 0.0, BIG)
         self._init_args = dict(scenario=scenario, action_mode=action_mode, observation_mode=observation_mode,
                                render_mode=render_mode, success_bonus=success_bonus)
         self.scenario = scenario
@@ -197,15 +308,16 @@ class SearchEnv(gym.Env):
 
     # ---- gymnasium --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        seed = None if seed is None else check_number("seed", seed, 0, integer=True)
+        options = check_options(options, self.reset_keys)
         super().reset(seed=seed)
-        options = options or {}
         eps = self.task.episodes
         k = options.get("episode")
-        k = int(self.np_random.integers(len(eps))) if k is None else int(k)
-        if not 0 <= k < len(eps):
-            raise ValueError(f"options['episode'] = {k}: the scenario has episodes 0..{len(eps) - 1}")
+        k = int(self.np_random.integers(len(eps))) if k is None else check_number(
+            "options['episode']", k, 0, len(eps) - 1, integer=True, note=f"the scenario has {len(eps)} episodes")
         s = options.get("repeat")
-        self.repeat = int(self.np_random.integers(2**31 - 1)) if s is None else int(s)
+        self.repeat = int(self.np_random.integers(2**31 - 1)) if s is None else check_number(
+            "options['repeat']", s, 0, MAX_REPEAT, integer=True)
         self.episode = eps[k]
         self.outcome = None
         self._reset_options = {"episode": k, "repeat": self.repeat}
@@ -226,6 +338,7 @@ class SearchEnv(gym.Env):
             raise RuntimeError("call reset() before step()")
         if self.outcome is not None:
             raise RuntimeError(f"the episode has ended ({self.outcome}); call reset()")
+        action = check_action(self.action_space, action)
         self._actions.append(action)
         s0 = self.state.steps
         if self._ended_at_reset is not None:

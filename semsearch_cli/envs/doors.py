@@ -40,6 +40,15 @@ agents: positions and angles in the world frame (x east, y north; degrees counte
 east), the choices numbered ``[n]``, and a last line that names exactly the actions the mask
 allows. ``render_mode="rgb_array"`` draws the belief and the path (north up). ``max_distance`` (m)
 replaces the scenario's budget, e.g. for shorter training episodes.
+
+Arguments and their ranges (anything else is a ``ValueError`` naming the argument, see
+:mod:`~semsearch_cli.envs.base`): ``window`` R, an integer 0..2048 (``MAX_WINDOW``: a window of
+4097 cells a side, 410 m at 0.1 m cells, holds the whole Hotel from any pose; each of its grids is
+16 MB); ``max_candidates`` K, 1..254 (the ``candidates`` grid holds k + 1 in a uint8);
+``max_signs`` S, 1..10,000 (``MAX_SIGNS``, far more signs than a building has);
+``replan_on_signs`` a bool; ``max_distance`` None or above 0 and at most 1e6 m (as the scenario's
+``experiment.max_distance``); ``success_bonus`` 0..1e6. Actions: an integer of the action space
+(macro 0..K, primitive 0..9).
 """
 
 from __future__ import annotations
@@ -55,8 +64,15 @@ from ..planners import Decision
 from ..tasks.doors import MAX_RETRIES, DoorSearch
 from ..tasks.loop import Stepper
 from ..world.labels import parse_label
-from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, clip_text, compass_moves, compass_step, deg, text_space,
-                   window)
+from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, check_flag, check_number, clip_text, compass_moves,
+                   compass_step, deg, text_space, window)
+
+# The largest window radius (cells). 2048 gives a window of 4097 cells a side (410 m at 0.1 m
+# cells: the whole Hotel, 133 m x 70 m, from any pose); each uint8 grid of it is 16 MB and an
+# observation holds three. A radius of 10**6 asked for 3.6 TiB.
+MAX_WINDOW = 2048
+MAX_CANDIDATES = 254  # the candidates grid holds k + 1 (1..K) in a uint8
+MAX_SIGNS = 10_000  # rows of the signs observation: far more than a building has (the Hotel's layout at twice the scale: 469)
 
 
 class _Agent:
@@ -82,16 +98,19 @@ class DoorSearchEnv(SearchEnv):
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
                  success_bonus: float = 100.0, window: int = 32, max_candidates: int = 64, max_signs: int = 32,
                  replan_on_signs: bool = True, max_distance: float | None = None):
+        # checked before the scenario loads: a bad argument is named at once
+        window = check_number("window", window, 0, MAX_WINDOW, integer=True, note="cells; the window is 2 window + 1 a side")
+        max_candidates = check_number("max_candidates", max_candidates, 1, MAX_CANDIDATES, integer=True)
+        max_signs = check_number("max_signs", max_signs, 1, MAX_SIGNS, integer=True)
+        replan_on_signs = check_flag("replan_on_signs", replan_on_signs)
+        if max_distance is not None:  # as the scenario's experiment.max_distance
+            max_distance = check_number("max_distance", max_distance, 0.0, BIG, above=True, unit="m", note="or None")
         super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
         self._init_args.update(window=window, max_candidates=max_candidates, max_signs=max_signs,
                                replan_on_signs=replan_on_signs, max_distance=max_distance)
-        if max_distance is not None and not max_distance > 0:
-            raise ValueError("max_distance must be positive (m)")
         self.max_distance = max_distance
-        if not 1 <= max_candidates <= 254:
-            raise ValueError("max_candidates must lie in 1..254")
-        self.R, self.K, self.S = int(window), int(max_candidates), int(max_signs)
-        self.replan_on_signs = bool(replan_on_signs)
+        self.R, self.K, self.S = window, max_candidates, max_signs
+        self.replan_on_signs = replan_on_signs
         self.sweep_action = self.K
         n = 2 * self.R + 1
         grid = gym.spaces.Box(0, 2, (n, n), np.uint8)
@@ -170,7 +189,7 @@ class DoorSearchEnv(SearchEnv):
     def _act(self, action):
         st = self.state
         d0 = st.distance
-        a = int(action)
+        a = action  # an int of the action space (SearchEnv.step checked it)
         if self.action_mode == "primitive":
             return self._primitive(a), self._primitive_outcome()
         ctx, cands = self.decision

@@ -5,6 +5,15 @@ takes ``options["building"]``), generates that building as ``semsearch generate 
 LAYOUT --numbering NUMBERING --seed SEED --spacing SPACING`` would (into a folder of this process,
 once per seed), and draws an episode of it: its four goals spread by distance, from its start, a
 random heading. Training on one range of seeds and evaluating on another holds buildings out.
+
+Arguments and their ranges (anything else is a ``ValueError`` naming the argument; the door
+search's own, ``window`` and the rest, as :mod:`~semsearch_cli.envs.doors`): ``layout`` and
+``numbering`` as ``semsearch generate building`` takes them; ``first_building`` an integer
+0..2^32-1 and ``buildings`` 1..2^32 - ``first_building`` (the seeds ``--seed`` takes);
+``spacing`` 0.5..50 m (as ``--spacing``). ``options["building"]`` names a seed of this
+environment's range, ``first_building .. first_building + buildings - 1``: a building outside it
+(one held out) is refused, never run by a training environment without a word; make an environment
+with that ``first_building`` to run it.
 """
 
 from __future__ import annotations
@@ -17,8 +26,11 @@ from pathlib import Path
 from gymnasium.utils import seeding
 
 from ..world.buildings.numbered import LAYOUTS, SCHEMES, generate_building
-from .base import load_task
+from .base import check_choice, check_number, check_options, load_task
 from .doors import DoorSearchEnv
+
+MAX_SEED = 2**32 - 1  # the largest building seed, as `semsearch generate building --seed`
+SPACING = (0.5, 50.0)  # m between door slots, as `semsearch generate building --spacing` (0 divided by zero)
 
 _FOLDER: tempfile.TemporaryDirectory | None = None
 
@@ -28,7 +40,7 @@ def building(layout: str, numbering: str, seed: int, spacing: float) -> Path:
     global _FOLDER
     if _FOLDER is None:
         _FOLDER = tempfile.TemporaryDirectory(prefix="semsearch-buildings-")
-    out = Path(_FOLDER.name) / f"{layout}-{numbering}-{seed}-{spacing:g}"
+    out = Path(_FOLDER.name) / f"{layout}-{numbering}-{seed}-{spacing!r}"  # not :g, which wrote 3 for 3.0000001
     if not (out / "scenario.yaml").is_file():
         # written aside and renamed into place: processes forked from one parent share the
         # folder, and one must never read a building another is still writing
@@ -44,16 +56,21 @@ def building(layout: str, numbering: str, seed: int, spacing: float) -> Path:
 class GeneratedDoorSearchEnv(DoorSearchEnv):
     """:class:`DoorSearchEnv` over generated buildings (see the module docstring)."""
 
+    reset_keys = ("building", "episode", "repeat")
+
     def __init__(self, layout: str = "wings", numbering: str = "odd-even-out", buildings: int = 100,
                  first_building: int = 0, spacing: float = 3.0, **kwargs):
-        if layout not in LAYOUTS:
-            raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, not {layout!r}")
-        if numbering not in SCHEMES:
-            raise ValueError(f"numbering must be one of {', '.join(SCHEMES)}, not {numbering!r}")
-        if buildings < 1 or first_building < 0:
-            raise ValueError("buildings must be at least 1 and first_building at least 0")
-        self.layout, self.numbering, self.buildings, self.first, self.spacing = layout, numbering, int(buildings), int(first_building), spacing
-        kwargs.pop("scenario", None)
+        check_choice("layout", layout, LAYOUTS)
+        check_choice("numbering", numbering, SCHEMES)
+        first_building = check_number("first_building", first_building, 0, MAX_SEED, integer=True)
+        buildings = check_number("buildings", buildings, 1, MAX_SEED + 1 - first_building, integer=True,
+                                 note=f"seeds {first_building} onwards, at most {MAX_SEED}")
+        spacing = check_number("spacing", spacing, *SPACING, unit="m")
+        self.layout, self.numbering, self.spacing = layout, numbering, spacing
+        self.buildings, self.first = buildings, first_building
+        if "scenario" in kwargs:  # was dropped without a word
+            raise ValueError("scenario: DoorSearch-Generated-v0 generates its buildings (layout, numbering, buildings, "
+                             "first_building, spacing); run a scenario file with semsearch/DoorSearch-v0")
         super().__init__(building(layout, numbering, self.first, spacing), **kwargs)
         self._init_args = {k: v for k, v in self._init_args.items() if k != "scenario"}
         self._init_args.update(layout=layout, numbering=numbering, buildings=buildings, first_building=first_building,
@@ -61,11 +78,14 @@ class GeneratedDoorSearchEnv(DoorSearchEnv):
         self.building_seed = self.first
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        options = check_options(options, self.reset_keys)
         if seed is not None:  # seed the generator here: the building is drawn before the episode
+            seed = check_number("seed", seed, 0, integer=True)
             self._np_random, self._np_random_seed = seeding.np_random(seed)
-        options = dict(options or {})
         b = options.pop("building", None)
-        self.building_seed = self.first + int(self.np_random.integers(self.buildings)) if b is None else int(b)
+        last = self.first + self.buildings - 1
+        self.building_seed = self.first + int(self.np_random.integers(self.buildings)) if b is None else check_number(
+            "options['building']", b, self.first, last, integer=True, note="this environment's buildings")
         self.bind(load_task(building(self.layout, self.numbering, self.building_seed, self.spacing), self.kind))
         obs, info = super().reset(options=options)
         self._reset_options = {**self._reset_options, "building": self.building_seed}

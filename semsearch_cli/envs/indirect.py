@@ -31,6 +31,11 @@ Observation (``observation_mode="dict"``)
 
 ``observation_mode="text"`` renders the same as a short text (the five likeliest cells of A);
 ``render_mode="rgb_array"`` draws the belief, the objects detected and the path.
+
+Arguments and their ranges (anything else is a ``ValueError`` naming the argument, see
+:mod:`~semsearch_cli.envs.base`): ``masks`` ``"soft"``, ``"hard"`` or None; ``negative`` a bool;
+``lattice`` 0.05..5 m; ``success_bonus`` 0..1e6. Actions: an integer of the action space (macro
+0..8N-1, primitive 0..3); -1 is refused, not read as the last lattice point.
 """
 
 from __future__ import annotations
@@ -45,7 +50,8 @@ from ..geometry import wrap_angle
 from ..planners import Goal
 from ..tasks.indirect import IndirectSearch
 from ..tasks.loop import Stepper
-from .base import BIG, FRAME_TEXT, TWO_PI, SearchEnv, answer_line, box, clip_text, deg, text_space
+from .base import (BIG, FRAME_TEXT, TWO_PI, SearchEnv, answer_line, box, check_choice, check_flag, check_number, clip_text,
+                   deg, text_space)
 
 HEADINGS = np.radians(np.arange(0, 360, 45))
 
@@ -75,15 +81,15 @@ class IndirectSearchEnv(SearchEnv):
 
     def __init__(self, scenario, action_mode: str = "macro", observation_mode: str = "dict", render_mode=None,
                  success_bonus: float = 100.0, masks: str | None = "soft", negative: bool = True, lattice: float = 0.5):
+        # checked before the scenario loads: a bad argument is named at once
+        masks = check_choice("masks", masks, ("soft", "hard", None))
+        negative = check_flag("negative", negative)
+        lattice = check_number("lattice", lattice, 0.05, 5.0, unit="m")
         super().__init__(scenario, action_mode, observation_mode, render_mode, success_bonus)
-        if masks not in ("soft", "hard", None):
-            raise ValueError(f"masks must be 'soft', 'hard' or None, not {masks!r}")
-        if not 0.05 <= lattice <= 5.0:
-            raise ValueError("lattice must lie in 0.05..5 m")
         self._init_args.update(masks=masks, negative=negative, lattice=lattice)
         t = self.task
-        self.masks, self.negative = masks, bool(negative) and masks is not None
-        self.lattice = float(lattice)
+        self.masks, self.negative = masks, negative and masks is not None
+        self.lattice = lattice
         self.secondary = list(t.spec.secondary)
         w, h = t.grids[0].room.size
         self.lx = np.arange(lattice / 2, w, lattice)
@@ -123,7 +129,7 @@ class IndirectSearchEnv(SearchEnv):
     def _act(self, action):
         st = self.state
         d0 = st.distance
-        a = int(action)
+        a = action  # an int of the action space (SearchEnv.step checked it)
         if self.action_mode == "primitive":
             spec = self.task.spec
             dt = 1.0 / spec.camera.fps

@@ -26,6 +26,10 @@ Observation (``observation_mode="dict"``)
 
 ``observation_mode="text"`` renders the same as a short text; ``render_mode="rgb_array"`` draws the
 map, the places (seen ones green) and the path.
+
+Arguments are those every environment takes (``success_bonus`` 0..1e6; anything else is a
+``ValueError`` naming the argument, see :mod:`~semsearch_cli.envs.base`). Actions: an integer of
+the action space (macro 0..P-1, primitive 0..9); -1 or P is refused, not read as a place.
 """
 
 from __future__ import annotations
@@ -108,7 +112,7 @@ class ObjectSearchEnv(SearchEnv):
     def _act(self, action):
         st = self.state
         d0 = st.distance
-        a = int(action)
+        a = action  # an int of the action space (SearchEnv.step checked it)
         if self.action_mode == "primitive":
             moved = compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
             found = self.search.sense(st)[0]

@@ -10,20 +10,33 @@ The planner sees what it sees in the batch (the belief, the pose, every candidat
 becomes the candidate's slot (planners that choose among the frontier candidates: greedy, nsos,
 geometric, draft; bvp picks cells of its own and cannot), so the run is the one ``semsearch run`` records for that episode and
 seed (tests/test_envs.py checks it run for run).
+
+A name that is not a registered door planner is a ``ValueError`` listing the door planners (with
+"did you mean"); a parameter the planner does not take, or out of its range, is its parameters'
+``ValidationError`` (a ``ValueError``) naming the parameter. Calling the policy on anything but a
+macro door-search environment waiting for a choice is a ``ValueError`` naming ``env``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..errors import PlannerError
-from ..planners import Variant
+from ..errors import PlannerError, did_you_mean
+from ..planners import PLANNERS, DoorPlanner, Variant, load_entry_points
+from .doors import DoorSearchEnv
 
 
 class PlannerPolicy:
     """A registered door planner with fixed parameters, answering the macro environment."""
 
     def __init__(self, name: str, **params):
+        if isinstance(name, str) and name not in PLANNERS:
+            load_entry_points()
+        if not (isinstance(name, str) and name in PLANNERS and issubclass(PLANNERS[name], DoorPlanner)):
+            valid = sorted(n for n, c in PLANNERS.items() if issubclass(c, DoorPlanner))
+            near = did_you_mean(name, valid) if isinstance(name, str) else ""
+            raise ValueError(f"name must be a registered door planner{near}, not {repr(name)[:60]}; door planners: "
+                             f"{', '.join(valid)} (semsearch planners lists them with their parameters)")
         self.variant = Variant(name, tuple(sorted(params.items())))
         self.planner = self.variant.build()
 
@@ -37,7 +50,12 @@ class PlannerPolicy:
         self.planner = self.variant.build()
 
     def __call__(self, env) -> int:
-        u = env.unwrapped
+        u = getattr(env, "unwrapped", None)
+        if not isinstance(u, DoorSearchEnv) or u.action_mode != "macro":
+            raise ValueError(f"env must be a door-search environment in the macro action mode (semsearch/DoorSearch-*, "
+                             f"action_mode='macro'), not {str(env)[:80]}")
+        if getattr(u, "decision", None) is None:
+            raise ValueError("env has no choice to make: call env.reset() first (an ended episode asks for none)")
         ctx, cands = u.decision
         dec = self.planner.choose(ctx, cands)
         if dec is None:

@@ -15,25 +15,29 @@ or marked it ``info["kept"] = True``.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import inspect
 import itertools
 import math
+import numbers
 import re
 import sys
 import traceback
+import types
+import typing
 from dataclasses import dataclass, field
 from importlib.metadata import entry_points, packages_distributions, version
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..belief import DoorBelief, Candidates
 from .. import __version__, deprecation
-from ..errors import ScenarioError, did_you_mean
+from ..errors import PlannerError, ScenarioError, did_you_mean
 from ..files import user_file
 from ..provenance import code_hash, files_hash
 from ..registry import Registry
@@ -84,11 +88,69 @@ class DoorContext:
 class Decision:
     """A door planner's choice: the target cell (``row``, ``col``, a free cell of the belief's
     grid) and ``info``, the numbers behind it for traces (any JSON-able values; ``"kept": True``
-    marks a re-plan that keeps the previous target, which is not counted as a decision)."""
+    marks a re-plan that keeps the previous target, which is not counted as a decision).
+
+    ``info`` is checked when the decision is made: a dict, holding no container that holds
+    itself (``info["me"] = info``) and nested at most :data:`MAX_INFO_DEPTH` deep; else a
+    :class:`~semsearch_cli.errors.PlannerError` (the run's ``error``), as no trace could hold it."""
 
     row: int
     col: int
     info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        fault = info_fault(self.info)
+        if fault:
+            raise PlannerError(f"Decision.info {fault}; info is a dict of JSON-able values (numbers, text, lists, "
+                               "dicts) for traces")
+
+
+MAX_INFO_DEPTH = 100  # levels of nesting a decision's info may have (a trace writes it recursively)
+_CONTAINERS = (dict, list, tuple, set, frozenset)
+
+
+def info_fault(info) -> str | None:
+    """What makes ``info`` (a decision's numbers behind it) impossible to write to a trace, in
+    words (``"holds itself: info['me'] is info"``), or None: not a dict, a container that holds
+    itself (anywhere below), or nesting deeper than :data:`MAX_INFO_DEPTH`. A value shared by two
+    keys is fine; the walk is iterative, so a deep ``info`` cannot overflow the stack here."""
+    if not isinstance(info, dict):
+        return f"is {type(info).__name__} {_short(info)}, not a dict"
+    on_path = {id(info): "info"}  # the containers from info down to the one being walked
+    stack = [(info, "info", iter(info.items()))]
+    while stack:
+        obj, where, items = stack[-1]
+        nxt = next(items, None)
+        if nxt is None:
+            on_path.pop(id(obj), None)
+            stack.pop()
+            continue
+        key, child = nxt
+        if not isinstance(child, _CONTAINERS):
+            continue
+        here = f"{where}[{_short(key)}]"
+        if id(child) in on_path:
+            return f"holds itself: {here} is {on_path[id(child)]}"
+        if len(stack) >= MAX_INFO_DEPTH:
+            return f"is nested deeper than {MAX_INFO_DEPTH} levels (at {here})"
+        on_path[id(child)] = here
+        stack.append((child, here, iter(child.items() if isinstance(child, dict) else enumerate(child))))
+    return None
+
+
+def _short(v, n: int = 40) -> str:
+    """``v`` as a message shows it: its repr cut to ``n`` characters (a class by its name, a
+    container by its type and length, so that one holding itself prints)."""
+    if isinstance(v, type):
+        r = v.__qualname__
+    elif isinstance(v, _CONTAINERS):
+        r = f"<{type(v).__name__} of {len(v)}>"
+    else:
+        try:
+            r = repr(v)
+        except Exception:
+            r = f"<{type(v).__name__}>"
+    return r if len(r) <= n else r[: n - 3] + "..."
 
 
 class Planner:
@@ -99,12 +161,14 @@ class Planner:
     Class attributes: ``Params`` (a pydantic model of the planner's parameters, checked when the
     scenario is loaded), ``task`` (the kind of search it answers), ``rank``, ``baseline``,
     ``swept`` and ``replay`` (how reports order, compare and replay it; see the attributes below).
+    :func:`register_planner` checks them, and those a kind's protocol adds, when the class
+    registers (:func:`check_planner_class`).
     """
 
     name: ClassVar[str] = ""
     task: ClassVar[str] = ""  # which kind of scenario the planner answers (a task's planner_kind)
     Params: ClassVar[type[BaseModel]] = NoParams
-    rank: ClassVar[int] = 100  # where reports list it among its kind's planners (lower first; then by name)
+    rank: ClassVar[float] = 100  # where reports list it among its kind's planners (lower first; then by name)
     baseline: ClassVar[bool] = False  # reports compare the other planners with this one, paired
     swept: ClassVar[str | None] = None  # the parameter `semsearch sweep-alpha` sweeps (and reports plot against)
     replay: ClassVar[bool] = False  # the planner a report replays by default (else the last in report order)
@@ -144,9 +208,179 @@ def register_planner(name: str):
                 raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search; subclass DoorPlanner (door "
                                 "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
             cls = _as_door_planner(cls)
+        if isinstance(cls, type) and issubclass(cls, Planner):
+            check_planner_class(cls)
         return PLANNERS.add(name, cls)
 
     return deco
+
+
+def check_planner_class(cls: type[Planner]) -> None:
+    """Refuse, when it registers, a planner class whose class attributes the simulator, the
+    planner list or a report would trip over later (after a whole batch, for a report): a
+    :class:`ScenarioError` naming the class's file, ``Class.attribute`` and the line that sets it.
+
+    - ``Params``: a pydantic model (a subclass of ``pydantic.BaseModel``) that builds from its
+      defaults when every parameter has one (a validator that raises is caught here);
+    - every class attribute a kind's protocol declares (``ClassVar`` annotations of
+      :class:`Planner`, :class:`DoorPlanner`, ``ObjectPlanner``, ``IndirectPlanner``) of the type
+      it declares: ``task`` text, ``rank`` a finite number, ``baseline`` and ``replay`` True or
+      False, ``masks`` text or None, ...;
+    - ``swept``: None or the name of a parameter whose default is a finite number (reports plot
+      against it, and read it from a label that does not set it);
+    - ``__doc__`` (the planner list's description): None or text.
+    """
+    params = cls.Params
+    if not (isinstance(params, type) and issubclass(params, BaseModel)):
+        _refuse(cls, "Params", f"Params = {_short(params)}: give a pydantic model of the planner's parameters (class "
+                "Params(BaseModel) with one annotated field per parameter, or leave it out for none)")
+    for attr, hint in _declared(cls).items():
+        value = getattr(cls, attr)
+        expected = _type_fault(value, hint)
+        if expected:
+            _refuse(cls, attr, f"{attr} = {_short(value)}: expected {expected}")
+    doc = cls.__doc__
+    if doc is not None and not isinstance(doc, str):
+        _refuse(cls, "__doc__", f"__doc__ = {_short(doc)}: a planner's description (what `semsearch planners` lists) is "
+                "text (its docstring) or None")
+    fields = params.model_fields
+    if all(not f.is_required() for f in fields.values()):
+        # the defaults, validated (pydantic takes a default as it is: a run would use one that
+        # breaks its own field's bounds, and a validator that raises, unseen until a scenario sets it)
+        defaults = {f.alias or k: f.default for k, f in fields.items() if f.default_factory is None}
+        try:
+            params.model_validate(defaults)
+        except ValidationError as exc:
+            e = exc.errors()[0]
+            _refuse(cls, "Params", f"its parameters' defaults are not valid ({'.'.join(map(str, e['loc']))}: {e['msg']})")
+        except (Exception, SystemExit) as exc:
+            file, _ = _source(cls)
+            line = _user_line(exc, file)
+            _refuse(cls, "Params", f"building its parameters from their defaults raised {type(exc).__name__}: {exc}",
+                    line)
+    if cls.swept is not None:
+        numeric = [k for k, f in fields.items() if _finite_number(f.default)]
+        if cls.swept not in fields:
+            _refuse(cls, "swept", f"swept = {cls.swept!r} names no parameter of the planner{did_you_mean(cls.swept, numeric)}; "
+                    + (f"give one whose default is a number ({', '.join(numeric)}) or None" if numeric else
+                       "none has a number as its default: leave swept None"))
+        if not _finite_number(fields[cls.swept].default):
+            _refuse(cls, "swept", f"swept = {cls.swept!r}, whose default is {fields[cls.swept].default!r}: the swept "
+                    "parameter needs a default that is a finite number (reports place a label that does not set it "
+                    "at that value)")
+
+
+def _finite_number(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _type_fault(value, hint) -> str | None:
+    """What ``value`` should have been, in words, when it is not of type ``hint`` (a class
+    attribute's declared type: bool, int, float, str, None, a Literal, or a union of them);
+    None when it is, or when ``hint`` is a type not checked here."""
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin in (typing.Union, types.UnionType):
+        faults = [_type_fault(value, a) for a in args]
+        if any(f is None for f in faults):
+            return None
+        return " or ".join(faults)
+    if origin is Literal:
+        return None if value in args else "one of " + ", ".join(repr(a) for a in args)
+    if hint is type(None):
+        return None if value is None else "None"
+    if hint is bool:
+        return None if isinstance(value, (bool, np.bool_)) else "True or False"
+    if hint in (int, float):
+        return None if _finite_number(value) and (hint is float or float(value).is_integer()) else (
+            "a finite number" if hint is float else "a whole number")
+    if hint is str:
+        return None if isinstance(value, str) else "text"
+    return None
+
+
+@functools.cache
+def _protocol_hints(base: type) -> dict:
+    """The class attributes ``base`` (one of semsearch's planner classes) declares, with types."""
+    try:
+        hints = typing.get_type_hints(base)
+    except Exception:  # an annotation that does not resolve: nothing to check against
+        return {}
+    return {k: typing.get_args(h)[0] for k, h in hints.items() if typing.get_origin(h) is ClassVar and typing.get_args(h)}
+
+
+def _declared(cls: type) -> dict:
+    """attribute -> declared type, over the semsearch planner classes ``cls`` derives from
+    (``Params`` and ``name`` are checked apart: a model, and the name the registry sets)."""
+    out: dict = {}
+    for base in reversed(cls.__mro__):
+        if issubclass(base, Planner) and base.__module__.startswith("semsearch_cli."):
+            out.update(_protocol_hints(base))
+    out.pop("Params", None)
+    out.pop("name", None)
+    return out
+
+
+def _source(cls: type) -> tuple[str, int | None]:
+    """(the file that defines ``cls``, the line of its ``class`` statement), the line None when
+    the source cannot be found (a class made by ``type()``, or in an interactive session)."""
+    module = sys.modules.get(cls.__module__)
+    file = getattr(module, "__file__", None) or f"module {cls.__module__}"
+    try:
+        lines, start = inspect.getsourcelines(cls)
+    except (OSError, TypeError):
+        return file, None
+    head = re.compile(rf"\s*class\s+{re.escape(cls.__name__)}\b")
+    return file, next((start + i for i, text in enumerate(lines) if head.match(text)), start)
+
+
+def _attribute_line(cls: type, attr: str) -> int | None:
+    """The line that sets ``attr`` in ``cls``'s own body (``attr = ...``, ``class attr``, ``def
+    attr``), else the line of the class statement (an attribute it inherits)."""
+    _, line = _source(cls)
+    if line is None or attr not in vars(cls):
+        return line
+    lines, start = inspect.getsourcelines(cls)
+    sets = re.compile(rf"\s+(?:(?:class|def)\s+{re.escape(attr)}\b|{re.escape(attr)}\s*(?::[^=]*)?=(?!=))")
+    return next((start + i for i, text in enumerate(lines) if start + i > line and sets.match(text)), line)
+
+
+def _refuse(cls: type, attr: str, message: str, line: int | None = None) -> None:
+    """Raise the :class:`ScenarioError` of a planner class's bad attribute: its file, the field
+    ``Class.attr``, and ``line N of FILE`` (``line``, else the line that sets it)."""
+    file, _ = _source(cls)
+    line = line if line is not None else _attribute_line(cls, attr)
+    where = f"line {line} of {Path(file).name}, " if line is not None else ""
+    raise ScenarioError(file, f"{cls.__name__}.{attr}", f"{where}planner class {cls.__name__}: {message}")
+
+
+def _same_file(a: str, b: str) -> bool:
+    if a == b:
+        return True
+    try:
+        return Path(a).resolve() == Path(b).resolve()
+    except (OSError, RuntimeError, ValueError):
+        return False
+
+
+def _user_line(exc: BaseException, file: str) -> int | None:
+    """The line of ``file`` (a user's planner file) in ``exc``'s traceback nearest to where it
+    was raised: the last frame in that file, not one of semsearch's own code or a library's."""
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if _same_file(f.filename, file)]
+    return frames[-1].lineno if frames else None
+
+
+def _raised_in(exc: BaseException, file: str) -> str:
+    """`` (raised at line N of OTHER)`` when ``exc`` was raised in a file other than ``file``
+    that is the user's too (a module the planner file imports), not semsearch's, Python's or an
+    installed library's; else ``""``."""
+    frames = traceback.extract_tb(exc.__traceback__)
+    if not frames:
+        return ""
+    last = frames[-1]
+    not_users = (str(Path(__file__).resolve().parents[1]), sys.prefix, sys.base_prefix, sys.exec_prefix, "<")
+    if _same_file(last.filename, file) or last.filename.startswith(not_users):
+        return ""
+    return f" (raised at line {last.lineno} of {last.filename})"
 
 
 def _as_door_planner(cls: type[Planner]) -> type[DoorPlanner]:
@@ -176,6 +410,8 @@ def load_entry_points() -> None:
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         try:
             ep.load()
+        except ScenarioError:  # a planner class refused when it registered: names its file and line
+            raise
         except Exception as exc:
             raise ScenarioError(f"entry point {ep.name} = {ep.value}", ENTRY_POINT_GROUP,
                                 f"the planner package failed to load: {type(exc).__name__}: {exc}") from None
@@ -183,27 +419,46 @@ def load_entry_points() -> None:
 
 def load_planner_file(path: str | Path) -> list[str]:
     """Import a user's planner file (once per process) and return the planner names it
-    registered. A broken file (it raises, it registers nothing, it reuses a registered name)
-    is a :class:`ScenarioError` naming the file."""
+    registered. A broken file (it raises, it registers nothing, it reuses a registered name, a
+    class it registers is refused by :func:`check_planner_class`) is a :class:`ScenarioError`
+    naming the file and the line of it where things went wrong (the last line of the file in
+    the traceback, not a line of semsearch's own code); the planners it registered before are
+    forgotten, so that loading it again says the same."""
     path = Path(path).resolve()
     key = str(path)
     if key in _LOADED_FILES:
         return _LOADED_FILES[key]
     user_file(path, "planner file")
+    if path.suffix != ".py":  # a planner file is Python source, wherever it lies (docs/usage.md, Paths)
+        raise ScenarioError(key, "", "not a planner file: give a Python file whose name ends in .py")
     mod_name = f"semsearch_user_planners.{path.stem}_{hashlib.sha1(key.encode()).hexdigest()[:8]}"
     spec = importlib.util.spec_from_file_location(mod_name, path)
     module = importlib.util.module_from_spec(spec)
     before = set(PLANNERS)
     sys.modules[mod_name] = module
+
+    def forget():
+        sys.modules.pop(mod_name, None)
+        for n in set(PLANNERS) - before:
+            del PLANNERS[n]
+
     try:
         spec.loader.exec_module(module)
+    except ScenarioError:  # a class refused when it registered: the error names its file and line
+        forget()
+        raise
     except SyntaxError as exc:
-        del sys.modules[mod_name]
-        raise ScenarioError(key, f"line {exc.lineno}", f"not valid Python: {exc.msg}") from None
+        forget()
+        if exc.filename is None or _same_file(exc.filename, key):
+            raise ScenarioError(key, f"line {exc.lineno}", f"not valid Python: {exc.msg}") from None
+        line = _user_line(exc, key)  # a module the file imports
+        raise ScenarioError(key, f"line {line}" if line is not None else "", f"imports a file that is not valid "
+                            f"Python: {exc.msg} (line {exc.lineno} of {exc.filename})") from None
     except (Exception, SystemExit) as exc:  # sys.exit() at import too: exit 2, naming the file
-        del sys.modules[mod_name]
-        line = traceback.extract_tb(exc.__traceback__)[-1].lineno
-        raise ScenarioError(key, f"line {line}", f"the planner file raised {type(exc).__name__}: {exc}") from None
+        forget()
+        line = _user_line(exc, key)
+        raise ScenarioError(key, f"line {line}" if line is not None else "",
+                            f"the planner file raised {type(exc).__name__}: {exc}{_raised_in(exc, key)}") from None
     names = [n for n in PLANNERS if n not in before]
     if not names:
         raise ScenarioError(key, "", "registers no planner: decorate a Planner subclass with "
@@ -280,6 +535,9 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
         module = None
         if spec.module is not None:
             module = str(((base or Path(".")) / spec.module).resolve())
+            if not module.endswith(".py"):
+                raise ScenarioError(file, f"planners[{i}].module", f"{spec.module} is not a planner file: give a Python file "
+                                    "whose name ends in .py (relative to the scenario's folder)")
             names = load_planner_file(module)
             if name not in names:
                 raise ScenarioError(file, f"planners[{i}].name", f"{module} registers {', '.join(names)}, not {name!r}")
@@ -313,6 +571,13 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                                         f"{did_you_mean(loc, PLANNERS[name].Params.model_fields)}; "
                                         f"{_parameters(PLANNERS[name])}") from None
                 raise ScenarioError(file, f"planners[{i}].{loc}", e["msg"]) from None
+            except (Exception, SystemExit) as exc:  # a validator of the planner's that raises something else
+                src, _ = _source(PLANNERS[name])
+                line = _user_line(exc, src)
+                at = f" (line {line} of {src})" if line is not None else ""
+                raise ScenarioError(file, f"planners[{i}]", f"planner {name!r} with "
+                                    f"{', '.join(f'{k}={v!r}' for k, v in p) or 'its defaults'}: its Params raised "
+                                    f"{type(exc).__name__}: {exc}{at}") from None
             v = Variant(name, p, module)
             key = (v.label, module)  # rows name a variant by its label; a set keeps a big sweep linear
             if key not in seen:

@@ -23,7 +23,7 @@ from .. import __version__
 from .. import provenance
 from ..errors import ScenarioError
 from ..planners import code_of
-from ..files import read_user_text
+from ..files import check_outputs, read_user_text
 from ..runner import Loaded, read_runs, run_rows
 from ..tasks.episodes import set_hash
 from . import doors, objects, chain, indirect  # noqa: F401  (each registers its section)
@@ -46,10 +46,13 @@ class ReplayChoice:
     seed: int
 
 
+_WHOLE = re.compile(r"[0-9]{1,18}", re.ASCII)  # an episode or a seed: ASCII digits, 64-bit (never ², never --1)
+
+
 def parse_replay(text: str) -> ReplayChoice:
     """``PLANNER,GOAL,EPISODE,SEED`` (split from the right: a planner label may hold commas)."""
     parts = [p.strip() for p in str(text).rsplit(",", 3)]
-    if len(parts) != 4 or not all(parts) or not parts[2].isdigit() or not parts[3].lstrip("-").isdigit():
+    if len(parts) != 4 or not all(parts) or not _WHOLE.fullmatch(parts[2]) or not _WHOLE.fullmatch(parts[3]):
         raise ScenarioError("<command line>", "--replay", f"expected PLANNER,GOAL,EPISODE,SEED with whole numbers for "
                             f"the episode and the seed (e.g. greedy,76,0,3), got {text!r}")
     return ReplayChoice(parts[0], parts[1], int(parts[2]), int(parts[3]))
@@ -269,6 +272,7 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     if isinstance(replay, ReplayChoice):
         check_replay(replay, parts_by_kind)
     out.mkdir(parents=True, exist_ok=True)
+    check_outputs(out, ("report.md", "report.html"), ("tables", "figures"))
     (out / "tables").mkdir(exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)
     formats = set(formats)

@@ -526,7 +526,8 @@ def budget_curve(runs: pd.DataFrame, budgets=None, confidence: float = 0.95) -> 
     A run succeeds at budget ``b`` (m) when it found the goal (``success`` 1) and travelled
     ``distance_m <= b``: the share of runs that would have succeeded had the search been cut off
     at ``b``. The interval is :func:`.stats.rate_ci` over :func:`.stats.units` (taken over all the
-    goal's rows, so every planner of a goal has the same kind of unit).
+    goal's rows, so every planner of a goal has the same kind of unit), computed for all budgets at
+    once (:func:`.stats.rate_ci_by_budget`).
 
     Parameters
     ----------
@@ -551,13 +552,11 @@ def budget_curve(runs: pd.DataFrame, budgets=None, confidence: float = 0.95) -> 
         grid = np.unique(np.r_[0.0, dist[found], np.nanmax(dist, initial=0.0)]) if budgets is None else np.sort(np.asarray(budgets, float))
         for lab in planner_order(g["planner"]):
             m = (g["planner"] == lab).to_numpy()
-            u = unit.to_numpy()[m]
-            for b in grid:
-                ok = (found[m] & (dist[m] <= b)).astype(float)
-                rate, lo, hi = stats.rate_ci(ok, u, confidence)
-                out.append({"goal": goal, "planner": lab, "budget_m": float(b), "n": int(m.sum()), "successes": int(ok.sum()),
-                            "rate": rate, "lo": lo, "hi": hi})
-    return pd.DataFrame(out, columns=["goal", "planner", "budget_m", "n", "successes", "rate", "lo", "hi"])
+            r = stats.rate_ci_by_budget(found[m], dist[m], unit.to_numpy()[m], grid, confidence)
+            out.append(pd.DataFrame({"goal": [goal] * len(grid), "planner": lab, "budget_m": grid.astype(float),
+                                     "n": int(m.sum()), **r}))
+    cols = ["goal", "planner", "budget_m", "n", "successes", "rate", "lo", "hi"]
+    return pd.concat(out, ignore_index=True)[cols] if out else pd.DataFrame(columns=cols)
 
 
 BUDGET_PAD = 0.08  # the budget axis runs this share past the longest run
@@ -566,7 +565,14 @@ BUDGET_PAD = 0.08  # the budget axis runs this share past the longest run
 def budget_limit(longest: float) -> float:
     """The right end of a budget axis whose longest run is ``longest`` m: a little past it, so
     that a last step (the longest run finding the goal) shows as a level, not as the frame."""
-    return longest * (1 + BUDGET_PAD) if longest > 0 else 1.0
+    return longest * (1 + BUDGET_PAD) if np.isfinite(longest) and longest > 0 else 1.0
+
+
+def _no_finite(ax, y: float | None = None) -> None:
+    """Say on ``ax`` that its data has no finite distance (in its middle, or at data height ``y``)."""
+    at = (0.5, 0.5, ax.transAxes) if y is None else (0.02, y, blended_transform_factory(ax.transAxes, ax.transData))
+    ax.text(at[0], at[1], "no finite distance", transform=at[2], ha="center" if y is None else "left", va="center",
+            fontsize=7, color="0.3")
 
 
 def _to_limit(e: pd.DataFrame, right: float) -> pd.DataFrame:
@@ -593,9 +599,14 @@ def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), c
                              sharey=True, layout="constrained")
     for r, g in enumerate(goals):
         d = curve[curve["goal"] == g]
-        right = budget_limit(float(d["budget_m"].max()))
+        finite = np.isfinite(d["budget_m"].astype(float))
+        none = not finite.all() and not (d.loc[finite, "budget_m"] > 0).any()  # every distance infinite or NaN
+        d = d[finite]  # the axis and the curves from finite budgets only (an infinite distance has no place on it)
+        right = budget_limit(float(d["budget_m"].max()) if len(d) else 0.0)
         for j, lab in enumerate(labels):
             ax = axes[r, j]
+            if none:
+                _no_finite(ax)
             for other in labels:
                 if other != lab:
                     e = _to_limit(d[d["planner"] == other], right)
@@ -647,14 +658,17 @@ def plot_boxes(runs, scenario: str, order: list, out: Path, formats=("png",), co
             if not len(v):
                 continue
             c = colors[lab]
-            ax.boxplot([v], positions=[y[k] - 0.12], widths=0.42, **_HORIZONTAL, patch_artist=True,
-                       boxprops=dict(facecolor=to_rgba(c, 0.25), edgecolor=c, lw=0.8), medianprops=dict(color=c, lw=1.4),
-                       whiskerprops=dict(color=c, lw=0.8), capprops=dict(color=c, lw=0.8),
-                       flierprops=dict(marker="o", ms=2.2, mfc=c, mec="none", alpha=0.7))
-            mean, lo, hi = stats.mean_ci(v, unit[m])
-            err = [[mean - lo], [hi - mean]] if np.isfinite(lo) else None
-            ax.errorbar([mean], [y[k] + 0.28], xerr=err, fmt="D", ms=3.2, c="black", mfc=c, mec="black", mew=0.5,
-                        capsize=2, lw=0.9)
+            if not np.isfinite(v).any():
+                _no_finite(ax, y[k])
+            else:
+                ax.boxplot([v], positions=[y[k] - 0.12], widths=0.42, **_HORIZONTAL, patch_artist=True,
+                           boxprops=dict(facecolor=to_rgba(c, 0.25), edgecolor=c, lw=0.8), medianprops=dict(color=c, lw=1.4),
+                           whiskerprops=dict(color=c, lw=0.8), capprops=dict(color=c, lw=0.8),
+                           flierprops=dict(marker="o", ms=2.2, mfc=c, mec="none", alpha=0.7))
+                mean, lo, hi = stats.mean_ci(v, unit[m])
+                err = [[mean - lo], [hi - mean]] if np.isfinite(lo) else None
+                ax.errorbar([mean], [y[k] + 0.28], xerr=err, fmt="D", ms=3.2, c="black", mfc=c, mec="black", mew=0.5,
+                            capsize=2, lw=0.9)
             if common is None:
                 ax.text(1.01, y[k], f"n={len(v)}", transform=blended_transform_factory(ax.transAxes, ax.transData),
                         va="center", fontsize=7)

@@ -11,11 +11,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..errors import ScenarioError
 from ..files import safe_chars
 from ..planners import Variant
 from ..planners.base import planner_named
 from ..runner import file_stem
-from ..runner.store import read_frames
+from ..runner.store import read_frames, read_npz
 from ..tasks import FrameRecorder
 from .stats import episodes
 
@@ -46,7 +47,11 @@ def load_paths(folder: Path, rows: pd.DataFrame) -> list[tuple[int, np.ndarray]]
     for i, r in rows.iterrows():
         f = path_file(folder, str(r["planner"]), r["goal"], int(r["seed"]), int(ep[i]))
         if f is not None:
-            out.append((i, np.load(f)["path"]))
+            path = read_npz(f, "path file").get("path")
+            if path is None or path.dtype.kind not in "iuf" or (path.size and (path.ndim != 2 or path.shape[1] != 2)):
+                raise ScenarioError(str(f), "path", "not a path file semsearch wrote (no (x, y) array 'path'); delete it "
+                                    "or run the batch again")
+            out.append((i, path))
     return out
 
 
@@ -106,7 +111,8 @@ def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rer
     """A run's replay frames (at most :data:`REPLAY_FRAMES`, evenly spaced): read from
     ``frames/<run>.npz`` when ``semsearch run --frames`` recorded them, else by ``rerun(observer)``
     (re-simulating the run, which is deterministic, with a :class:`FrameRecorder` watching).
-    Returns (frames, "recorded" or "re-simulated")."""
+    Returns (frames, "recorded" or "re-simulated"); a run whose planner raised (an ``error``
+    row) is re-simulated up to the error, which ``how`` names."""
     for stem in stems(planner, goal, seed, episode):
         f = Path(folder) / "frames" / f"{stem}.npz"
         if f.is_file():
@@ -114,8 +120,12 @@ def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rer
             break
     else:
         recorder = FrameRecorder()
-        rerun(recorder)
-        frames, how = recorder.frames, "re-simulated"
+        how = "re-simulated"
+        try:
+            rerun(recorder)
+        except Exception as exc:  # noqa: BLE001  a user's planner raised, as it did in the batch (an error row)
+            how = f"re-simulated up to the planner's error, {type(exc).__name__}: {str(exc)[:80]}"
+        frames = recorder.frames
     step = max(1, -(-len(frames) // REPLAY_FRAMES))
     return frames[::step], how
 

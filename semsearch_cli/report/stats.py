@@ -18,9 +18,11 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy.stats import bootstrap, mannwhitneyu, norm, rankdata, wilcoxon
+from scipy.special import ndtr, ndtri
+from scipy.stats import mannwhitneyu, norm, rankdata, wilcoxon
 
 NAN = float("nan")
+RESAMPLE_BLOCK = 1 << 20  # resampled values held at once by the bootstrap (8 MiB of them, as much of indices)
 
 
 def episodes(df: pd.DataFrame) -> pd.Series:
@@ -86,10 +88,67 @@ def _unit_means(values, unit_labels) -> pd.Series:
     return v.groupby(np.asarray(unit_labels), sort=True).mean().dropna()
 
 
-def _boot(samples: tuple, statistic, point: float, confidence: float, n_resamples: int, seed: int) -> tuple[float, float, float]:
-    res = bootstrap(samples, statistic, confidence_level=confidence, n_resamples=n_resamples, method="BCa",
-                    rng=np.random.default_rng(seed))
-    return point, float(res.confidence_interval.low), float(res.confidence_interval.high)
+def _resample_means(x: np.ndarray, n_resamples: int, rng: np.random.Generator) -> np.ndarray:
+    """Means of ``n_resamples`` bootstrap resamples of ``x`` ((n,) float): (n_resamples,) float.
+
+    The resamples are drawn ``RESAMPLE_BLOCK // n`` at a time (at least one), each block by one
+    ``rng.integers(0, n, (rows, n))``: the same draws, in the same order, as the single
+    ``(n_resamples, n)`` draw of ``scipy.stats.bootstrap``, so the same seed gives the same means,
+    while at most ``max(RESAMPLE_BLOCK, n)`` resampled values are held at once, whatever
+    ``n_resamples`` (issue 35: 9999 x 20,000 at once ran out of memory)."""
+    n = len(x)
+    rows = max(1, RESAMPLE_BLOCK // n)
+    out = np.empty(n_resamples)
+    for k in range(0, n_resamples, rows):
+        b = min(rows, n_resamples - k)
+        out[k:k + b] = x[rng.integers(0, n, (b, n))].mean(axis=-1)
+    return out
+
+
+def _boot(samples: tuple, point: float, confidence: float, n_resamples: int, seed: int) -> tuple[float, float, float]:
+    """BCa bootstrap interval (Efron & Tibshirani 1993, *An Introduction to the Bootstrap*, sec.
+    14.3) of the mean of ``samples[0]``, or, given two samples, of the difference
+    of their means: what ``scipy.stats.bootstrap(samples, statistic, method="BCa",
+    rng=np.random.default_rng(seed))`` returns for ``np.mean`` and the mean difference, computed in
+    memory bounded independently of the sample sizes' product.
+
+    The bootstrap distribution is drawn as SciPy draws it (each sample's resamples in turn, from
+    one generator; :func:`_resample_means`). The acceleration ``a`` comes from the jackknife,
+    written out for a mean: the leave-one-out means' ``(n - 1)(mean_(.) - mean_(-i))`` is
+    ``x_i - mean(x)`` (negated for the subtracted sample), so ``a = sum_j sum_i U_ji^3 / n_j^3 /
+    (6 (sum_j sum_i U_ji^2 / n_j^2)^(3/2))`` takes O(n) instead of SciPy's n x (n - 1) leave-one-out
+    resamples. The interval's ends are the linear-interpolation quantiles of the distribution at
+    the BCa levels; NaN where a level is not a number (where SciPy warns that the BCa interval
+    cannot be calculated: every resampled statistic on one side of ``point``).
+
+    Parameters
+    ----------
+    samples : tuple of one or two (n_j,) float arrays
+        Per-unit values (at least two each), the second subtracted.
+    point : float
+        The statistic on the data (the mean, or the difference of the means).
+
+    Returns
+    -------
+    (point, lo, hi) : float
+    """
+    rng = np.random.default_rng(seed)
+    xs = [np.asarray(x, dtype=float) for x in samples]
+    dist = _resample_means(xs[0], n_resamples, rng)
+    for y in xs[1:]:
+        dist -= _resample_means(y, n_resamples, rng)
+    theta = xs[0].mean() - sum(y.mean() for y in xs[1:])
+    z0 = ndtri((np.count_nonzero(dist < theta) + np.count_nonzero(dist <= theta)) / (2.0 * n_resamples))
+    u = [x - x.mean() for x in xs]  # the jackknife's U_i; its sign does not matter for U^2 and flips U^3
+    num = sum((1 if j == 0 else -1) * np.sum(ui**3) / len(ui) ** 3 for j, ui in enumerate(u))
+    den = sum(np.sum(ui**2) / len(ui) ** 2 for ui in u)
+    a = num / (6.0 * den**1.5)
+    z = ndtri((1.0 - confidence) / 2.0)
+    levels = [ndtr(z0 + (z0 + zz) / (1.0 - a * (z0 + zz))) for zz in (z, -z)]
+    if not all(0.0 <= q <= 1.0 for q in levels):  # NaN: a degenerate distribution
+        return point, NAN, NAN
+    lo, hi = np.quantile(dist, levels)
+    return point, float(lo), float(hi)
 
 
 def mean_ci(values, units, confidence: float = 0.95, n_resamples: int = 9999, seed: int = 0) -> tuple[float, float, float]:
@@ -111,28 +170,35 @@ def mean_ci(values, units, confidence: float = 0.95, n_resamples: int = 9999, se
     -------
     (mean, lo, hi) : float
         ``mean`` is the unweighted mean of the per-unit means (the mean of all runs when every unit
-        has as many runs). The interval is ``scipy.stats.bootstrap`` (BCa) over the per-unit
-        means; ``(m, m, m)`` when all unit means are equal, ``(m, nan, nan)`` with fewer than two
-        units (``(nan, nan, nan)`` with none).
+        has as many runs). The interval is the BCa bootstrap over the per-unit means
+        (:func:`_boot`: ``scipy.stats.bootstrap``'s, in memory bounded whatever the number of
+        units); ``(m, m, m)`` when all unit means are equal, ``(m, nan, nan)`` with fewer than two
+        units or an infinite unit mean (``(nan, nan, nan)`` with none).
     """
     um = _unit_means(values, units).to_numpy()
     if len(um) == 0:
         return NAN, NAN, NAN
     m = float(um.mean())
-    if len(um) < 2:
+    if len(um) < 2 or not np.isfinite(um).all():
         return m, NAN, NAN
     if np.ptp(um) == 0:
         return m, m, m
-    return _boot((um,), np.mean, m, confidence, n_resamples, seed)
+    return _boot((um,), m, confidence, n_resamples, seed)
 
 
-def wilson(p: float, n: float, confidence: float = 0.95) -> tuple[float, float]:
-    """Wilson score interval of a proportion ``p`` observed over ``n`` (may be fractional) trials."""
+def _wilson(p, n, confidence: float):
+    """:func:`wilson` over arrays: ``p``, ``n`` broadcast; returns (lo, hi) arrays."""
     z = float(norm.ppf(0.5 + confidence / 2.0))
     d = 1.0 + z * z / n
     centre = (p + z * z / (2.0 * n)) / d
     half = z * np.sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / d
-    return max(0.0, float(centre - half)), min(1.0, float(centre + half))
+    return np.maximum(0.0, centre - half), np.minimum(1.0, centre + half)
+
+
+def wilson(p: float, n: float, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a proportion ``p`` observed over ``n`` (may be fractional) trials."""
+    lo, hi = _wilson(np.float64(p), np.float64(n), confidence)
+    return float(lo), float(hi)
 
 
 def rate_ci(successes, units, confidence: float = 0.95) -> tuple[float, float, float]:
@@ -184,8 +250,61 @@ def rate_ci(successes, units, confidence: float = 0.95) -> tuple[float, float, f
     return p, lo, hi
 
 
-def _mean_diff(x, y, axis=-1):
-    return np.mean(x, axis=axis) - np.mean(y, axis=axis)
+def rate_ci_by_budget(found, distance, units, budgets, confidence: float = 0.95) -> dict:
+    """:func:`rate_ci` of the runs that found the goal within each budget, all budgets at once.
+
+    At budget ``b`` a run counts as a success when ``found`` and ``distance <= b``; the result at
+    each ``b`` is what ``rate_ci(found & (distance <= b), units)`` returns, but computed from one
+    sort of the successful runs by distance instead of one pass over the runs per budget
+    (issue 35: a budget curve over every distinct distance of 20,000 runs took minutes). Kish's
+    variance needs, per budget, ``S1 = sum_i y_i``, ``S2 = sum_i y_i^2`` and ``S3 = sum_i y_i m_i``
+    over units ``i`` (``y_i`` successes of ``m_i`` runs): ``n^2 Var = S2 - 2 p S3 + p^2 sum_i
+    m_i^2``. Taking the successes in order of distance, the k-th success of a unit raises ``S1``
+    by 1, ``S2`` by ``2 k + 1`` (k counted from 0) and ``S3`` by ``m_i``; cumulative sums read at
+    ``searchsorted(b)`` give them at every budget.
+
+    Parameters
+    ----------
+    found : (n,) 0/1
+        Whether each run found the goal.
+    distance : (n,) float, m
+        How far each run travelled (NaN: never within a budget).
+    units : (n,)
+        The unit of each run (:func:`units`).
+    budgets : (k,) float, m
+
+    Returns
+    -------
+    dict of (k,) arrays: ``successes`` (int), ``rate``, ``lo``, ``hi`` (float; NaN as :func:`rate_ci`).
+    """
+    ok = np.asarray(found, dtype=float) == 1
+    dist = np.asarray(distance, dtype=float)
+    b = np.asarray(budgets, dtype=float)
+    n = len(dist)
+    if n == 0:
+        nan = np.full(len(b), NAN)
+        return {"successes": np.zeros(len(b), np.int64), "rate": nan, "lo": nan.copy(), "hi": nan.copy()}
+    _, code, size = np.unique(np.asarray(units).astype(str), return_inverse=True, return_counts=True)
+    code = code.ravel()
+    ev = np.flatnonzero(ok & ~np.isnan(dist))
+    ev = ev[np.argsort(dist[ev], kind="stable")]
+    d_sorted, c = dist[ev], code[ev]
+    by_unit = np.argsort(c, kind="stable")  # the successes grouped by unit, in distance order within each
+    first = np.r_[0, np.cumsum(np.bincount(c, minlength=len(size)))[:-1]]
+    rank = np.empty(len(c), np.int64)
+    rank[by_unit] = np.arange(len(c)) - first[c[by_unit]]
+    s2 = np.r_[0.0, np.cumsum(2.0 * rank + 1.0)]
+    s3 = np.r_[0.0, np.cumsum(size[c].astype(float))]
+    k = np.where(np.isnan(b), 0, np.searchsorted(d_sorted, b, side="right"))
+    p = k / n
+    var = (s2[k] - 2.0 * p * s3[k] + p * p * float(np.sum(size.astype(float) ** 2))) / n**2
+    inside = (p > 0.0) & (p < 1.0)
+    deff = np.ones(len(b))
+    deff[inside] = np.maximum(1.0, var[inside] / (p[inside] * (1.0 - p[inside]) / n))
+    lo, hi = _wilson(p, n / deff, confidence)
+    if len(size) < 2 and n > 1:
+        lo, hi = np.full(len(b), NAN), np.full(len(b), NAN)
+    return {"successes": k.astype(np.int64), "rate": p, "lo": lo, "hi": hi}
 
 
 def paired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confidence: float = 0.95) -> dict:
@@ -239,7 +358,7 @@ def unpaired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confid
     dict
         ``n_a``, ``n_b`` (units); ``mean_diff`` (mean of A's unit means minus B's) with ``diff_lo``,
         ``diff_hi`` from a two-sample BCa bootstrap (``(d, nan, nan)`` when a side has fewer than
-        two units, ``(d, d, d)`` when both sides are constant); ``U`` (A's statistic), ``p_value``
+        two units or an infinite unit mean, ``(d, d, d)`` when both sides are constant); ``U`` (A's statistic), ``p_value``
         and ``effect_r = 2U / (n_a n_b) - 1``, the rank-biserial correlation (positive when A has
         the larger ``value``, as :func:`paired`).
     """
@@ -249,12 +368,12 @@ def unpaired(a: pd.DataFrame, b: pd.DataFrame, value: str = "distance_m", confid
     if not (len(x) and len(y)):
         return out | {"mean_diff": NAN, "diff_lo": NAN, "diff_hi": NAN, "U": NAN, "p_value": NAN, "effect_r": NAN}
     d = float(x.mean() - y.mean())
-    if min(len(x), len(y)) < 2:
+    if min(len(x), len(y)) < 2 or not (np.isfinite(x).all() and np.isfinite(y).all()):
         ci = (d, NAN, NAN)
     elif np.ptp(x) == 0 and np.ptp(y) == 0:
         ci = (d, d, d)
     else:
-        ci = _boot((x, y), _mean_diff, d, confidence, 9999, 0)
+        ci = _boot((x, y), d, confidence, 9999, 0)
     u, p = mannwhitneyu(x, y, alternative="two-sided")
     return out | {"mean_diff": ci[0], "diff_lo": ci[1], "diff_hi": ci[2], "U": float(u), "p_value": float(p),
                   "effect_r": 2.0 * float(u) / (len(x) * len(y)) - 1.0}

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+import re
+
 import numpy as np
 import pandas as pd
 
@@ -25,9 +28,12 @@ def intervals(g: pd.DataFrame, value: str = "distance_m") -> dict:
 
 
 def per_group(runs: pd.DataFrame, keys: list, fn, columns: list) -> pd.DataFrame:
-    """One row per group of ``runs`` by ``keys`` (sorted): the keys and the dict ``fn(group)``."""
-    rows = [dict(zip(keys, k)) | fn(d) for k, d in runs.groupby(keys, sort=True)]
-    return pd.DataFrame(rows, columns=keys + columns)
+    """One row per group of ``runs`` by ``keys`` (sorted; a missing key is a group of its own,
+    last): the keys and the dict ``fn(group)``. The keys keep the dtypes of ``runs``' columns,
+    also when there is no group, so that the result merges back on them."""
+    rows = [dict(zip(keys, k)) | fn(d) for k, d in runs.groupby(keys, sort=True, dropna=False)]
+    out = pd.DataFrame(rows, columns=keys + columns)
+    return out if len(out) else out.astype({k: runs[k].dtype for k in keys})
 
 
 def _finite(v: pd.Series) -> pd.Series:
@@ -50,8 +56,15 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     convention; see :mod:`.stats`). ``mean`` is the mean of all runs, as the thesis; the
     interval is that of the mean of per-unit means (:func:`.stats.mean_ci`), the same number when
     every unit has as many runs. Intervals are 95%: a bootstrap over units for the mean, the
-    clustered Wilson interval (:func:`.stats.rate_ci`) for the rate."""
-    g = runs.groupby(KEYS, sort=True)
+    clustered Wilson interval (:func:`.stats.rate_ci`) for the rate.
+
+    The keys are taken as they come: rows read with ``read_runs(path, as_written=True)`` keep each
+    goal and planner as the text it was written with, so a goal ``NA``, ``4.50`` or ``1e3`` is
+    summarised under that label (``4.50`` apart from ``4.5``). A missing key (rows read without
+    it, where pandas reads ``NA`` as NaN) is a group of its own, never dropped. Rows are ordered by
+    scenario, goal (:func:`goal_key`: numbers by value, whether read as numbers or as text) and
+    planner."""
+    g = runs.groupby(KEYS, sort=True, dropna=False)
     out = g.agg(
         n=("distance_m", "size"),
         success_rate=("success", "mean"),
@@ -67,8 +80,13 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
         extra["soft_spl"] = lambda d: float(d["soft_spl"].mean())
     if "left_m" in runs.columns:
         extra["left_m"] = lambda d: float(_finite(d.loc[d["success"] == 0, "left_m"]).mean())
-    more = per_group(runs, KEYS, lambda d: intervals(d) | {k: f(d) for k, f in extra.items()}, INTERVALS + list(extra))
-    out = out.merge(more, on=KEYS, how="left")
+    # the same groups in the same order as ``out`` (no merge on the keys: a NaN key, or keys of
+    # mixed types, must not decide which rows meet)
+    more = pd.DataFrame([intervals(d) | {k: f(d) for k, f in extra.items()} for _, d in g], columns=INTERVALS + list(extra))
+    out = pd.concat([out, more], axis=1)
+    order = sorted(range(len(out)), key=lambda i: (str(out["scenario"].iat[i]), goal_key(out["goal"].iat[i]),
+                                                   str(out["planner"].iat[i])))
+    out = out.iloc[order].reset_index(drop=True)
     cols = KEYS + ["n", "episodes", "success_rate", "success_lo", "success_hi", "median", "mean", "mean_lo", "mean_hi",
                    "std", "min", "max", "shortest_m", "mean_ratio"] + [c for c in extra if c != "shortest_m"] + ["unit", "n_units"]
     return out[cols].round(3)
@@ -100,9 +118,16 @@ FIVE = ["median", "mean", "std", "min", "max"]
 
 
 def goal_key(g):
-    """Sort goals numerically when they are numbers, then as text."""
+    """Sort goals numerically when they are numbers (``54``, ``54.0``, ``4.50``, ``1e3``: by
+    value, then as text), then the rest as text (``NA``, ``kitchen``, a missing goal)."""
     s = str(g)
-    return (0, int(s), "") if s.lstrip("-").isdigit() else (1, 0, s)
+    if re.fullmatch(r"-?[0-9]{1,18}", s, re.ASCII):  # ASCII digits only: 30² is text
+        return (0, int(s), s)
+    try:
+        v = float(s) if s.isascii() and "_" not in s else math.nan
+    except ValueError:
+        return (1, 0, s)
+    return (0, v, s) if np.isfinite(v) else (1, 0, s)
 
 
 def five_statistics(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -235,7 +260,7 @@ def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "
     is 1 by convention when every paired difference is 0, and flags fewer than ``MIN_N`` units
     (pairs), too few for the test to mean much."""
     rows = []
-    for (scen, goal), g in runs.groupby(["scenario", "goal"]):
+    for (scen, goal), g in runs.groupby(["scenario", "goal"], dropna=False):  # a missing goal is compared too
         order = planner_order(g["planner"])
         base = baseline if baseline in order else baseline_of(order)
         b = g[g["planner"] == base]

@@ -11,13 +11,13 @@ from typing import Callable, Sequence
 import pandas as pd
 
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
-from ..files import temp_path
+from ..files import check_outputs, temp_path
 from ..planners import code_of
 from .execution import Executor, Watch
 from .executors import SerialExecutor, make_executor
 from .options import BatchOptions
 from .lock import folder_lock
-from .specs import Loaded, RunSpec
+from .specs import Loaded, RunSpec, file_stem
 from .store import RowWriter, read_runs, run_rows
 
 
@@ -27,8 +27,12 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
 
     ``codes`` (planner label -> code hash, :func:`~semsearch_cli.planners.code_of`): rows of
     those planners made by other code (an edited planner file, another semsearch) are never
-    reused: they are moved to ``runs.superseded.csv`` (appended, so nothing is lost), said so on
-    standard error, and their runs run again."""
+    reused: they are moved to ``runs.superseded.csv`` (appended, so nothing is lost), their runs'
+    files (paths, traces, frames) to ``superseded/<n>/``, said so on standard error, and their runs
+    run again; ``force`` keeps another scenario's runs.csv as ``runs.<n>.csv.bak`` and its runs'
+    files in ``runs.<n>.bak/``. Before anything: the files and folders a batch and
+    its report write are of the kind they will be written as (:func:`~semsearch_cli.files.check_outputs`)."""
+    check_outputs(out, BATCH_FILES, BATCH_FOLDERS)
     runs_csv = out / "runs.csv"
     done = run_rows(read_runs(runs_csv, as_written=True))
     fp = loaded.fingerprint
@@ -36,12 +40,17 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
     if foreign and not force:
         raise ScenarioError(str(runs_csv), "fingerprint", f"these rows were made with another scenario, with {loaded.path} before it was edited, "
                             "or by an older semsearch, so they cannot be resumed; write into a fresh folder with --out, "
-                            "or re-run everything here with --force (the old runs.csv is kept as runs.<n>.csv.bak)")
-    if foreign:
+                            "or re-run everything here with --force (the old runs.csv is kept as runs.<n>.csv.bak, "
+                            "its runs' paths, traces and frames in runs.<n>.bak/)")
+    if foreign:  # kept whole: the rows as runs.<n>.csv.bak, their runs' files in runs.<n>.bak/
         n = 1
-        while (out / f"runs.{n}.csv.bak").exists():
+        while (out / f"runs.{n}.csv.bak").exists() or (out / f"runs.{n}.bak").exists():
             n += 1
         runs_csv.rename(out / f"runs.{n}.csv.bak")
+        for d, _ in RUN_FILES:
+            if (out / d).is_dir():
+                (out / f"runs.{n}.bak").mkdir(exist_ok=True)
+                os.replace(out / d, out / f"runs.{n}.bak" / d)
         done = run_rows(read_runs(runs_csv, as_written=True))
     if codes and len(done):
         stale = done["planner"].isin(list(codes)) & (done["code"].astype(str) != done["planner"].map(codes))
@@ -90,9 +99,32 @@ def _supersede(out: Path, which, why: str) -> None:
         fh.flush()
         os.fsync(fh.fileno())
     os.replace(tmp, runs_csv)
-    print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}; their runs run again", file=sys.stderr)
+    stems = {file_stem(str(p), g, int(s), int(e)) for p, g, s, e in zip(old["planner"], old["goal"], old["seed"], old["episode"])}
+    files = [out / d / f"{st}{ext}" for st in sorted(stems) for d, ext in RUN_FILES if (out / d / f"{st}{ext}").is_file()]
+    where = ""
+    if files:
+        aside = _next_free(out / "superseded", "{}")
+        for f in files:
+            (aside / f.parent.name).mkdir(parents=True, exist_ok=True)
+            os.replace(f, aside / f.parent.name / f.name)
+        where = f", and their {len(files)} file(s) (paths, traces, frames) to {aside.relative_to(out)}/"
+    print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}{where}; their runs run again", file=sys.stderr)
 
 
+RUN_FILES = (("paths", ".npz"), ("traces", ".jsonl"), ("frames", ".npz"))  # a run's files, by its stem
+
+
+def _next_free(folder: Path, pattern: str) -> Path:
+    """``folder/pattern.format(n)`` for the first n = 1, 2, ... that does not exist."""
+    n = 1
+    while (folder / pattern.format(n)).exists():
+        n += 1
+    return folder / pattern.format(n)
+
+
+# what a batch, and the report that follows it, write into a results folder
+BATCH_FILES = ("runs.csv", "runs.superseded.csv", "meta.json", "summary.csv", "report.md", "report.html")
+BATCH_FOLDERS = ("paths", "traces", "frames", "superseded", "tables", "figures")
 MANY_RUNS = 10_000  # a batch this large says how many runs it has before it starts
 LARGE_RUN = 1e9  # bytes: a batch whose runs need more than this each says so before it starts
 

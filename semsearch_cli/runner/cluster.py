@@ -11,7 +11,12 @@ and a chunk's rows are written only when it comes back, so each run lands in run
 
 from __future__ import annotations
 
+import asyncio
 import itertools
+import re
+import socket
+import threading
+import time
 from pathlib import Path
 from typing import Iterable, Iterator
 
@@ -24,6 +29,8 @@ from .store import save_run_files
 
 
 CONNECT_S = 8  # s to reach a scheduler before the command gives up
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")  # a scheduler's protocols; all but ucx run over TCP and are probed first
+_ADDRESS = re.compile(r"(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):(?P<port>\d{1,5})/?")
 dask = lazy_module("dask")  # imported at first use (the dask extra; None without it)
 distributed = lazy_module("distributed")
 
@@ -60,18 +67,26 @@ class DaskExecutor(Executor):
     def _client(self):
         if self.address:
             try:
-                return distributed.Client(self.address, set_as_default=False, timeout=CONNECT_S), None
-            except (OSError, TimeoutError, ValueError, TypeError) as exc:  # unreachable, refused, a malformed address
+                left = _probe(self.address)
+                return distributed.Client(self.address, set_as_default=False, timeout=left), None
+            except ScenarioError:
+                raise
+            except Exception as exc:  # unreachable, refused, not a scheduler (whatever answered), a failed handshake
+                why = _why(exc)
                 raise ScenarioError("<command line>", "--scheduler", f"no Dask scheduler answers at {self.address!r} "
-                                    f"within {CONNECT_S} s ({type(exc).__name__}: {exc}); give tcp://HOST:PORT of a "
-                                    "running scheduler, or leave --scheduler out for a local cluster") from None
+                                    f"({why}; waited at most {CONNECT_S} s); give tcp://HOST:PORT of a running "
+                                    "scheduler, or leave --scheduler out for a local cluster") from None
+        # distributed adds its defaults to dask.config when it is imported; it must be imported before the
+        # set() below, which would otherwise insert a "distributed" section and, on leaving, delete it whole
+        # (defaults and all: KeyError 'distributed' from the scheduler and the cluster as they closed)
+        local_cluster = distributed.LocalCluster
         # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which fixes glibc's mmap threshold
         # so that every grid-sized temporary is mapped and unmapped: runs took 1.45x as long (28.3 s vs
         # 19.6 s of run time for 40 Hotel runs). Unset here, and NumPy's huge pages off as in our own
         # processes (semsearch_cli/__init__.py); docs/usage.md "Running on a cluster" for your own workers.
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                               "distributed.nanny.pre-spawn-environ.NUMPY_MADVISE_HUGEPAGE": "0"}):
-            cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+            cluster = local_cluster(n_workers=self.workers, threads_per_worker=1, processes=True, dashboard_address=":0",
                                    silence_logs=50)  # CRITICAL: no heartbeat noise when the cluster closes
         return distributed.Client(cluster, set_as_default=False), cluster
 
@@ -114,6 +129,73 @@ class DaskExecutor(Executor):
             raise
 
 
+def check_address(address: str) -> tuple[str, str, int]:
+    """(scheme, host, port) of a scheduler's address, ``[SCHEME://]HOST:PORT`` (scheme tcp by
+    default; an IPv6 host in brackets); a :class:`ScenarioError` naming ``--scheduler`` for any
+    other form, an unknown scheme or a port outside 1-65535. Only the form is checked here."""
+    text = str(address).strip()
+    m = _ADDRESS.fullmatch(text)
+    if m is None:
+        raise ScenarioError("<command line>", "--scheduler", f"{address!r} is not a scheduler address; give "
+                            "tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786, or tcp://[::1]:8786 for IPv6)")
+    scheme, host, port = (m["scheme"] or "tcp").lower(), m["host"].strip("[]"), int(m["port"])
+    if scheme not in SCHEMES:
+        raise ScenarioError("<command line>", "--scheduler", f"unknown protocol {scheme!r} in {address!r}; valid: "
+                            f"{', '.join(SCHEMES)} (tcp://HOST:PORT for most clusters)")
+    if not 1 <= port <= 65535:
+        raise ScenarioError("<command line>", "--scheduler", f"port {port} in {address!r} is outside 1-65535")
+    return scheme, host, port
+
+
+def _probe(address: str) -> float:
+    """Reach the scheduler at ``address`` and complete Dask's handshake, within :data:`CONNECT_S`
+    in all; returns the seconds left of it. A refused port fails at once (a plain TCP connect
+    first: Dask's own connect retries a refusal until its timeout), and a port that accepts but
+    never answers, or answers with something else, fails at the bound: Dask's client bounds the
+    connect but not the handshake after it, and a client that fails there takes another 16 s to
+    close when it is collected. Raises what went wrong (OSError, TimeoutError, ...)."""
+    scheme, host, port = check_address(address)
+    t0 = time.monotonic()
+
+    def left() -> float:
+        return CONNECT_S - (time.monotonic() - t0)
+
+    if scheme != "ucx":
+        socket.create_connection((host, port), timeout=CONNECT_S).close()
+    args = distributed.security.Security().get_connection_args("client")  # as the client's (tls:// from dask.config)
+
+    async def hello():
+        comm = await asyncio.wait_for(distributed.comm.connect(address, timeout=max(0.1, left()), **args), max(0.1, left()))
+        await comm.close()
+
+    failed: list[BaseException] = []
+
+    def run():  # in a thread of its own: the caller may be inside a running event loop (a notebook)
+        try:
+            asyncio.run(hello())
+        except BaseException as exc:  # handed to the caller
+            failed.append(exc)
+
+    t = threading.Thread(target=run, daemon=True, name="semsearch-scheduler-probe")
+    t.start()
+    t.join(max(0.1, left()) + 1)
+    if t.is_alive():
+        raise TimeoutError("no handshake")
+    if failed:
+        raise failed[0]
+    return max(1.0, left())
+
+
+def _why(exc: BaseException) -> str:
+    """What went wrong reaching a scheduler, in a few words."""
+    if isinstance(exc, TimeoutError):
+        return "no answer"
+    if isinstance(exc, OSError):
+        return exc.strerror or str(exc) or type(exc).__name__
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text[:160]}" if text else type(exc).__name__  # e.g. garbage read as a message's length
+
+
 def _close(client, cluster) -> None:
     client.close()
     if cluster is not None:
@@ -125,4 +207,6 @@ def dask_executor(workers: int, start_method: str | None, address: str | None, c
     """The Dask scheduler at ``address``, or a local cluster of ``workers`` processes."""
     if distributed is None:
         raise ScenarioError("<command line>", "--executor", "dask needs the distributed package: pip install 'semsearch[dask]'")
+    if address:
+        check_address(address)  # a malformed address is refused before a client is made
     return DaskExecutor(workers, address, chunk)

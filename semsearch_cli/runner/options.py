@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ScenarioError
+from .cluster import check_address
 from .executors import check_kind
 
 MAX_WORKERS = 512  # even with --oversubscribe
@@ -56,6 +57,7 @@ class BatchOptions:
         if self.scheduler is not None and not self.scheduler.strip():
             raise ScenarioError("<command line>", "--scheduler", "an empty address; give tcp://HOST:PORT")
         if self.scheduler:
+            check_address(self.scheduler)  # its form, before the scenario loads
             return self.replace(workers=self.workers or 1)
         return self.replace(workers=workers_for(self.workers, self.oversubscribe))
 

@@ -8,12 +8,15 @@ import io
 import json
 import math
 import os
+import re
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..errors import ScenarioError
+from ..errors import ScenarioError, did_you_mean
 from ..metrics import CAUSES, COLUMNS
 from ..files import temp_path
 
@@ -55,6 +58,10 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
         if c not in df.columns:
             df[c] = df["outcome"].map(CAUSES) if c == "cause" else default
     df[TEXT] = df[TEXT].fillna("")
+    extra = [c for c in df.columns if c not in COLUMNS]
+    if extra:
+        raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), COLUMNS)} "
+                            "(edited by hand?); remove it, or write into another folder with --out")
     for c in NUMBERS:
         if c in df.columns and not pd.api.types.is_numeric_dtype(df[c]):  # a cell that is not a number
             num = pd.to_numeric(df[c], errors="coerce")
@@ -64,7 +71,17 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
                 raise ScenarioError(str(path), c, f"expected numbers, found {df[c].iloc[k]!r} on line {k + 2} "
                                     "(edited by hand?); fix it, or write into another folder with --out")
             df[c] = num
-    return df.dropna(subset=["wall_s"])
+    df = df.dropna(subset=["wall_s"])
+    failed = df["outcome"].isin(["error", "timeout"]).to_numpy()  # a run that failed has no distance
+    for c in NUMBERS:  # every number a run writes is finite; a few are never missing
+        v = df[c].to_numpy(float)
+        bad = np.isinf(v) | (np.isnan(v) & ~failed if c == "distance_m" else False) | (v < 0 if c in MEASURED else False)
+        if bad.any():
+            k = int(bad.nonzero()[0][0])
+            raise ScenarioError(str(path), c, f"expected {'a finite number' if c not in MEASURED else 'a finite number >= 0'}"
+                                f", found {df[c].iloc[k]} on line {df.index[k] + 2} (edited by hand?); fix it, or write "
+                                "into another folder with --out")
+    return df
 
 
 # columns added after the first release, with what rows written before them stand for
@@ -73,6 +90,7 @@ LATER = {"episode": 0, "start_x": float("nan"), "start_y": float("nan"), "start_
 TEXT = ["stage", "map", "message", "room", "cause", "code"]
 KEY_TEXT = ("planner", "params", "goal")  # read as written: never a number, never missing
 MISSING = ["", "nan", "NaN", "NA", "N/A", "null", "None", "<NA>"]  # what pandas reads as missing in the other columns
+MEASURED = ("episode", "seed", "distance_m", "wall_s")  # never negative; a distance missing only in a failed run's row
 NUMBERS = ["episode", "seed", "start_x", "start_y", "start_heading", "success", "distance_m", "shortest_m", "ratio", "spl",
            "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s"]
 
@@ -146,18 +164,28 @@ def _cut_back(fh, size: int):
     return open(path, "a", newline="")
 
 
+MAX_NESTING = 100  # levels of containers in a trace's info (as planners.base checks a Decision's)
+
+
 def json_safe(v):
     """``v`` as strict JSON can hold it, whatever a planner put in ``Decision.info``: NaN and
     infinities become null, NumPy numbers and arrays plain numbers and lists, keys text, anything
-    else its ``repr``."""
-    if isinstance(v, dict):
-        return {str(k): json_safe(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple, set, frozenset)):
-        return [json_safe(x) for x in v]
+    else its ``repr``; a container that holds itself ``"<cycle>"``."""
+    return _json_safe(v, ())
+
+
+def _json_safe(v, outer: tuple):
+    if isinstance(v, (dict, list, tuple, set, frozenset)):
+        if any(v is o for o in outer) or len(outer) >= MAX_NESTING:  # a container that holds itself
+            return "<cycle>" if any(v is o for o in outer) else "<nested too deeply>"
+        inner = (*outer, v)
+        if isinstance(v, dict):
+            return {str(k): _json_safe(x, inner) for k, x in v.items()}
+        return [_json_safe(x, inner) for x in v]
     if isinstance(v, np.ndarray):
-        return json_safe(v.tolist())
+        return _json_safe(v.tolist(), outer)
     if isinstance(v, np.generic):
-        return json_safe(v.item())
+        return _json_safe(v.item(), outer)
     if isinstance(v, float):
         return v if math.isfinite(v) else None
     if v is None or isinstance(v, (bool, int, str)):
@@ -204,25 +232,88 @@ def write_frames(path: Path, frames: list[dict]) -> None:
     os.replace(tmp, path)
 
 
+MAX_FRAMES = 10_000  # frames in one replay file (a recorder keeps at most 121)
+MAX_STORED = 25_000_000  # elements of one stored array: the map size limit (docs/usage.md, Limits)
+_KEY = re.compile(r"(0|[1-9][0-9]{0,5})/([a-z_][a-z0-9_]{0,31})", re.ASCII)
+_PAIRS = {"path", "trail", "cands", "seen_xy"}  # (k, 2) arrays of (x, y) m
+_POINTS = {"target", "goal"}  # one (x, y) m
+# what a frame holds (tasks' Event.frame), name -> dimensions: a door search's, an indirect search's
+FRAME_KINDS = ({"map": 2, "path": 2, "distance": 0, "cands": 2, "target": 1, "read": 1},
+               {"p": 2, "p0": 0, "trail": 2, "t": 0, "goal": 1, "seen_names": 1, "seen_xy": 2})
+
+
+def read_npz(path: Path, what: str) -> dict[str, np.ndarray]:
+    """Every array of an ``.npz`` file semsearch wrote, each checked from its header before its
+    data is read: numbers or text only (no pickled objects), at most :data:`MAX_STORED` elements.
+    A file that is not such an archive (empty, cut short, another format) is a
+    :class:`ScenarioError` naming it, never a traceback or an allocation of the header's size."""
+    def damaged(field: str, why: str) -> ScenarioError:
+        return ScenarioError(str(path), field, f"not a {what} semsearch wrote ({why}); delete it (a report then "
+                             "re-simulates the run) or run the batch again")
+    out = {}
+    try:
+        with zipfile.ZipFile(path) as zf:
+            for info in zf.infolist():
+                name = info.filename.removesuffix(".npy")
+                with zf.open(info) as fh:
+                    version = np.lib.format.read_magic(fh)
+                    read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+                    shape, _, dtype = read(fh)
+                    if dtype.hasobject or dtype.kind not in "biufU":
+                        raise damaged(name, f"{name} holds {dtype} values, not numbers or text")
+                    if math.prod(shape) > MAX_STORED:
+                        raise damaged(name, f"{name} claims {' x '.join(map(str, shape))} values, more than {MAX_STORED:,}")
+                with zf.open(info) as fh:
+                    out[name] = np.lib.format.read_array(fh, allow_pickle=False)
+    except ScenarioError:
+        raise
+    except (OSError, EOFError, ValueError, zipfile.BadZipFile, zlib.error, NotImplementedError, RuntimeError) as exc:
+        raise damaged("", f"{type(exc).__name__}: {exc}") from None
+    return out
+
+
 def read_frames(path: Path) -> list[dict]:
-    """The frames :func:`write_frames` wrote, as the replay draws them."""
-    with np.load(path) as z:
-        frames = [dict() for _ in range(int(z["n"]))]
-        for key in z.files:
-            if key == "n":
-                continue
-            i, k = key.split("/", 1)
-            frames[int(i)][k] = z[key]
+    """The frames :func:`write_frames` wrote, as the replay draws them, read by :func:`read_npz`
+    and checked: a frame count ``n`` of at most :data:`MAX_FRAMES`, keys ``<frame>/<name>`` of a
+    frame below ``n``, (x, y) arrays of two columns; a :class:`ScenarioError` naming the file and
+    the key otherwise."""
+    arrays = read_npz(path, "replay frames file")
+
+    def bad(field: str, why: str) -> ScenarioError:
+        return ScenarioError(str(path), field, f"not a replay frames file semsearch wrote ({why}); delete it (a report then "
+                             "re-simulates the run) or run the batch again with --frames")
+    n = arrays.pop("n", None)
+    if n is None or n.shape != () or n.dtype.kind not in "iu" or not 0 <= int(n) <= MAX_FRAMES:
+        raise bad("n", f"the frame count must be a whole number from 0 to {MAX_FRAMES:,}, got "
+                  f"{'nothing' if n is None else n.ravel()[:3].tolist()}")
+    frames = [dict() for _ in range(int(n))]
+    for key, v in arrays.items():
+        m = _KEY.fullmatch(key)
+        if m is None or int(m[1]) >= len(frames):
+            raise bad(key, f"a key of frame index below {len(frames)} and a name, like 0/path, expected")
+        name = m[2]
+        if name != "seen_names" and v.dtype.kind == "U":
+            raise bad(key, "text where numbers belong")
+        if (name in _PAIRS and v.size and (v.ndim != 2 or v.shape[1] != 2)) or (name in _POINTS and v.shape != (2,)):
+            raise bad(key, f"(x, y) values expected, got an array of shape {v.shape}")
+        frames[int(m[1])][name] = v
+    for k, f in enumerate(frames):
+        kind = next((d for d in FRAME_KINDS if set(f) == set(d) - ({"seen_names", "seen_xy"} - set(f))), None)
+        if kind is None:
+            raise bad(f"{k}/", f"frame {k} holds {', '.join(sorted(f)) or 'nothing'}; a frame holds "
+                      + " or ".join(", ".join(d) for d in FRAME_KINDS))
+        for name, v in f.items():
+            if v.ndim != kind[name] and v.size:
+                raise bad(f"{k}/{name}", f"{kind[name]} dimension(s) expected, got an array of shape {v.shape}")
     for f in frames:
         if "seen_names" in f:
-            f["seen"] = {str(c): tuple(float(u) for u in xy) for c, xy in zip(f.pop("seen_names"), f.pop("seen_xy"))}
+            f["seen"] = {str(c): tuple(float(u) for u in xy) for c, xy in zip(f.pop("seen_names"), f.pop("seen_xy", ()))}
         for k, v in list(f.items()):
             if isinstance(v, np.ndarray) and v.ndim == 0:
                 f[k] = v.item()
         if "read" in f:
-            f["read"] = [int(i) for i in f["read"]]
-        if "target" in f or "goal" in f:
-            for k in ("target", "goal"):
-                if k in f:
-                    f[k] = tuple(float(u) for u in f[k])
+            f["read"] = [int(i) for i in np.ravel(f["read"])]
+        for k in ("target", "goal"):
+            if k in f:
+                f[k] = tuple(float(u) for u in f[k])
     return frames

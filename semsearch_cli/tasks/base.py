@@ -28,7 +28,7 @@ from ..registry import Registry
 from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
 from ..world.ground_truth import World
-from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words, region_mask
+from .episodes import Episode, check_hash, draw_starts, episode_seed, given_episodes, label_words, region_mask
 
 
 @dataclass
@@ -321,11 +321,25 @@ class Task:
             if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
                 raise ScenarioError(e["file"], e["field"], f"the start ({e['x']:g}, {e['y']:g}) m is not free space "
                                     "reachable from the scenario's start (or lies closer than the robot radius to a wall)")
-        # a drawn or default episode brings its shortest path; inf only for a goal nothing achieves
-        # (an object absent at its hour)
-        return [Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None,
-                        e["shortest"] if "shortest" in e else self.shortest_from(goal, e["x"], e["y"]))
-                for k, (goal, e) in enumerate(zip(goals, eps))]
+        # a drawn or default episode brings its shortest path (inf only for a goal nothing achieves:
+        # an object absent at its hour); a given one is measured here, one path search per goal
+        # (its distance field) when the goal has several starts, one per start otherwise
+        shortest = {k: e["shortest"] for k, e in enumerate(eps) if "shortest" in e}
+        by_goal: dict[str, list[int]] = {}
+        for k, goal in enumerate(goals):
+            if k not in shortest:
+                by_goal.setdefault(str(goal), []).append(k)
+        for key, ks in by_goal.items():
+            if len(ks) > 1:
+                self.goal_field(goals[ks[0]])
+            for k in ks:
+                shortest[k] = self.shortest_from(goals[k], eps[k]["x"], eps[k]["y"])
+            self._fields.pop(key, None)
+        out = [Episode(k, goal, float(e["x"]), float(e["y"]), e["heading"], None, shortest[k])
+               for k, (goal, e) in enumerate(zip(goals, eps))]
+        for ep, e in zip(out, eps):
+            check_hash(ep, e)
+        return out
 
     def start_episode(self, goal) -> dict:
         """The episode of ``goal`` from the scenario's start (its heading, or None: per repeat), with

@@ -36,13 +36,14 @@ import hashlib
 import io
 import json
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ..config.base import EpisodesSpec
+from ..config.base import MAX_EPISODES, EpisodesSpec, sign_label
 from ..errors import ScenarioError
 from ..files import read_user_text
 
@@ -129,14 +130,20 @@ def draw_starts(stand: np.ndarray, fields: list[np.ndarray], to_world, n: int, r
 
 
 def read_episodes_csv(path: Path, owner: str) -> list[dict]:
-    """The rows of an episodes CSV (goal, start_x, start_y, start_heading[, room]) as dicts; a
-    :class:`ScenarioError` naming the file and the line for anything else."""
+    """The rows of an episodes CSV (goal, start_x, start_y, start_heading[, room][, hash]) as
+    dicts; a :class:`ScenarioError` naming the file and the line for anything else. At most
+    ``MAX_EPISODES`` (100,000) rows, refused before any is measured; a goal is read in its
+    canonical form (``304.0`` is 304, :func:`~semsearch_cli.config.base.sign_label`); a row's
+    ``hash``, when given, must be its episode's (:func:`check_hash`)."""
     text = read_user_text(path, "episodes file", owner, "episodes.file")
     reader = csv.DictReader(io.StringIO(text))
     rows = []
     try:
         for r in reader:
             rows.append((reader.line_num, r))
+            if len(rows) > MAX_EPISODES:
+                raise ScenarioError(str(path), f"line {reader.line_num}", f"more than {MAX_EPISODES:,} episodes, the bound "
+                                    "of an episode set (docs/usage.md, Limits); split the set into several scenarios")
     except csv.Error as exc:
         raise ScenarioError(str(path), f"line {reader.line_num}", f"not a CSV file semsearch can read ({exc})") from None
     need = {"goal", "start_x", "start_y"}
@@ -145,19 +152,47 @@ def read_episodes_csv(path: Path, owner: str) -> list[dict]:
                             "(as semsearch episodes writes), with at least one row")
     out = []
     for k, r in rows:
+        if None in r:
+            raise ScenarioError(str(path), f"line {k}", f"{len(r[None]) + len(reader.fieldnames)} fields where the header "
+                                f"has {len(reader.fieldnames)} ({', '.join(reader.fieldnames)})")
         try:
-            x, y = float(r["start_x"]), float(r["start_y"])
+            x, y = _number(r["start_x"]), _number(r["start_y"])
             h = (r.get("start_heading") or "").strip()
-            heading = None if h in ("", "random") else float(h)
+            heading = None if h in ("", "random") else _number(h)
             room = (r.get("room") or "").strip()
         except (TypeError, ValueError):
             raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be numbers "
                                 "(start_heading may be empty: drawn at each repeat)") from None
         if not all(math.isfinite(v) for v in (x, y) + (() if heading is None else (heading,))):
             raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be finite")
-        out.append({"goal": (r["goal"] or "").strip(), "x": x, "y": y, "heading": heading, "room": room or None,
-                    "file": str(path), "field": f"line {k}"})
+        try:
+            goal = sign_label(r["goal"] or "")
+        except ValueError as exc:
+            raise ScenarioError(str(path), f"line {k} goal", str(exc)) from None
+        out.append({"goal": goal, "x": x, "y": y, "heading": heading, "room": room or None,
+                    "hash": (r.get("hash") or "").strip() or None, "file": str(path), "field": f"line {k}"})
     return out
+
+
+_NUMBER = re.compile(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*", re.ASCII)
+
+
+def _number(text) -> float:
+    """A CSV cell as a number, written as numbers are (``1_5`` and ``١٥`` are not, though
+    Python's ``float`` reads them as 15); inf and nan as such, refused by the caller."""
+    if text is None or not (_NUMBER.fullmatch(text) or text.strip().lstrip("+-").lower() in ("inf", "nan", "infinity")):
+        raise ValueError(text)
+    return float(text)
+
+
+def check_hash(ep: Episode, given: dict) -> None:
+    """A :class:`ScenarioError` when an episode read from a file carries a ``hash`` that is not
+    its own: the row was edited after ``semsearch episodes`` wrote it (its runs would be matched to
+    the old episode's). Remove the hash, or the whole column, to accept an edit."""
+    if given.get("hash") and given["hash"] != ep.hash:
+        raise ScenarioError(given["file"], f"{given['field']} hash", f"the row's hash {given['hash']} is not its "
+                            f"episode's ({ep.hash}): the goal, start or room was edited after semsearch episodes wrote "
+                            "it; clear the hash to keep the edit")
 
 
 def given_episodes(spec: EpisodesSpec, base: Path, file: str) -> list[dict] | None:

@@ -28,16 +28,16 @@ from scipy import ndimage
 import yaml
 
 from ..belief.indirect import IndirectBelief, relation_mask
-from ..config.indirect import CATEGORIES
-from ..errors import ScenarioError
+from ..config.indirect import CATEGORIES, SIDE_BLIND_TABLES
+from ..errors import ScenarioError, did_you_mean
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch
 from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.indirect import SemanticCamera, YawMemory
-from ..world.rooms import Room, estimate_relations, generate_rooms, read_rooms
+from ..world.rooms import OBJECT_GAP, WALL_MARGIN, Room, estimate_relations, generate_rooms, read_rooms
 from .base import Event, Observer, Outcome, RobotState, RunResult, Task, checked_point, register_task
-from .episodes import Episode, draw_starts, episode_seed, given_episodes, label_words
+from .episodes import Episode, check_hash, draw_starts, episode_seed, given_episodes, label_words
 from .loop import run_loop
 
 
@@ -335,6 +335,33 @@ class IndirectSearch:
 MAX_ROOM_CELLS = 1_000_000  # cells of one room's grid: the map, eight yaw hypotheses per class, the masks
 
 
+def check_classes(spec, file: str) -> None:
+    """A :class:`ScenarioError` naming ``indirect.target`` or ``indirect.relations.<class>`` for an
+    object class with no detection table: the paper's four (the tables of config/indirect.py serve
+    those) and those given in ``indirect.camera.detection``. A mistyped class was accepted, and
+    searched for with a table meant for another."""
+    known = list(dict.fromkeys([*SIDE_BLIND_TABLES, *(spec.camera.detection or {})]))
+    for field, name in [("indirect.target", spec.target), *((f"indirect.relations.{c}", c) for c in spec.secondary)]:
+        if name not in known:
+            raise ScenarioError(file, field, f"no detection table for the class {name!r}{did_you_mean(name, known)}; "
+                                f"the classes with one: {', '.join(known)}. A class of your own needs its table in "
+                                "indirect.camera.detection (8 rows, yaw 0..315 by 45 degrees, of 5 percentages, at "
+                                "0.8, 1.2, 1.6, 2.0 and 2.5 m)")
+
+
+def _generated(spec, file: str, field: str, n: int, seed: int, size, obstacles: int, which: str = "") -> list[Room]:
+    """:func:`generate_rooms`, its failure (no place left for an object after many draws: rooms
+    too small, or too full of obstacles) a :class:`ScenarioError` naming ``field``."""
+    try:
+        return generate_rooms(n, seed, spec.relations, spec.masks, spec.target, size, obstacles)
+    except ValueError as exc:
+        w, h = size
+        raise ScenarioError(file, field, f"{which}{exc}: rooms of {w:g} x {h:g} m{' with obstacles' if obstacles else ''} "
+                            f"cannot hold the {spec.target} and {len(spec.secondary)} secondary object(s), each "
+                            f"{WALL_MARGIN:g} m from the walls and obstacles and {OBJECT_GAP:g} m from the others; "
+                            "give larger rooms" + (" or fewer obstacles" if obstacles else "")) from None
+
+
 @register_task
 class IndirectTask(Task):
     """Indirect search: goals are view scales; each episode searches one room from one start."""
@@ -382,27 +409,20 @@ class IndirectTask(Task):
         task = cls(sc, world, path)
         spec = task.spec
         field = "indirect.rooms"
+        check_classes(spec, task.file)
         if isinstance(spec.rooms, str):
             rooms = read_rooms(task.path.parent / spec.rooms, spec.target, spec.secondary)
         else:
             g = spec.rooms
-            try:
-                rooms = generate_rooms(g.count, g.seed, spec.relations, spec.masks, spec.target, g.size, g.obstacles)
-            except ValueError as exc:
-                raise ScenarioError(task.file, field, str(exc)) from None
-        if spec.learned is not None:
-            training = generate_rooms(spec.learned.rooms, spec.learned.seed, spec.relations, spec.masks, spec.target,
-                                      rooms[0].size)
+            rooms = _generated(spec, task.file, "indirect.rooms.size", g.count, g.seed, g.size, g.obstacles)
+        if spec.learned is not None:  # training rooms of the test rooms' size (a rooms file's, or rooms.size)
+            where = "indirect.rooms.size" if not isinstance(spec.rooms, str) else "indirect.learned"
+            training = _generated(spec, task.file, where, spec.learned.rooms, spec.learned.seed, rooms[0].size, 0,
+                                  "a training room of indirect.learned: ")
             task.believe(estimate_relations(training, spec.target, spec.secondary, spec.masks))
         if spec.ablation == "no_secondary":
             for r in rooms:
                 r.objects = {spec.target: r.objects[spec.target]}
-        for cls_name in [spec.target, *spec.secondary]:
-            try:
-                task.camera.table(cls_name)
-            except KeyError:
-                raise ScenarioError(task.file, "indirect.camera.detection", f"no detection table for {cls_name!r}; give "
-                                    "one (rows yaw 0..315, columns 0.8..2.5 m)") from None
         w, h = rooms[0].size
         cells = math.ceil(w / spec.resolution) * math.ceil(h / spec.resolution)
         if cells > MAX_ROOM_CELLS:
@@ -514,6 +534,7 @@ class IndirectTask(Task):
         names = {g.room.name: k for k, g in enumerate(self.grids)}
         per_room: list[tuple[int, float, float, float | None, str, str]] = []  # room, x, y, heading, file, field
         scaled: list[tuple[float, int, float, float, float | None, str, str]] = []  # given with a scale
+        given: dict[tuple[str, str], dict] = {}  # (file, field) -> a row of an episodes file
         if spec is None:
             per_room = [(k, *g.room.start, self.file, f"indirect.rooms ({g.room.name})") for k, g in enumerate(self.grids)]
         elif spec.starts is not None:
@@ -531,6 +552,7 @@ class IndirectTask(Task):
                 per_room += [(k, x, y, h, self.file, "episodes") for x, y, h in starts]
         else:
             for e in given_episodes(spec, self.path.parent, self.file):
+                given[(e["file"], e["field"])] = e
                 room = e["room"] if e["room"] is not None else str(e["goal"])
                 if room not in names:
                     raise ScenarioError(e["file"], e["field"], f"no room named {room!r} (rooms: {', '.join(list(names)[:5])}, ...)")
@@ -551,6 +573,8 @@ class IndirectTask(Task):
                                     "the robot can stand on")
             out.append(Episode(len(out), scale, float(x), float(y), None if h is None else float(h), k,
                                self.shortest_of(k, scale, x, y)))
+            if (file, field) in given and given[(file, field)]["room"] is not None:  # one row, one episode
+                check_hash(out[-1], given[(file, field)])
         return out
 
     # ---- running ----------------------------------------------------------------------------

@@ -70,7 +70,12 @@ def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> li
         need = {"number", "x", "y", "facing"}
         if reader.fieldnames is None or not need <= set(reader.fieldnames):
             raise ScenarioError(str(path), field, f"expected CSV columns number,x,y,facing (got {reader.fieldnames})")
-        rows = list(reader)
+        rows = []
+        for row in reader:  # a row of more or fewer fields than the header is no sign
+            if None in row or None in row.values():
+                raise ScenarioError(str(path), f"line {reader.line_num}", f"{'more' if None in row else 'fewer'} fields "
+                                    f"than the header's {len(reader.fieldnames)} ({','.join(reader.fieldnames)})")
+            rows.append(row)
     out = []
     for i, row in enumerate(rows):
         if not isinstance(row, dict):

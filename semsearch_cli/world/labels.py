@@ -6,7 +6,8 @@ beside the number's: ``D``, ``a``; or the door index ``/2``). The number is the 
 after which only a short letter suffix (at most three letters) and a door index may follow; what
 comes before it is the prefix, its trailing separators (``.``, ``-``, ``_``, a space) dropped. So
 ``2.14`` is floor 2, room 14, and ``3-107a`` is wing 3, room 107, suffix a. A label with no digits
-(``Lab``, ``Kitchen``) has no number.
+(``Lab``, ``Kitchen``) has no number; digits are ASCII ``0-9`` (``30²`` has none), and a
+label is at most 64 characters (:data:`~semsearch_cli.config.base.MAX_LABEL`).
 
 How the planners use it (nsos, the draft planner): a goal is matched on the whole label, and the
 semantic terms reason on the numbers of the signs that share the goal's prefix (a sign with a
@@ -22,7 +23,10 @@ from functools import lru_cache
 
 import numpy as np
 
-_LABEL = re.compile(r"(?P<prefix>.*?)(?P<number>\d+)(?P<suffix>[A-Za-z]{0,3}(?:/\d+)?)")
+from ..config.base import MAX_LABEL, MAX_LABEL_DIGITS
+
+# ASCII digits only (re.ASCII): a superscript or an Arabic-Indic digit is text, never part of a number
+_LABEL = re.compile(r"(?P<prefix>.*?)(?P<number>[0-9]+)(?P<suffix>[A-Za-z]{0,3}(?:/[0-9]+)?)", re.ASCII)
 
 
 @dataclass(frozen=True)
@@ -40,8 +44,11 @@ def parse_label(label) -> SignLabel | None:
     if isinstance(label, bool):
         return None
     if isinstance(label, (int, np.integer)):
-        return SignLabel("", int(label), "") if label >= 0 else None
-    m = _LABEL.fullmatch(str(label).strip())
-    if m is None:
+        return SignLabel("", int(label), "") if 0 <= label < 10 ** MAX_LABEL_DIGITS else None
+    text = str(label).strip()
+    if len(text) > MAX_LABEL:  # refused where labels are read (config.base.sign_label); never parsed here
+        return None
+    m = _LABEL.fullmatch(text)
+    if m is None or len(m["number"]) > MAX_LABEL_DIGITS:
         return None
     return SignLabel(m["prefix"].rstrip(".-_ "), int(m["number"]), m["suffix"])

@@ -31,13 +31,19 @@ from ...geometry import GridFrame
 from ..scenario_folder import map_image, scenario_dict, write_building
 from ..labels import parse_label
 from ...config import parse_scenario
+from ...config.base import sign_label
 from .mobilesim import MARGIN_M, snap_report, snap_signs, spread_goals
 from ..ground_truth import build_world
 
 
 def _label(name: str):
+    """A space's sign label: its name after the floor prefix (``A4_2512`` -> 2512), in the one
+    canonical form (config.base.sign_label); None when that is no label (empty, too long)."""
     tail = name.split("_", 1)[1] if "_" in name else name
-    return int(tail) if tail.isdigit() else tail
+    try:
+        return sign_label(tail)
+    except ValueError:
+        return None
 
 
 CORRIDOR_TYPES = ("KORRIDOR", "PASSAGE", "HALL", "KULVERT", "ENTRE")
@@ -131,7 +137,7 @@ def import_kth(xml_path: Path, out: Path, res: float = 0.1, goals: list | None =
                     links.setdefault((s.get("name"), ls.get("target")), []).append(np.array([[x1, -y1], [x2, -y2]]))
         else:
             for ls in s.iter("linesegment"):
-                if ls.get("type") == "Portal" and ls.get("target") in corridors:
+                if ls.get("type") == "Portal" and ls.get("target") in corridors and _label(s.get("name")) is not None:
                     x1, y1, x2, y2 = seg(ls)
                     portals.append((_label(s.get("name")), (x1 + x2) / 2, -(y1 + y2) / 2))
     polys = [p for p in polys if len(p) >= 3]

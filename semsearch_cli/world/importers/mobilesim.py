@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from ...config.base import sign_label
 from ...errors import ScenarioError
 from ...files import read_user_text
 from ...geometry import GridFrame
@@ -57,7 +58,11 @@ def read_mobilesim_doors(path: Path) -> list[tuple]:
             x, y, num, facing = float(parts[0]), float(parts[1]), parts[2], float(parts[3])
         except (ValueError, IndexError):
             raise ScenarioError(str(path), f"line {k + 1}", f"expected 'x y number facing', got {line!r}") from None
-        out.append((int(num) if num.lstrip("-").isdigit() else num, x, y, facing))
+        try:
+            label = sign_label(num)
+        except ValueError as exc:
+            raise ScenarioError(str(path), f"line {k + 1}", f"the sign's number: {exc}") from None
+        out.append((label, x, y, facing))
     return out
 
 
@@ -176,7 +181,10 @@ def import_mobilesim(map_path: Path, doors_path: Path, out: Path, res: float = 0
         raise ScenarioError("<command line>", "--start", f"start {start} m is not in free space of {map_path}")
     free = lab == lab[r, c]
     snapped, report = snap_report(signs, snap_signs(free, frame, signs), frame)
-
+    if not snapped:
+        raise ScenarioError(str(doors_path), "", f"none of its {len(signs)} signs lies within {MAX_SNAP_M:g} m of the free "
+                            f"space the robot can reach from the start {start} m: there is no sign to read and no goal "
+                            "to seek; are the signs in the map's frame (millimetres)?")
     if not goals:
         goals = spread_goals(free, frame, snapped, start)
     scen = scenario_dict(name or map_path.stem, res, start, goals, [{"name": "greedy"}, {"name": "bvp"}],
