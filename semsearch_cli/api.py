@@ -25,7 +25,7 @@ from .runner import BatchOptions, Loaded, check_folder, expand, folder_lock, mak
 from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
-from .files import inside, output_file, output_folder, temp_path
+from .files import check_outputs, inside, output_file, output_folder, temp_path
 from . import shipped
 from .shipped import scenario_file
 
@@ -172,8 +172,9 @@ def _load_value(path: Path, data: dict, param: str, value) -> Loaded:
     try:
         return Loaded.load(path, with_param(data, param, value, path))
     except ScenarioError as exc:
-        if exc.file == str(path) and exc.field and (exc.field == param or exc.field.startswith(param + ".")
-                                                     or param.endswith("." + exc.field.split(".")[-1])):
+        own = exc.field == param or exc.field.startswith(param + ".") or (  # a section's field, or a planner's parameter
+            exc.field.startswith("planners[") and exc.field.split(".")[-1] == param.split(".")[-1])
+        if exc.file == str(path) and own:
             raise ScenarioError("<command line>", "--param", f"{param}={str(value).lower() if isinstance(value, bool) else value} "
                                 f"({exc.field} of the scenario): {exc.message}") from None
         raise
@@ -195,6 +196,7 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
     shared = (make_executor(options.workers, None, options.executor, options.scheduler) if options.executor != "processes"
               else nullcontext())
     with folder_lock(out_dir), shared as runner:
+        check_outputs(out_dir, ("sweep.csv", "sweep.md", "sweep.png"))
         subs = [inside(out_dir, f"{param}={v}") for v in values]
         for ld, sub in zip(loaded, subs):  # refuse foreign rows before anything runs
             check_folder(ld, sub, options.force)

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from semsearch_cli.config.base import sign_label
+from semsearch_cli.config.base import label_column, sign_label
 from semsearch_cli.config.scenario import load_yaml_text
 from semsearch_cli.errors import ScenarioError
 from semsearch_cli.metrics import COLUMNS
@@ -24,7 +24,8 @@ from semsearch_cli.tasks import episodes as episodes_mod
 from semsearch_cli.tasks.episodes import Episode
 
 
-@pytest.mark.parametrize("written, label", [(148, 148), ("148", 148), (" 148.0 ", 148), ("304.0", 304), (304.0, 304),
+@pytest.mark.parametrize("written, label", [(148, 148), ("148", 148), (" 148 ", 148), ("304.0", "304.0"), (304.0, 304),
+                                            ("Room\xa0101", "Room 101"),
                                             ("2.14", "2.14"), ("4.50", "4.50"), ("1e3", "1e3"), ("NA", "NA"),
                                             ("30²", "30²"), ("K202", "K202"), (10 ** 17, 10 ** 17)])
 def test_a_label_has_one_canonical_form(written, label):
@@ -33,10 +34,15 @@ def test_a_label_has_one_canonical_form(written, label):
 
 @pytest.mark.parametrize("written, says", [("", "empty"), ("  ", "empty"), ("x" * 65, "64 characters"),
                                            ("9" * 19, "18 digits"), (10 ** 19, "18 digits"), (float("nan"), "finite"),
-                                           ("a\tb", "printable"), ("9" * 60_000, "64 characters")])
+                                           ("a\tb", "control character"), ("9" * 60_000, "64 characters")])
 def test_a_label_beyond_its_bounds_is_refused_naming_the_bound(written, says):
     with pytest.raises(ValueError, match=says):
         sign_label(written)
+
+
+def test_a_spreadsheets_column_of_floats_is_its_numbers_and_a_mixed_column_is_text():
+    assert label_column(["304.0", " 101.00", "-2.0"]) == [304, 101, -2]
+    assert label_column(["3.0", "K202", "148"]) == ["3.0", "K202", 148]
 
 
 def test_numbers_are_read_as_written():
@@ -56,7 +62,10 @@ def _scenario(demo_dir: Path, folder: Path, **changes) -> Path:
 
 
 @pytest.mark.parametrize("text, says", [("episodes:\n  starts: yes\n", "episodes.starts"),
-                                        ("start: {x: 1_5, y: 10.0}\n", "start.x")])
+                                        ("start: {x: 1_5, y: 10.0}\n", "start.x"),
+                                        ("start: {x: 15.0, y: 10.0}\nlaser: {beams: 010}\n", "laser.beams"),
+                                        ("start: {x: 15.0, y: 10.0}\nlaser: {beams: '010'}\n", "laser.beams"),
+                                        ("start: {x: 15.0, y: 10.0}\nrobot: {radius: yes}\n", "robot.radius")])
 def test_a_yaml_boolean_or_an_underscored_number_is_refused_where_a_number_belongs(demo_dir, tmp_path, text, says):
     path = _scenario(demo_dir, tmp_path)
     data = yaml.safe_load(path.read_text())
@@ -98,6 +107,8 @@ def test_runs_csv_is_read_strictly(tmp_path):
     f = tmp_path / "runs.csv"
     pd.DataFrame([base, {**base, "seed": 1, "outcome": "error", "distance_m": float("nan")}]).to_csv(f, index=False)
     assert list(read_runs(f)["seed"]) == [0, 1]  # a failed run has no distance
+    pd.DataFrame([{**base, "outcome": "not_found", "shortest_m": float("inf"), "left_m": float("inf")}]).to_csv(f, index=False)
+    assert np.isinf(read_runs(f)["shortest_m"]).all()  # semsearch writes inf for a goal nothing achieves
     for change, says in (({"distance_m": float("nan")}, "distance_m"), ({"distance_m": float("inf")}, "distance_m"),
                          ({"distnace": 1.0}, "'distnace'.*did you mean 'distance_m'")):
         pd.DataFrame([{**base, **change}]).to_csv(f, index=False)

@@ -7,6 +7,7 @@ array too big for memory or a loop that never ends."""
 from __future__ import annotations
 
 import re
+import unicodedata
 from typing import Annotated, Any, Literal, Union, get_args
 
 import numpy as np
@@ -24,19 +25,21 @@ Angle = Annotated[float, Field(ge=-3600.0, le=3600.0, description="degrees")]
 
 MAX_LABEL = 64  # characters of a sign's label (a goal, a room): longer is not a label but a file name too long
 MAX_LABEL_DIGITS = 18  # digits of a whole-number label: it is kept as a 64-bit integer
-_WHOLE = re.compile(r"[-+]?[0-9]+(?:\.0*)?", re.ASCII)  # 148, 148.0 (a spreadsheet's column of numbers)
+_WHOLE = re.compile(r"[-+]?[0-9]+", re.ASCII)
+_SPREADSHEET = re.compile(r"[-+]?[0-9]+\.0+", re.ASCII)  # 304.0: a whole number a spreadsheet wrote as a float
 
 
 def sign_label(value):
     """A sign's label in its one canonical form, wherever it was written (a scenario, a doors or
     episodes CSV, ``--goal``, an importer): a whole number (``148``, ``"148"`` in YAML or a CSV,
-    ``148.0`` or ``"148.0"`` from a spreadsheet column of numbers) is an int, anything else
-    (``K202``, ``24D``, ``2.14``, ``NA``) stripped text. A goal is then matched to its sign however
-    either was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV.
+    the float ``148.0``) is an int, anything else (``K202``, ``24D``, ``2.14``, ``NA``) stripped
+    text, its spaces (a spreadsheet's non-breaking space) plain. A goal is then matched to its sign
+    however either was written: ``goals: ["148"]`` finds the sign ``148`` of a CSV. A CSV column
+    a spreadsheet wrote as floats (``304.0``) is read by :func:`label_column`.
 
-    Bounds (a ``ValueError`` naming them): at most ``MAX_LABEL`` (64) characters, printable, not
-    empty; a whole number has at most ``MAX_LABEL_DIGITS`` (18) digits. Digits are ASCII ``0-9``
-    only: ``30²`` or ``٣٠`` is a text label with no number, never the number 30."""
+    Bounds (a ``ValueError`` naming them): at most ``MAX_LABEL`` (64) characters, no control
+    character, not empty; a whole number has at most ``MAX_LABEL_DIGITS`` (18) digits. Digits are
+    ASCII ``0-9`` only: ``30²`` or ``٣٠`` is a text label with no number, never the number 30."""
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, (float, np.floating)):
@@ -50,19 +53,47 @@ def sign_label(value):
     text = str(value)
     if len(text) > 4 * MAX_LABEL:  # before any work on it: a 60,000-character label is refused at once
         raise ValueError(f"a label has at most {MAX_LABEL} characters, got {len(text)}")
-    text = text.strip()
+    text = "".join(" " if unicodedata.category(ch) == "Zs" else ch for ch in text).strip()
     if not text:
         raise ValueError("a label cannot be empty")
     if len(text) > MAX_LABEL:
         raise ValueError(f"a label has at most {MAX_LABEL} characters, got {len(text)}: {text[:20]}...")
-    if not text.isprintable():
-        raise ValueError(f"a label holds only printable characters (no tab, newline or control character), got {text!r}")
+    if any(unicodedata.category(ch) in ("Cc", "Cf", "Zl", "Zp") for ch in text):
+        raise ValueError(f"a label holds no tab, line break or other control character, got {text!r}")
     if _WHOLE.fullmatch(text):
-        return sign_label(int(text.split(".")[0]))
+        return sign_label(int(text))
     return text
 
 
+def label_column(values: list) -> list:
+    """The labels of one CSV column (a doors file's numbers, an episodes file's goals), each by
+    :func:`sign_label`; when every one of them is a whole number written as a float (``304.0``,
+    ``101.00``: a spreadsheet's column of numbers), they are those numbers. A column that mixes
+    ``3.0`` with ``K202`` or ``2.14`` is text (``3.0`` may be floor 3, room 0)."""
+    texts = [str(v).strip() for v in values]
+    if texts and all(_SPREADSHEET.fullmatch(t) for t in texts):
+        return [sign_label(int(t.split(".")[0])) for t in texts]
+    return [sign_label(v) for v in values]
+
+
+_NUMBER = re.compile(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*", re.ASCII)
+
+
+def number_text(text) -> float:
+    """A number written in a CSV or a text file, read as a person writes numbers: ``1_5`` and
+    ``١٥``, which Python's ``float`` reads as 15, raise ``ValueError``; so does anything not a
+    number. ``inf`` and ``nan`` are read as such (the caller refuses them where they are wrong)."""
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        return float(text)
+    if not isinstance(text, str) or not (_NUMBER.fullmatch(text) or text.strip().lstrip("+-").lower() in ("inf", "nan", "infinity")):
+        raise ValueError(f"not a number: {text!r}")
+    return float(text)
+
+
 Label = Annotated[Union[int, str], BeforeValidator(sign_label)]
+
+
+_ODD_NUMBER = re.compile(r"_|^\s*[-+]?0[0-9]", re.ASCII)  # 1_5 (Python reads 15), 010 (YAML 1.1 reads 8)
 
 
 def _takes(annotation, types) -> bool:
@@ -80,11 +111,14 @@ class Strict(BaseModel):
     @field_validator("*", mode="before")
     @classmethod
     def _numbers_as_written(cls, value, info):
-        f = cls.model_fields[info.field_name]
-        if isinstance(value, bool) and not _takes(f.annotation, bool):
-            raise ValueError("expected a number or text, not yes/no (a YAML boolean: yes, no, on, off, true, false)")
-        if isinstance(value, str) and "_" in value and _takes(f.annotation, (int, float)) and not _takes(f.annotation, str):
-            raise ValueError("expected a number, written without underscores")
+        ann = cls.model_fields[info.field_name].annotation
+        if isinstance(value, dict) or not _takes(ann, (int, float)):
+            return value  # a section (checked by its own model), or a field of no numbers
+        for leaf in value if isinstance(value, (list, tuple)) else (value,):  # a number or a list of numbers
+            if isinstance(leaf, bool) and not _takes(ann, bool):
+                raise ValueError("expected a number or text, not yes/no (a YAML boolean: yes, no, on, off, true, false)")
+            if isinstance(leaf, str) and not _takes(ann, str) and _ODD_NUMBER.search(leaf):
+                raise ValueError(f"expected a number as written in decimal, got {leaf!r} (no underscores, no leading zeros)")
         return value
 
 

@@ -168,7 +168,8 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
     if variant is None:
         return
     frames, how = replay_frames(folder, label, goal, seed, episode,
-                                lambda watch: _rerun(loaded.task, variant, goal, episode, seed, watch))
+                                lambda watch: _rerun(loaded.task, variant, goal, episode, seed, watch),
+                                failed=row["outcome"] == "error")
     if not frames:
         return
     signs = w.signs

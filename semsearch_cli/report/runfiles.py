@@ -107,12 +107,12 @@ def start_points(rows: pd.DataFrame, world) -> list[tuple[float, float]]:
 REPLAY_FRAMES = 60  # at most this many frames in a replay
 
 
-def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rerun) -> tuple[list[dict], str]:
+def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rerun, failed: bool = False) -> tuple[list[dict], str]:
     """A run's replay frames (at most :data:`REPLAY_FRAMES`, evenly spaced): read from
     ``frames/<run>.npz`` when ``semsearch run --frames`` recorded them, else by ``rerun(observer)``
     (re-simulating the run, which is deterministic, with a :class:`FrameRecorder` watching).
-    Returns (frames, "recorded" or "re-simulated"); a run whose planner raised (an ``error``
-    row) is re-simulated up to the error, which ``how`` names."""
+    Returns (frames, "recorded" or "re-simulated"); a run whose planner raised (``failed``: its row's
+    outcome is ``error``) is re-simulated up to the error, which ``how`` names."""
     for stem in stems(planner, goal, seed, episode):
         f = Path(folder) / "frames" / f"{stem}.npz"
         if f.is_file():
@@ -124,6 +124,8 @@ def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rer
         try:
             rerun(recorder)
         except Exception as exc:  # noqa: BLE001  a user's planner raised, as it did in the batch (an error row)
+            if not failed:
+                raise
             how = f"re-simulated up to the planner's error, {type(exc).__name__}: {str(exc)[:80]}"
         frames = recorder.frames
     step = max(1, -(-len(frames) // REPLAY_FRAMES))

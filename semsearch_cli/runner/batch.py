@@ -124,7 +124,7 @@ def _next_free(folder: Path, pattern: str) -> Path:
 
 # what a batch, and the report that follows it, write into a results folder
 BATCH_FILES = ("runs.csv", "runs.superseded.csv", "meta.json", "summary.csv", "report.md", "report.html")
-BATCH_FOLDERS = ("paths", "traces", "frames", "superseded", "tables", "figures")
+BATCH_FOLDERS = ("paths", "traces", "frames", "superseded", "tables", "figures", "logs")
 MANY_RUNS = 10_000  # a batch this large says how many runs it has before it starts
 LARGE_RUN = 1e9  # bytes: a batch whose runs need more than this each says so before it starts
 

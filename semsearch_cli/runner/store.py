@@ -18,6 +18,7 @@ import pandas as pd
 
 from ..errors import ScenarioError, did_you_mean
 from ..metrics import CAUSES, COLUMNS
+from ..planners.base import MAX_INFO_DEPTH
 from ..files import temp_path
 
 
@@ -75,10 +76,12 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     failed = df["outcome"].isin(["error", "timeout"]).to_numpy()  # a run that failed has no distance
     for c in NUMBERS:  # every number a run writes is finite; a few are never missing
         v = df[c].to_numpy(float)
-        bad = np.isinf(v) | (np.isnan(v) & ~failed if c == "distance_m" else False) | (v < 0 if c in MEASURED else False)
+        inf = np.isneginf(v) if c in UNREACHABLE else np.isinf(v)  # a goal nothing reaches: an infinite shortest path
+        bad = inf | (np.isnan(v) & ~failed if c == "distance_m" else False) | (v < 0 if c in MEASURED else False)
         if bad.any():
             k = int(bad.nonzero()[0][0])
-            raise ScenarioError(str(path), c, f"expected {'a finite number' if c not in MEASURED else 'a finite number >= 0'}"
+            want = "a finite number >= 0" if c in MEASURED else "a number, or inf" if c in UNREACHABLE else "a finite number"
+            raise ScenarioError(str(path), c, f"expected {want}"
                                 f", found {df[c].iloc[k]} on line {df.index[k] + 2} (edited by hand?); fix it, or write "
                                 "into another folder with --out")
     return df
@@ -90,6 +93,7 @@ LATER = {"episode": 0, "start_x": float("nan"), "start_y": float("nan"), "start_
 TEXT = ["stage", "map", "message", "room", "cause", "code"]
 KEY_TEXT = ("planner", "params", "goal")  # read as written: never a number, never missing
 MISSING = ["", "nan", "NaN", "NA", "N/A", "null", "None", "<NA>"]  # what pandas reads as missing in the other columns
+UNREACHABLE = ("shortest_m", "left_m", "ratio")  # +inf where nothing achieves the goal (an absent object)
 MEASURED = ("episode", "seed", "distance_m", "wall_s")  # never negative; a distance missing only in a failed run's row
 NUMBERS = ["episode", "seed", "start_x", "start_y", "start_heading", "success", "distance_m", "shortest_m", "ratio", "spl",
            "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s"]
@@ -164,7 +168,6 @@ def _cut_back(fh, size: int):
     return open(path, "a", newline="")
 
 
-MAX_NESTING = 100  # levels of containers in a trace's info (as planners.base checks a Decision's)
 
 
 def json_safe(v):
@@ -176,7 +179,7 @@ def json_safe(v):
 
 def _json_safe(v, outer: tuple):
     if isinstance(v, (dict, list, tuple, set, frozenset)):
-        if any(v is o for o in outer) or len(outer) >= MAX_NESTING:  # a container that holds itself
+        if any(v is o for o in outer) or len(outer) >= MAX_INFO_DEPTH:  # a container that holds itself
             return "<cycle>" if any(v is o for o in outer) else "<nested too deeply>"
         inner = (*outer, v)
         if isinstance(v, dict):

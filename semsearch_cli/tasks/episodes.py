@@ -36,14 +36,13 @@ import hashlib
 import io
 import json
 import math
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ..config.base import MAX_EPISODES, EpisodesSpec, sign_label
+from ..config.base import MAX_EPISODES, EpisodesSpec, label_column, number_text, sign_label
 from ..errors import ScenarioError
 from ..files import read_user_text
 
@@ -132,8 +131,9 @@ def draw_starts(stand: np.ndarray, fields: list[np.ndarray], to_world, n: int, r
 def read_episodes_csv(path: Path, owner: str) -> list[dict]:
     """The rows of an episodes CSV (goal, start_x, start_y, start_heading[, room][, hash]) as
     dicts; a :class:`ScenarioError` naming the file and the line for anything else. At most
-    ``MAX_EPISODES`` (100,000) rows, refused before any is measured; a goal is read in its
-    canonical form (``304.0`` is 304, :func:`~semsearch_cli.config.base.sign_label`); a row's
+    ``MAX_EPISODES`` (100,000) rows, refused before any is measured; the goals are read as labels
+    (:func:`~semsearch_cli.config.base.label_column`: a spreadsheet's column ``304.0`` is 304), each
+    row keeping its goal as written in ``text`` (an indirect search's room name); a row's
     ``hash``, when given, must be its episode's (:func:`check_hash`)."""
     text = read_user_text(path, "episodes file", owner, "episodes.file")
     reader = csv.DictReader(io.StringIO(text))
@@ -156,33 +156,33 @@ def read_episodes_csv(path: Path, owner: str) -> list[dict]:
             raise ScenarioError(str(path), f"line {k}", f"{len(r[None]) + len(reader.fieldnames)} fields where the header "
                                 f"has {len(reader.fieldnames)} ({', '.join(reader.fieldnames)})")
         try:
-            x, y = _number(r["start_x"]), _number(r["start_y"])
+            x, y = number_text(r["start_x"]), number_text(r["start_y"])
             h = (r.get("start_heading") or "").strip()
-            heading = None if h in ("", "random") else _number(h)
+            heading = None if h in ("", "random") else number_text(h)
             room = (r.get("room") or "").strip()
         except (TypeError, ValueError):
             raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be numbers "
                                 "(start_heading may be empty: drawn at each repeat)") from None
         if not all(math.isfinite(v) for v in (x, y) + (() if heading is None else (heading,))):
             raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be finite")
-        try:
-            goal = sign_label(r["goal"] or "")
-        except ValueError as exc:
-            raise ScenarioError(str(path), f"line {k} goal", str(exc)) from None
-        out.append({"goal": goal, "x": x, "y": y, "heading": heading, "room": room or None,
+        out.append({"goal": (r["goal"] or "").strip(), "x": x, "y": y, "heading": heading, "room": room or None,
                     "hash": (r.get("hash") or "").strip() or None, "file": str(path), "field": f"line {k}"})
+    try:  # the goals as labels, a spreadsheet's column of floats (304.0) as numbers; room names stay as written
+        goals = label_column([e["goal"] for e in out])
+    except ValueError as exc:
+        k = next(i for i, e in enumerate(out) if not _is_label(e["goal"]))
+        raise ScenarioError(str(path), f"{out[k]['field']} goal", str(exc)) from None
+    for e, goal in zip(out, goals):
+        e["text"], e["goal"] = e["goal"], goal
     return out
 
 
-_NUMBER = re.compile(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*", re.ASCII)
-
-
-def _number(text) -> float:
-    """A CSV cell as a number, written as numbers are (``1_5`` and ``١٥`` are not, though
-    Python's ``float`` reads them as 15); inf and nan as such, refused by the caller."""
-    if text is None or not (_NUMBER.fullmatch(text) or text.strip().lstrip("+-").lower() in ("inf", "nan", "infinity")):
-        raise ValueError(text)
-    return float(text)
+def _is_label(text) -> bool:
+    try:
+        sign_label(text)
+        return True
+    except ValueError:
+        return False
 
 
 def check_hash(ep: Episode, given: dict) -> None:

@@ -553,7 +553,7 @@ class IndirectTask(Task):
         else:
             for e in given_episodes(spec, self.path.parent, self.file):
                 given[(e["file"], e["field"])] = e
-                room = e["room"] if e["room"] is not None else str(e["goal"])
+                room = e["room"] if e["room"] is not None else str(e.get("text", e["goal"]))  # a room name as written (01)
                 if room not in names:
                     raise ScenarioError(e["file"], e["field"], f"no room named {room!r} (rooms: {', '.join(list(names)[:5])}, ...)")
                 if e["room"] is None:

@@ -16,6 +16,7 @@ import cv2
 import numpy as np
 
 from ..config import DoorSpec, OnMap, Scenario, read_yaml
+from ..config.base import label_column, number_text
 from ..errors import ScenarioError
 from ..files import read_user_text
 from ..geometry import GridFrame
@@ -73,15 +74,24 @@ def read_doors(path: Path, field: str = "doors", owner: str | None = None) -> li
         rows = []
         for row in reader:  # a row of more or fewer fields than the header is no sign
             if None in row or None in row.values():
-                raise ScenarioError(str(path), f"line {reader.line_num}", f"{'more' if None in row else 'fewer'} fields "
-                                    f"than the header's {len(reader.fieldnames)} ({','.join(reader.fieldnames)})")
+                fields = [v for k, v in row.items() if k is not None and v is not None] + list(row.get(None) or ())
+                raise ScenarioError(str(path), f"line {reader.line_num}", f"{len(fields)} fields ({','.join(fields)}); "
+                                    f"expected {len(reader.fieldnames)}, one per column of the header "
+                                    f"({','.join(reader.fieldnames)})")
             rows.append(row)
     out = []
     for i, row in enumerate(rows):
         if not isinstance(row, dict):
             raise ScenarioError(str(path), f"row {i + 1}", f"expected a sign {{number, x, y, facing}}, got {row!r}")
+    if rows and all("number" in r for r in rows):  # a spreadsheet's column of floats (304.0) is its numbers
         try:
-            out.append(DoorSpec(number=row["number"], x=float(row["x"]), y=float(row["y"]), facing=float(row["facing"])))
+            rows = [{**r, "number": n} for r, n in zip(rows, label_column([r["number"] for r in rows]))]
+        except ValueError:
+            pass  # each row's own label then names what is wrong, below
+    for i, row in enumerate(rows):
+        try:
+            out.append(DoorSpec(number=row["number"], x=number_text(row["x"]), y=number_text(row["y"]),
+                                facing=number_text(row["facing"])))
         except (KeyError, ValueError, TypeError) as exc:
             raise ScenarioError(str(path), f"row {i + 1}", f"cannot read a door sign from {row!r}: {exc}") from None
     return out

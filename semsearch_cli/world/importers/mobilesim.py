@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from ...config.base import sign_label
+from ...config.base import number_text, sign_label
 from ...errors import ScenarioError
 from ...files import read_user_text
 from ...geometry import GridFrame
@@ -39,7 +39,7 @@ def read_mobilesim_lines(path: Path) -> np.ndarray:
         if inside and s:
             parts = s.split()
             try:
-                segs.append([float(p) / 1000.0 for p in parts[:4]])
+                segs.append([number_text(p) / 1000.0 for p in parts[:4]])
             except ValueError:
                 raise ScenarioError(str(path), f"line {k + 1}", f"expected 'x1 y1 x2 y2' in millimetres, got {s!r}") from None
     if not segs:
@@ -55,7 +55,7 @@ def read_mobilesim_doors(path: Path) -> list[tuple]:
         if not parts:
             continue
         try:
-            x, y, num, facing = float(parts[0]), float(parts[1]), parts[2], float(parts[3])
+            x, y, num, facing = number_text(parts[0]), number_text(parts[1]), parts[2], number_text(parts[3])
         except (ValueError, IndexError):
             raise ScenarioError(str(path), f"line {k + 1}", f"expected 'x y number facing', got {line!r}") from None
         try:

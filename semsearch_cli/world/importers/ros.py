@@ -72,7 +72,6 @@ def import_ros(map_yaml: Path, doors: Path, out: Path, start: tuple[float, float
         cleaned = [f"cleaned the map: {gone:,} free cells ({gone * res * res:.1f} m2) the robot could not reach from the "
                    f"start, or narrower than the robot (laser fans), became outside (map.clean: true)"]
     free = lab == lab[r, c]
-    check_csv_fields(Path(doors))
     signs = [(d.number, d.x, d.y, d.facing) for d in read_doors(Path(doors))]
     if not signs:
         raise ScenarioError(str(doors), "", "no door signs")
@@ -107,20 +106,3 @@ def clearance(space: np.ndarray, res: float) -> np.ndarray:
     """
     d = cv2.distanceTransform(np.pad(space, 1).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
     return d * np.float32(res)
-
-
-def check_csv_fields(path: Path) -> None:
-    """A :class:`ScenarioError` naming the file and line of a doors CSV row with more or fewer
-    fields than its header (a five-field row was read as four, the fifth dropped); blank lines
-    are skipped, as the reader skips them. A YAML doors file is left to the reader."""
-    if path.suffix.lower() in (".yaml", ".yml"):
-        return
-    reader = csv.reader(io.StringIO(read_user_text(path, "door file"), newline=""))
-    header = next(reader, None)
-    if not header:
-        return  # the reader names the missing columns
-    for row in reader:
-        if row and len(row) != len(header):
-            raise ScenarioError(str(path), f"line {reader.line_num}", f"{len(row)} fields ({','.join(row)}); expected "
-                                f"{len(header)}, one per column of the header ({','.join(header)}): a sign's number, "
-                                "its x and y in m, and the direction it faces in degrees")
