@@ -8,6 +8,7 @@ import io
 import zipfile
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -195,3 +196,14 @@ def test_a_superseded_run_takes_its_files_aside_and_force_keeps_what_it_replaces
     assert sorted(p.stem for p in (out / "runs.1.bak" / "paths").iterdir()) == stems  # kept, not overwritten
     assert [p.stem for p in (out / "runs.1.bak" / "traces").iterdir()] == [stems[1]]  # the re-run one had no --trace
     assert [p.stem for p in (out / "paths").iterdir()] == [stems[0]]
+
+
+def test_an_inverted_map_is_blamed_on_the_map_not_the_start(demo_dir, tmp_path):
+    cv2.imwrite(str(tmp_path / "inverted.png"), 255 - cv2.imread(str(demo_dir / "map.png"), cv2.IMREAD_GRAYSCALE))
+    path = _scenario(demo_dir, tmp_path)
+    data = yaml.safe_load(path.read_text())
+    data["map"]["image"] = str(tmp_path / "inverted.png")
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ScenarioError, match="is the image inverted") as exc:
+        Loaded.load(path)
+    assert exc.value.field == "map.image"

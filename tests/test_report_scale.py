@@ -144,21 +144,24 @@ def test_goals_are_summarised_as_written(tmp_path):
     assert greedy["mean_lo"].notna().all()
 
 
-def test_a_missing_goal_read_as_a_number_is_kept_not_a_crash(tmp_path):
-    """Without as_written pandas reads NA as NaN: summary.csv (write_summary) and the report's
-    success table used to end in 'You are trying to merge on float64 and object columns'."""
+def test_a_goal_labelled_na_is_that_label_and_a_missing_goal_is_kept_not_a_crash(tmp_path):
+    """read_runs keeps a goal NA as the label "NA" (key columns are numbers only when lossless);
+    a DataFrame whose goal is missing (NaN) still summarises, the missing goal a group of its own:
+    summary.csv (write_summary) and the success table used to end in 'You are trying to merge on
+    float64 and object columns'."""
     f = runs_csv(tmp_path / "runs.csv", ["NA"])
     runs = read_runs(f)
-    assert runs["goal"].isna().all()
-    s = T.summarise(runs)
-    assert len(s) == 2 and s["goal"].isna().all() and list(s["planner"]) == ["bvp", "greedy"] and (s["n"] == 3).all()
-    assert s.loc[s["planner"] == "bvp", "mean"].item() == 26.0
-    t = T.success_and_spl(runs)
-    assert len(t) == 2 and (t["n"] == 3).all()
-    sig = T.significance(runs)
-    assert len(sig) == 1 and sig["goal"].isna().all() and sig["n_pairs"].item() == 3  # bvp against greedy, seed by seed
-    mixed = read_runs(runs_csv(tmp_path / "mixed.csv", ["NA", "54"]))  # 54.0 and NaN: both kept, NaN last
-    assert [g for g in T.summarise(mixed)["goal"]][::2] == [54.0, pytest.approx(np.nan, nan_ok=True)]
+    assert (runs["goal"] == "NA").all()
+    for goals in (runs, runs.assign(goal=np.nan)):
+        s = T.summarise(goals)
+        assert len(s) == 2 and list(s["planner"]) == ["bvp", "greedy"] and (s["n"] == 3).all()
+        assert s.loc[s["planner"] == "bvp", "mean"].item() == 26.0
+        t = T.success_and_spl(goals)
+        assert len(t) == 2 and (t["n"] == 3).all()
+        sig = T.significance(goals)
+        assert len(sig) == 1 and sig["n_pairs"].item() == 3  # bvp against greedy, seed by seed
+    mixed = read_runs(runs_csv(tmp_path / "mixed.csv", ["NA", "54"]))  # a number, then the text label
+    assert list(T.summarise(mixed)["goal"])[::2] == ["54", "NA"]
 
 
 # ---- figures from finite values -------------------------------------------------------------------

@@ -28,11 +28,12 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     a runs.csv written by semsearch is a :class:`ScenarioError`. ``stage`` and ``map`` are read as
     text (empty for a run's own row).
 
-    ``as_written``: a run's key columns (``planner``, ``params``, ``goal``) as the text that was
-    written, never a number or a missing value: a goal labelled ``4.50``, ``1e3`` or ``NA`` is that
-    label. A batch resumes (and moves rows aside) by these, so no label can make a run count
-    twice or be rewritten; without it, pandas reads them as it reads any column (``4.5``, NaN),
-    as the rows the API returns always have."""
+    A run's key columns (``planner``, ``params``, ``goal``) are never read as a missing value, and
+    as numbers only when every entry reads back as it was written (goals ``304``: int64; view
+    scales ``1.5``: float64): a goal labelled ``4.50``, ``1e3`` or ``NA`` is that label, in the
+    rows, the summary and the report. ``as_written``: those columns as text, always (a batch
+    resumes, and moves rows aside, by them, so no label can make a run count twice or be
+    rewritten)."""
     if path.is_dir():
         raise ScenarioError(str(path), "", "is a folder, not a runs.csv; move it away or write into another folder with --out")
     if not path.is_file() or path.stat().st_size == 0:
@@ -41,12 +42,11 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     data = data[: data.rfind(b"\n") + 1]  # whole lines only
     bad = "not a runs.csv written by semsearch; move it away or write into another folder with --out"
     try:
-        text = dict.fromkeys(KEY_TEXT, str) if as_written else {}
-        na = dict(keep_default_na=False, na_values={c: MISSING for c in [*COLUMNS, *LATER] if c not in KEY_TEXT}) \
-            if as_written else {}
         df = pd.read_csv(io.BytesIO(data), dtype={"stage": str, "map": str, "message": str, "kind": str, "scenario": str,
-                                                  "fingerprint": str, "code": str, "room": str, "cause": str, **text},
-                         encoding="utf-8", **na)  # a scenario may be named 50045233
+                                                  "fingerprint": str, "code": str, "room": str, "cause": str,
+                                                  **dict.fromkeys(KEY_TEXT, str)},
+                         encoding="utf-8", keep_default_na=False,
+                         na_values={c: MISSING for c in [*COLUMNS, *LATER] if c not in KEY_TEXT})  # a scenario may be named 50045233
     except (ValueError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
         raise ScenarioError(str(path), "", f"{bad} ({type(exc).__name__})") from None
     if "kind" not in df.columns and "wall_s" in df.columns:
@@ -59,6 +59,10 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
         if c not in df.columns:
             df[c] = df["outcome"].map(CAUSES) if c == "cause" else default
     df[TEXT] = df[TEXT].fillna("")
+    if not as_written:
+        for c in KEY_TEXT:
+            if c in df.columns:
+                df[c] = _lossless(df[c])
     extra = [c for c in df.columns if c not in COLUMNS]
     if extra:
         raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), COLUMNS)} "
@@ -85,6 +89,18 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
                                 f", found {df[c].iloc[k]} on line {df.index[k] + 2} (edited by hand?); fix it, or write "
                                 "into another folder with --out")
     return df
+
+
+def _lossless(col: pd.Series) -> pd.Series:
+    """A key column as numbers when every entry reads back as written (``304``, ``-2``: int64;
+    ``1.5``, ``2.0``: float64), else its text (``4.50``, ``1e3``, ``NA``, ``K202``)."""
+    text = col.astype(str)
+    if len(text) and text.str.fullmatch(r"-?[0-9]{1,18}").all():
+        return text.astype(np.int64)
+    num = pd.to_numeric(text, errors="coerce")
+    if len(text) and num.notna().all() and (num.map(lambda v: repr(float(v))) == text).all():
+        return num.astype(float)
+    return text
 
 
 # columns added after the first release, with what rows written before them stand for

@@ -297,6 +297,12 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     if not start_in:
         raise ScenarioError(file, "start", f"start ({sc.start.x:g}, {sc.start.y:g}) m lies outside the map: {extent}")
     if not start_ok:
+        wall = int((img < WALL_BELOW).sum())
+        if wall > free.sum() and not free[sr, scc]:  # more wall than free space, the start on a wall: an inverted image
+            raise ScenarioError(file, map_field, f"the start ({sc.start.x:g}, {sc.start.y:g}) m is on a wall, and the map "
+                                f"is more wall ({wall / img.size:.0%} of its pixels, < {WALL_BELOW} of 255) than free space "
+                                f"({free.sum() / img.size:.0%}, >= {FREE_FROM}): is the image inverted? Walls are dark, "
+                                "free space light")
         raise ScenarioError(file, "start", f"start ({sc.start.x}, {sc.start.y}) m is inside a wall or closer than the robot radius ({sc.robot.radius} m) to one")
     if bad:
         k = bad[0]
