@@ -5,6 +5,10 @@ import pytest
 
 matplotlib.use("Agg")
 
+import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+
+from semsearch_cli.report import plots  # noqa: E402
+
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 REF = SHARED / "reference_maps"
 
@@ -36,3 +40,13 @@ def _console_width(monkeypatch):
     the processes a test starts inherit it."""
     monkeypatch.setenv("COLUMNS", "200")
     monkeypatch.delenv("LINES", raising=False)
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures the plot functions draw, kept open instead of written (closed after the test)."""
+    figs = []
+    monkeypatch.setattr(plots, "_save", lambda fig, out, formats=("png",), dpi=plots.PNG_DPI: figs.append(fig) or [])
+    yield figs
+    for f in figs:
+        plt.close(f)

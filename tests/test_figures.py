@@ -220,14 +220,6 @@ def test_path_files_new_stem_then_old(demo_runs, tmp_path):
 
 
 # ---- figures that agree with their tables, and labels that do not collide (issue: new user) ------
-@pytest.fixture
-def drawn(monkeypatch):
-    """The figures the plot functions draw, kept open instead of written (closed after the test)."""
-    figs = []
-    monkeypatch.setattr(plots, "_save", lambda fig, out, formats=("png",), dpi=plots.PNG_DPI: figs.append(fig) or [])
-    yield figs
-    for f in figs:
-        plt.close(f)
 
 
 def has_data(ax) -> bool:

@@ -4,7 +4,6 @@ summarised by the text they were written with; figures that take limits from fin
 
 import tracemalloc
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
@@ -165,13 +164,6 @@ def test_a_goal_labelled_na_is_that_label_and_a_missing_goal_is_kept_not_a_crash
 
 
 # ---- figures from finite values -------------------------------------------------------------------
-@pytest.fixture
-def drawn(monkeypatch):
-    figs = []
-    monkeypatch.setattr(plots, "_save", lambda fig, out, formats=("png",), dpi=plots.PNG_DPI: figs.append(fig) or [])
-    yield figs
-    for fig in figs:
-        plt.close(fig)
 
 
 def doors(distances, success=1):
