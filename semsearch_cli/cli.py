@@ -510,8 +510,10 @@ def generate_rooms(
         spec = IndirectSpec()
         try:
             rooms = gen_rooms(n, seed, spec.relations, spec.masks, spec.target, (w, d), obstacles)
-        except ValueError as exc:
-            raise ScenarioError("<command line>", "--obstacles", str(exc)) from None
+        except ValueError as exc:  # no free place for an object: the boxes took it, or the room is too small for the rings
+            raise ScenarioError("<command line>", "--obstacles" if obstacles else "--size",
+                                f"{exc}" + ("" if obstacles else f" (a {w:g} x {d:g} m room is too small for the objects' "
+                                                                 "rings; give a larger --size)")) from None
         path = write_rooms(output_folder(out_dir) / "rooms.yaml", rooms)
     except ScenarioError as exc:
         _fail(exc)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from pathlib import Path
 
@@ -108,6 +109,11 @@ def main() -> int:
     ap.add_argument("--eval-buildings", type=int, default=20)
     ap.add_argument("--out", type=Path, default=Path("results/rl"))
     a = ap.parse_args()
+    if not (math.isfinite(a.minutes) and a.minutes > 0):
+        ap.error(f"--minutes must be a positive number, got {a.minutes}")
+    for flag, n in (("--buildings", a.buildings), ("--eval-buildings", a.eval_buildings)):
+        if n < 1:
+            ap.error(f"{flag} must be at least 1, got {n}")
     a.out.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
     vec = SubprocVecEnv([make_env(0, a.buildings, 500.0, s) for s in range(2)])
