@@ -47,8 +47,8 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
              "(next table).")
     doc.table(tabs["mean_std"])
     doc.heading(3, "Mean with its 95% interval [low, high] (n) beside the shortest path")
-    doc.para(f"{units}; n in brackets after each interval. The interval is a BCa bootstrap (SciPy, 9999 "
-             "resamples) of the mean of the per-unit mean distances.")
+    doc.para(f"{units}; n in brackets after each interval. The interval is a BCa bootstrap (9999 resamples, "
+             "drawn as scipy.stats.bootstrap draws them) of the mean of the per-unit mean distances.")
     doc.table(tabs["mean_ci"])
     doc.heading(3, "Mean as percent of the shortest path (Table 4.10)")
     doc.table(tabs["percent_of_optimal"], mark_rows=True)

@@ -33,7 +33,19 @@ def per_group(runs: pd.DataFrame, keys: list, fn, columns: list) -> pd.DataFrame
     also when there is no group, so that the result merges back on them."""
     rows = [dict(zip(keys, k)) | fn(d) for k, d in runs.groupby(keys, sort=True, dropna=False)]
     out = pd.DataFrame(rows, columns=keys + columns)
-    return out if len(out) else out.astype({k: runs[k].dtype for k in keys})
+    return in_goal_order(out) if len(out) else out.astype({k: runs[k].dtype for k in keys})
+
+
+def in_goal_order(df: pd.DataFrame) -> pd.DataFrame:
+    """``df``'s rows in the report's goal order: by scenario, then goal (:func:`goal_key`: ``4.50``
+    before ``1e3`` before ``NA``, whether the goals were read as numbers or as text), the rest in
+    the order they had (a stable sort). ``goal`` (and ``scenario``) are columns or index levels."""
+    flat = df.reset_index() if "goal" in (df.index.names or []) else df
+    if "goal" not in flat.columns:
+        return df
+    scen = flat["scenario"].astype(str).tolist() if "scenario" in flat.columns else [""] * len(flat)
+    order = sorted(range(len(flat)), key=lambda i: (scen[i], goal_key(flat["goal"].iat[i])))
+    return df.iloc[order]
 
 
 def _finite(v: pd.Series) -> pd.Series:
@@ -84,9 +96,7 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     # mixed types, must not decide which rows meet)
     more = pd.DataFrame([intervals(d) | {k: f(d) for k, f in extra.items()} for _, d in g], columns=INTERVALS + list(extra))
     out = pd.concat([out, more], axis=1)
-    order = sorted(range(len(out)), key=lambda i: (str(out["scenario"].iat[i]), goal_key(out["goal"].iat[i]),
-                                                   str(out["planner"].iat[i])))
-    out = out.iloc[order].reset_index(drop=True)
+    out = in_goal_order(out).reset_index(drop=True)  # the groups come sorted by planner within a goal
     cols = KEYS + ["n", "episodes", "success_rate", "success_lo", "success_hi", "median", "mean", "mean_lo", "mean_hi",
                    "std", "min", "max", "shortest_m", "mean_ratio"] + [c for c in extra if c != "shortest_m"] + ["unit", "n_units"]
     return out[cols].round(3)
@@ -138,7 +148,7 @@ def five_statistics(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> 
     t = long.pivot_table(index=["scenario", "goal", "statistic"], columns="planner", values="value", sort=False)
     t = t.reindex(columns=planner_order(t.columns))
     order = {k: i for i, k in enumerate(FIVE)}
-    return t.sort_index(level=[0, 1, 2], key=lambda idx: idx.map(order) if idx.name == "statistic" else idx)
+    return in_goal_order(t.sort_index(level=[0, 1, 2], key=lambda idx: idx.map(order) if idx.name == "statistic" else idx))
 
 
 def _wide(s: pd.DataFrame, cell) -> pd.DataFrame:
@@ -146,7 +156,7 @@ def _wide(s: pd.DataFrame, cell) -> pd.DataFrame:
     t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="cell", aggfunc="first")
     t = t.reindex(columns=planner_order(t.columns))
     t["shortest_m"] = s.groupby(["scenario", "goal"])["shortest_m"].first()
-    return t
+    return in_goal_order(t)
 
 
 def mean_std(runs: pd.DataFrame, summary: pd.DataFrame | None = None) -> pd.DataFrame:

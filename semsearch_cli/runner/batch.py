@@ -103,7 +103,7 @@ def _supersede(out: Path, which, why: str) -> None:
     files = [out / d / f"{st}{ext}" for st in sorted(stems) for d, ext in RUN_FILES if (out / d / f"{st}{ext}").is_file()]
     where = ""
     if files:
-        aside = _next_free(out / "superseded", "{}")
+        aside = _next_free(out / "superseded")
         for f in files:
             (aside / f.parent.name).mkdir(parents=True, exist_ok=True)
             os.replace(f, aside / f.parent.name / f.name)
@@ -114,12 +114,12 @@ def _supersede(out: Path, which, why: str) -> None:
 RUN_FILES = (("paths", ".npz"), ("traces", ".jsonl"), ("frames", ".npz"))  # a run's files, by its stem
 
 
-def _next_free(folder: Path, pattern: str) -> Path:
-    """``folder/pattern.format(n)`` for the first n = 1, 2, ... that does not exist."""
+def _next_free(folder: Path) -> Path:
+    """``folder/<n>`` for the first n = 1, 2, ... that does not exist."""
     n = 1
-    while (folder / pattern.format(n)).exists():
+    while (folder / str(n)).exists():
         n += 1
-    return folder / pattern.format(n)
+    return folder / str(n)
 
 
 # what a batch, and the report that follows it, write into a results folder

@@ -167,22 +167,15 @@ def read_episodes_csv(path: Path, owner: str) -> list[dict]:
             raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be finite")
         out.append({"goal": (r["goal"] or "").strip(), "x": x, "y": y, "heading": heading, "room": room or None,
                     "hash": (r.get("hash") or "").strip() or None, "file": str(path), "field": f"line {k}"})
-    try:  # the goals as labels, a spreadsheet's column of floats (304.0) as numbers; room names stay as written
-        goals = label_column([e["goal"] for e in out])
-    except ValueError as exc:
-        k = next(i for i, e in enumerate(out) if not _is_label(e["goal"]))
-        raise ScenarioError(str(path), f"{out[k]['field']} goal", str(exc)) from None
-    for e, goal in zip(out, goals):
+    for e in out:
+        try:
+            sign_label(e["goal"])
+        except ValueError as exc:
+            raise ScenarioError(str(path), f"{e['field']} goal", str(exc)) from None
+    # the goals as labels, a spreadsheet's column of floats (304.0) as numbers; room names as written too
+    for e, goal in zip(out, label_column([e["goal"] for e in out])):
         e["text"], e["goal"] = e["goal"], goal
     return out
-
-
-def _is_label(text) -> bool:
-    try:
-        sign_label(text)
-        return True
-    except ValueError:
-        return False
 
 
 def check_hash(ep: Episode, given: dict) -> None:
