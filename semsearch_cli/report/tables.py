@@ -185,7 +185,7 @@ def percent_of_optimal(runs: pd.DataFrame, summary: pd.DataFrame | None = None) 
     s = (summarise(runs) if summary is None else summary).copy()
     s["pct"] = (100.0 * s["mean"] / s["shortest_m"]).round(2)
     t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="pct")
-    return t.reindex(columns=planner_order(t.columns))
+    return in_goal_order(t.reindex(columns=planner_order(t.columns)))
 
 
 CAUSES = ("budget", "stuck", "explored", "error", "timeout")
@@ -291,7 +291,7 @@ def significance(runs: pd.DataFrame, baseline: str | None = None, value: str = "
             row |= {k: r[k] for k in ("mean_diff", "diff_lo", "diff_hi", "p_value", "effect_r")}
             row["note"] = "; ".join(_blanks(r) + ([f"n < {MIN_N}: too few units to judge"] if 0 < small < MIN_N else []))
             rows.append(row)
-    out = pd.DataFrame(rows, columns=SIGNIFICANCE)
+    out = in_goal_order(pd.DataFrame(rows, columns=SIGNIFICANCE)).reset_index(drop=True)
     return out.round({"mean_diff": 3, "diff_lo": 3, "diff_hi": 3, "effect_r": 3})
 
 
