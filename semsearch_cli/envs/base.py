@@ -3,7 +3,8 @@ reward, the action mask (``info["action_mask"]``, int8), the robot-centred windo
 the text observation's charset and shared wording (the frame statement, the answer line).
 
 An environment runs the batch's own simulator (the task a scenario builds, its sensors, belief and
-step loop, :class:`~semsearch_cli.tasks.loop.Stepper`); only who makes each decision changes. A
+step loop, :class:`~semsearch_cli.tasks.loop.Session`); only who answers each decision point changes:
+the agent's action, where the batch asks the planner. A
 reset draws an episode of the scenario's episode set (``episodes:`` section, or one per goal from
 its start) and a repeat, from the environment's generator; ``options={"episode": k, "repeat": s}``
 names them, and then the run is the one ``semsearch run`` records as episode ``k``, seed ``s``.
@@ -39,6 +40,7 @@ from ..config import load_scenario
 from .. import shipped as shipped_scenarios
 from ..errors import ScenarioError, did_you_mean
 from ..tasks import Task, build_task
+from ..tasks.decisions import DecisionPoint
 from ..tasks.episodes import Episode, episode_seed
 from ..world.ground_truth import build_world
 
@@ -171,6 +173,12 @@ def check_action(space: gym.spaces.Discrete, action) -> int:
         raise ValueError(f"action must be an integer from {lo} to {hi} (the action space, Discrete({space.n}); "
                          f"info['action_mask'] marks those valid now), not {_show(action)}")
     return a
+
+
+def ended(point) -> str | None:
+    """The outcome :meth:`~semsearch_cli.tasks.loop.Session.start` or ``answer`` returned, or None
+    when the episode waits at a decision point."""
+    return None if isinstance(point, DecisionPoint) else point
 
 
 def window(a: np.ndarray, r: int, c: int, radius: int, out: np.ndarray) -> np.ndarray:

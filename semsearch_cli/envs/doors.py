@@ -1,7 +1,8 @@
 """``semsearch/DoorSearch-v0``: find the door sign with the goal's label, one decision at a time.
 
 The environment is the batch's door search (:class:`~semsearch_cli.tasks.doors.DoorSearch` in
-the :class:`~semsearch_cli.tasks.loop.Stepper` loop); the agent takes the planner's place.
+the :class:`~semsearch_cli.tasks.loop.Session` loop); the agent takes the planner's place, answering the
+same decision points.
 
 Action modes
 ------------
@@ -61,8 +62,9 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..planners import Decision
-from ..tasks.doors import MAX_RETRIES, DoorSearch
-from ..tasks.loop import Stepper
+from ..tasks.decisions import DecisionPoint, StandIn
+from ..tasks.doors import DoorSearch
+from ..tasks.loop import Session
 from ..world.labels import parse_label
 from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, check_flag, check_number, clip_text, compass_moves,
                    compass_step, deg, text_space, window)
@@ -73,19 +75,6 @@ from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, check_flag, che
 MAX_WINDOW = 2048
 MAX_CANDIDATES = 254  # the candidates grid holds k + 1 (1..K) in a uint8
 MAX_SIGNS = 10_000  # rows of the signs observation: far more than a building has (the Hotel's layout at twice the scale: 469)
-
-
-class _Agent:
-    """Stands in the planner's place inside :class:`DoorSearch`: names the agent in the checks
-    and sets the re-plan cadence; its choices come through :meth:`DoorSearchEnv.step`."""
-
-    name = "agent"
-
-    def __init__(self, replan_on_signs: bool):
-        self.replan_on_signs = replan_on_signs
-
-    def choose(self, ctx, cands):  # pragma: no cover - the environment never lets DoorSearch call it
-        raise RuntimeError("the agent chooses through step()")
 
 
 class DoorSearchEnv(SearchEnv):
@@ -149,35 +138,29 @@ class DoorSearchEnv(SearchEnv):
         t, ep = self.task, self.episode
         self.state = st = t.start_state(ep, self.rng)
         st.belief = t.new_belief()
-        self.search = DoorSearch(t, _Agent(self.replan_on_signs), ep.goal, self.rng)
+        # the agent in the planner's seat: named in the checks of its choices, with the re-plan cadence
+        self.search = DoorSearch(t, StandIn("agent", {"replan_on_signs": self.replan_on_signs}), ep.goal, self.rng)
         self.goal_label = parse_label(ep.goal)
         self.decision = None
         if self.action_mode == "macro":
-            self.stepper = Stepper(self.search, st, self.step_m, self.budget, self.step_limit)
-            self.outcome = self._to_decision(self.stepper.advance())
+            self.session = Session(self.search, st, self.step_m, self.budget, self.step_limit)
+            self.outcome = self._to_choice(self.session.start())
         else:
             found, _ = self.search.sense(st)
             self.search.update(st)
             self.outcome = "found" if found else None
 
-    def _to_decision(self, out):
-        """Run the loop from a re-plan to the next one the agent makes (candidates to choose from),
-        or to the end; returns the outcome or None."""
-        st, search = self.state, self.search
-        while out is None:
-            prep = search.prepare(st)
-            if isinstance(prep, str):
-                out = self.stepper.follow(prep)
-                continue
-            ctx, cands = prep
-            if len(cands) == 0:
-                out = self.stepper.follow(search.sweep(st, ctx))
-                continue
-            self._set_decision(ctx, cands)
-            self._tries = 0
-            return None
-        self.decision = None
-        return out
+    def _to_choice(self, point):
+        """The episode from a decision point to the next one that offers the agent a choice (one
+        with no frontier candidate has one answer, the sweep, and is answered so), or to its end;
+        returns the outcome, or None."""
+        while isinstance(point, DecisionPoint) and len(point.choices) == 0:
+            point = self.session.answer(None)
+        if not isinstance(point, DecisionPoint):
+            self.decision = None
+            return point
+        self._set_decision(point.observation, point.choices)
+        return None
 
     def _set_decision(self, ctx, cands) -> None:
         """The agent's choice: ``slots[k]`` is the candidate (its index in ``cands``) in action
@@ -192,21 +175,14 @@ class DoorSearchEnv(SearchEnv):
         a = action  # an int of the action space (SearchEnv.step checked it)
         if self.action_mode == "primitive":
             return self._primitive(a), self._primitive_outcome()
-        ctx, cands = self.decision
-        if not 0 <= a < len(self.slots):
-            out = self.stepper.follow(self.search.sweep(st, ctx))
-        else:
+        cands = self.decision[1]
+        choice = None  # the sweep: look at the nearest wall face not read yet
+        if 0 <= a < len(self.slots):
             j = int(self.slots[a])
-            p, left = self.search.attempt(st, ctx, cands, Decision(int(cands.rows[j]), int(cands.cols[j])))
-            self._tries += 1
-            if p is not None:
-                out = self.stepper.follow(p)
-            elif left is not None and self._tries < MAX_RETRIES:
-                self._set_decision(ctx, left)  # ask again, that candidate removed
-                return 0.0, None
-            else:
-                out = self.stepper.follow(self.search.sweep(st, ctx))
-        out = self._to_decision(out)  # sweeps on the way travel too
+            choice = Decision(int(cands.rows[j]), int(cands.cols[j]))
+        # a candidate with no path is taken out and the agent asked again (travelling nothing), as
+        # the planner is in the batch; sweeps on the way travel too
+        out = self._to_choice(self.session.answer(choice))
         return st.distance - d0, out
 
     def _primitive(self, a: int) -> float:

@@ -2,8 +2,8 @@
 the secondary objects, within the time limit.
 
 The environment is the batch's indirect search (:class:`~semsearch_cli.tasks.indirect.IndirectSearch`
-in the :class:`~semsearch_cli.tasks.loop.Stepper` loop, one step a camera frame); the agent names
-the poses, as a planner's goals. An episode is a room, a start and a view scale of the scenario.
+in the :class:`~semsearch_cli.tasks.loop.Session` loop, one step a camera frame); the agent answers
+its decision points with the poses, as a planner's goals. An episode is a room, a start and a view scale of the scenario.
 
 The robot's map of A is built as the methods of the paper build theirs: ``masks`` ``"soft"``
 (default), ``"hard"`` or None (A's non-detections only), and ``negative`` (default True: the
@@ -49,27 +49,12 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..planners import Goal
 from ..tasks.indirect import IndirectSearch
-from ..tasks.loop import Stepper
+from ..tasks.decisions import StandIn
+from ..tasks.loop import Session
 from .base import (BIG, FRAME_TEXT, TWO_PI, SearchEnv, answer_line, box, check_choice, check_flag, check_number, clip_text,
-                   deg, text_space)
+                   deg, ended, text_space)
 
 HEADINGS = np.radians(np.arange(0, 360, 45))
-
-
-class _Agent:
-    """Stands in the planner's place inside :class:`IndirectSearch`: the map's kind, and the
-    goal the agent chose (through :meth:`IndirectSearchEnv.step`)."""
-
-    name = "agent"
-    uses_map = True
-    replan_on_detection = True
-
-    def __init__(self, masks, negative: bool):
-        self.masks, self.negative = masks, negative
-        self.goal: Goal | None = None
-
-    def plan(self, ctx) -> Goal:
-        return self.goal
 
 
 class IndirectSearchEnv(SearchEnv):
@@ -106,7 +91,9 @@ class IndirectSearchEnv(SearchEnv):
     def _begin(self) -> None:
         t, ep = self.task, self.episode
         self.grid = t.grids[ep.room]
-        self.agent = _Agent(self.masks, self.negative)
+        # the agent in the planner's seat: the map's kind, and re-plans on detections too
+        self.agent = StandIn("agent", {"masks": self.masks, "negative": self.negative, "uses_map": True,
+                                       "replan_on_detection": True})
         self.search = IndirectSearch(t, self.grid, self.agent, float(ep.goal), self.rng)
         self.state = st = t.start_state(ep, self.rng)
         st.belief = self.search.new_belief()
@@ -119,8 +106,8 @@ class IndirectSearchEnv(SearchEnv):
         self.standable[ok] = self.grid.stand[r[ok], c[ok]]
         self.points = np.stack([gx.ravel(), gy.ravel()], axis=1)
         if self.action_mode == "macro":
-            self.stepper = Stepper(self.search, st, 0.0, math.inf, self.max_steps, move=self.search.move)
-            self.outcome = self.stepper.advance()
+            self.session = Session(self.search, st, 0.0, math.inf, self.max_steps, move=self.search.move)
+            self.outcome = ended(self.session.start())
         else:
             found, _ = self.search.sense(st)
             self.search.update(st)
@@ -153,8 +140,8 @@ class IndirectSearchEnv(SearchEnv):
             d = np.hypot(*(self.points - self.points[k]).T)
             d[~self.standable] = np.inf
             k = int(np.argmin(d))
-        self.agent.goal = Goal(float(self.points[k, 0]), float(self.points[k, 1]), float(HEADINGS[h]), {"action": a})
-        out = self.stepper.follow(self.search.plan(st))
+        goal = Goal(float(self.points[k, 0]), float(self.points[k, 1]), float(HEADINGS[h]), {"action": a})
+        out = ended(self.session.answer(goal))
         return st.distance - d0, out
 
     def action_masks(self) -> np.ndarray:

@@ -1,7 +1,7 @@
 """``semsearch/ObjectSearch-v0``: answer an object request (a class at an hour) on the recorded map.
 
 The environment is the batch's object search (:class:`~semsearch_cli.tasks.objects.ObjectSearch`
-in the :class:`~semsearch_cli.tasks.loop.Stepper` loop); the agent names the places to visit, as
+in the :class:`~semsearch_cli.tasks.loop.Session` loop); the agent names the places to visit, as
 an object planner does. An episode is one request of the scenario (``goal``: ``Static.mug@12``).
 
 Action modes
@@ -43,26 +43,10 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..planners import ObjectContext
 from ..sensors import PlaceCamera
-from ..tasks.loop import Stepper
+from ..tasks.loop import Session
 from ..tasks.objects import ObjectSearch
 from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, clip_text, compass_moves, compass_step, deg,
-                   text_space)
-
-
-class _Feed:
-    """The targets iterator of :class:`ObjectSearch`: the place the agent chose, once."""
-
-    def __init__(self):
-        self.next = None
-
-    def __iter__(self):
-        return self
-
-    def __next__(self):
-        t, self.next = self.next, None
-        if t is None:
-            raise StopIteration
-        return t
+                   ended, text_space)
 
 
 class ObjectSearchEnv(SearchEnv):
@@ -95,17 +79,15 @@ class ObjectSearchEnv(SearchEnv):
         camera = PlaceCamera(t.world, t.spec.camera, t.places, t.facing, instances)
         log = t.logs[req.case]
         self.ctx = ObjectContext(t.world.frame, t.known, t.places, list(t.route), t.world.start_xy, req.cls, req.hour, log, self.rng)
-        self.feed = _Feed()
-        self.here = None  # the place the robot arrived at and looked around
-        self.search = ObjectSearch(t, self.feed, req.cls, instances, camera, self.ctx, self.rng)
+        self.search = ObjectSearch(t, None, req.cls, instances, camera, self.ctx, self.rng)  # the agent answers
         self.search.planner_name = "agent"
         cls_log = log[log["class"] == req.cls]
         near = cls_log[np.abs(((cls_log["hour"] - req.hour + 12.0) % 24.0) - 12.0) <= 1.0]
         self.history = np.array([[float((cls_log["place"] == n).sum()), float((near["place"] == n).sum())] for n in self.names],
                                 np.float32).reshape(self.P, 2)
         if self.action_mode == "macro":
-            self.stepper = Stepper(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
-            self.outcome = self.stepper.advance()
+            self.session = Session(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
+            self.outcome = ended(self.session.start())
         else:
             self.outcome = "found" if self.search.sense(st)[0] else None
 
@@ -119,27 +101,17 @@ class ObjectSearchEnv(SearchEnv):
             e = self.task.sc.experiment
             budget = st.distance >= e.max_distance or st.steps >= self.task.max_steps()
             return moved, "found" if found else "budget" if budget else None
+        # the place, driven to on the recorded map, looked around on arrival; a place with no path,
+        # or the one the robot stands at, travels nothing and asks again, as a planner's target does
         x, y = self.task.places[self.names[a]]
-        self.feed.next = (x, y, {"place": self.names[a]})
-        p = self.search.plan(st)
-        if p == "not_found":  # no path to that place (or the robot stands there): nothing travelled, choose again
-            return 0.0, None
-        self.here = None
-        out = self.stepper.follow(p)
-        if out is None:  # arrived (the path used up): look around there now, as the batch does next
-            self.here = a
-            self.search.look = False
-            if self.search._look_around(st):
-                out = self.stepper.follow("found")
+        out = ended(self.session.answer((x, y, {"place": self.names[a]})))
         return st.distance - d0, out
 
     def action_masks(self) -> np.ndarray:
         """(action_space.n,) bool. Macro: every place but the one the robot has just looked around
         at (choosing it again would travel nothing and see nothing new); primitive: every action."""
-        m = np.ones(self.action_space.n, bool)
-        if self.action_mode == "macro" and self.here is not None:
-            m[self.here] = False
-        return m
+        point = self.session.point if self.action_mode == "macro" else None
+        return point.mask.copy() if point is not None else np.ones(self.action_space.n, bool)
 
     def _places(self) -> np.ndarray:
         st = self.state
@@ -174,8 +146,9 @@ class ObjectSearchEnv(SearchEnv):
                          f"log: {p[3]:.0f} detections, {p[4]:.0f} within the hour")
         if not macro:
             lines.append(compass_moves(self.step_m))
-        elif self.here is not None:
-            lines.append(f"[{self.here}] {self.names[self.here]} is left out: you have just looked around there.")
+        elif self.search.here is not None:
+            here = self.search.here
+            lines.append(f"[{here}] {self.names[here]} is left out: you have just looked around there.")
         lines.append(answer_line(self.action_masks()))
         return clip_text("\n".join(lines))
 

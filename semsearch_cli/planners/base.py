@@ -172,6 +172,9 @@ class Planner:
     baseline: ClassVar[bool] = False  # reports compare the other planners with this one, paired
     swept: ClassVar[str | None] = None  # the parameter `semsearch sweep-alpha` sweeps (and reports plot against)
     replay: ClassVar[bool] = False  # the planner a report replays by default (else the last in report order)
+    # the attributes that shape a run besides the planner's choices: a run's decisions record
+    # keeps them, and its replay seats a stand-in that has them (semsearch_cli.tasks.decisions)
+    run_attributes: ClassVar[tuple] = ()
 
     def __init__(self, params: BaseModel):
         self.params = params
@@ -183,6 +186,8 @@ class DoorPlanner(Planner):
     when no candidate suits (the robot then looks at the walls it has not read yet)."""
 
     task: ClassVar[str] = "doors"
+    replan_on_signs: ClassVar[bool] = False  # re-plan also when a sign reaches belief.min_reads reads
+    run_attributes: ClassVar[tuple] = ("replan_on_signs",)  # what shapes a run besides the choices (a replay keeps them)
 
     def choose(self, ctx: DoorContext, cands: Candidates) -> Decision | None:  # pragma: no cover
         raise NotImplementedError

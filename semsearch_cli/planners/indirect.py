@@ -111,6 +111,7 @@ class IndirectPlanner(Planner):
     negative: ClassVar[bool] = False
     uses_map: ClassVar[bool] = True
     replan_on_detection: ClassVar[bool] = False
+    run_attributes: ClassVar[tuple] = ("masks", "negative", "uses_map", "replan_on_detection")  # a replay keeps them
 
     def plan(self, ctx: IndirectContext) -> Goal:  # pragma: no cover
         raise NotImplementedError

@@ -28,6 +28,7 @@ from ..registry import Registry
 from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
 from ..world.ground_truth import World
+from .decisions import Seat, ask
 from .episodes import Episode, check_hash, draw_starts, episode_seed, given_episodes, label_words, region_mask
 
 
@@ -57,12 +58,18 @@ class RobotState:
 @dataclass
 class Outcome:
     """How one episode ended: ``outcome`` is found, not_found (the planner had nowhere left to
-    look), stuck (no path to anywhere new), budget or error; the counts are this episode's."""
+    look), stuck (no path to anywhere new), budget or error; the counts are this episode's.
+    What a kind adds to its run's result: ``left_m`` (None: the task's :meth:`Task.distance_left`
+    from where the run ended), ``time_s`` (simulated), ``message``, ``stages`` (a chain's rows)."""
 
     outcome: str
     distance_m: float
     steps: int
     decisions: int
+    left_m: float | None = None
+    time_s: float = float("nan")
+    message: str = ""
+    stages: list = field(default_factory=list)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -405,7 +412,9 @@ class Task:
         return RobotState(ep.x, ep.y, heading, trail=[(ep.x, ep.y)])
 
     def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
-                observer: Observer | None = None) -> tuple[Outcome, RobotState]:  # pragma: no cover
+                observer: Observer | None = None, decide=ask) -> tuple[Outcome, RobotState]:  # pragma: no cover
+        """One search for ``goal`` by ``planner`` from ``state``, its decisions answered by
+        ``decide`` (:mod:`.decisions`)."""
         raise NotImplementedError
 
     BYTES_PER_CELL: ClassVar[int] = 110  # measured: one run on a 25-million-cell map took 2.6 GB
@@ -416,19 +425,30 @@ class Task:
         f = self.world.frame
         return int(f.height * f.width * self.BYTES_PER_CELL)
 
-    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None) -> RunResult:
+    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None,
+            seat: Seat | None = None) -> RunResult:
         """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode): the start state, then
-        one search, its decisions shown to ``observer``."""
+        the kind's search (:meth:`search`), its events shown to ``observer`` and its decisions
+        answered by ``seat`` (default: the variant's planner; a
+        :class:`~semsearch_cli.tasks.decisions.Recording` keeps them, a
+        :class:`~semsearch_cli.tasks.decisions.Replay` answers from a record). Every kind's run."""
         t0 = time.perf_counter()
         ep = self.as_episode(ep)
         rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
         st = self.start_state(ep, rng)
         heading = st.heading
-        out, st = self.episode(st, variant.build(), ep.goal, rng, observer)
-        left = 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
+        out = self.search(variant, ep, seed, st, rng, Seat() if seat is None else seat, observer)
+        left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), sorted(st.read_signs), left_m=left,
-                         start_heading=heading)
+                         np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=out.stages,
+                         message=out.message, time_s=out.time_s, left_m=left, start_heading=heading)
+
+    def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng: np.random.Generator, seat: Seat,
+               observer: Observer | None) -> Outcome:
+        """One run's search from ``st`` (changed in place): by default one :meth:`episode` of the
+        variant's planner (as ``seat`` seats it) for the episode's goal."""
+        out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
+        return out
 
     def rows(self, variant: Variant, ep: Episode, seed: int, res: RunResult) -> list[dict]:
         """The rows of one finished run: its own, then any per-stage rows."""

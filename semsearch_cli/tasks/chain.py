@@ -35,7 +35,8 @@ from ..errors import ScenarioError
 from ..metrics import result_columns
 from ..planners import PLANNERS, Variant
 from ..world.buildings.demo import write_demo
-from .base import Observer, RobotState, RunResult, StageObserver, Task, register_task
+from .base import Observer, Outcome, RobotState, StageObserver, Task, register_task
+from .decisions import Seat
 from .episodes import Episode, episode_seed
 from .doors import DoorTask
 from .objects import Case, ObjectTask
@@ -181,30 +182,29 @@ class ChainTask(Task):
         return self.legs[key]
 
     # ---- running ----------------------------------------------------------------------
-    def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, observer: Observer | None):
+    def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, observer: Observer | None,
+               seat: Seat):
         """One stage from ``st``: (outcome, decisions)."""
-        out, st = self.doors.episode(st, variant.build(), s.door, rng, observer, reuse_reads=reuse)
+        out, st = self.doors.episode(st, seat.planner(variant), s.door, rng, observer, reuse_reads=reuse, decide=seat.decide)
         decisions = out.decisions
         if out.outcome != "found" or s.cls is None:
             return out.outcome, decisions
         room = self.room_places(s.door)
         log = self.logs[ch.name]
         near = _nearest_place(log, self.objects.places)
-        planner = Variant(ch.object_planner, ()).build()
+        planner = seat.planner(Variant(ch.object_planner, ()))
         out, st = self.objects.search_episode(st, planner, s.cls, s.hour, self._instances(ch, s), log[near.isin(room)],
-                                              room, None, rng, observer)
+                                              room, None, rng, observer, decide=seat.decide)
         return out.outcome, decisions + out.decisions
 
-    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None) -> RunResult:
+    def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng, seat: Seat,
+               observer: Observer | None) -> Outcome:
         """A chain's stages from one robot state (the map and the signs read kept); each stage
         again from scratch beside it, unobserved. ``observer`` sees the kept stages' events,
-        marked with their stage."""
-        t0 = time.perf_counter()
-        ep = self.as_episode(ep)
+        marked with their stage; ``seat`` answers every stage's decisions, kept and from scratch,
+        in the order they are met."""
         ch = self.chains[str(ep.goal)]
         base = self.sc.experiment.base_seed
-        st = self.start_state(ep, np.random.default_rng(episode_seed(ep, seed, base)))
-        heading = st.heading
         st.belief = self.doors.new_belief()
         stages, decisions = [], 0
         outcome = "found"
@@ -217,7 +217,7 @@ class ChainTask(Task):
             d0, s0, t_stage = st.distance, st.steps, time.perf_counter()
             stage_seed = episode_seed(ep, seed, base, k)  # the same draws kept and from scratch
             outcome, dec = self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True,
-                                       StageObserver(observer, k) if observer is not None else None)
+                                       StageObserver(observer, k) if observer is not None else None, seat)
             n_legs = 2 if s.cls is not None else 1
             shortest = sum(next(leg) for _ in range(n_legs))
             used += n_legs
@@ -226,7 +226,7 @@ class ChainTask(Task):
             # the same stage from scratch: same pose, empty map, same seed
             fresh = RobotState(*pose, trail=[pose[:2]])
             t_s = time.perf_counter()
-            o2, d2 = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, None)
+            o2, d2 = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, None, seat)
             stages.append(_stage_row(k, s, "scratch", o2, fresh.distance, fresh.steps, shortest, d2, time.perf_counter() - t_s))
             if outcome != "found":
                 # left: to this stage's door and on to its object (when its door was not read), or
@@ -239,10 +239,7 @@ class ChainTask(Task):
                     left = self.world.geodesic((int(r), int(c)), self._object_target(ch, s))[0]
                 left += rest
                 break
-        res = RunResult(outcome, st.distance, st.steps, decisions, time.perf_counter() - t0,
-                        np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=stages, left_m=left,
-                        start_heading=heading)
-        return res
+        return Outcome(outcome, st.distance, st.steps, decisions, left_m=left, stages=stages)
 
     def rows(self, variant, ep, seed, res):
         rows = super().rows(variant, ep, seed, res)

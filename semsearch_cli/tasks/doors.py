@@ -29,9 +29,30 @@ from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
 from ..world.buildings.demo import write_demo
 from .base import Event, Observer, Outcome, RobotState, Task, checked_cell, register_task
+from .decisions import Codec, DecisionPoint, ask
 from .loop import run_loop
 
 MAX_RETRIES = 5
+
+
+def _encode(dec: Decision | None):
+    """A door choice in a few bytes: ``[row, col]``, ``[row, col, 1]`` when the planner marked it
+    kept (``info["kept"]``), null for no target."""
+    if dec is None:
+        return None
+    return [int(dec.row), int(dec.col), 1] if dec.info.get("kept", False) else [int(dec.row), int(dec.col)]
+
+
+def _decode(item) -> Decision | None:
+    if item is None:
+        return None
+    row, col, *kept = item
+    if not (isinstance(row, int) and isinstance(col, int)) or kept not in ([], [1]):
+        raise ValueError("expected [row, col] or [row, col, 1]")
+    return Decision(row, col, {"kept": True} if kept else {})
+
+
+DOOR_CODEC = Codec(_encode, _decode)
 
 
 class DoorSensing:
@@ -164,17 +185,29 @@ class DoorSearch(DoorSensing):
         return self.turn(st, self.look_turns, np.pi / (self.look_turns + 1), self.views_needed) or found
 
     def plan(self, st):
+        """A re-plan, the door search's one decision point (a generator, see
+        :class:`~semsearch_cli.tasks.loop.Session`): look where the robot came to look
+        (:meth:`prepare`), then ask for a target among the frontier candidates; a target with no
+        path is taken out and the question asked again, at most ``MAX_RETRIES`` times; no target
+        (None), or none reachable, sends the robot to the nearest wall face not read yet
+        (:meth:`sweep`). The retry-and-sweep policy is here alone, for every driver."""
         prep = self.prepare(st)
         if isinstance(prep, str):
             return prep
         ctx, cands = prep
         for _ in range(MAX_RETRIES):
-            p, cands = self.attempt(st, ctx, cands, self.planner.choose(ctx, cands))
+            dec = yield self.point(ctx, cands)
+            p, cands = self.attempt(st, ctx, cands, dec)
             if p is not None:
                 return p
             if cands is None:
                 break
         return self.sweep(st, ctx)
+
+    def point(self, ctx, cands) -> DecisionPoint:
+        """The decision: a target among ``cands`` (every one legal), or None."""
+        return DecisionPoint("doors", ctx, cands, np.ones(len(cands), bool), lambda: self.planner.choose(ctx, cands),
+                             DOOR_CODEC, self.rng)
 
     def prepare(self, st):
         """The first half of a re-plan: at a wall face the robot came to look at, look all round;
@@ -346,20 +379,23 @@ class DoorTask(Task):
     def new_belief(self) -> DoorBelief:
         return DoorBelief(self.world.frame, self.sc.belief, self.sc.robot.radius)
 
-    def episode(self, state, planner, goal, rng, observer: Observer | None = None, reuse_reads: bool = False):
-        """Search for sign ``goal`` from ``state`` (a new belief when it has none). With
-        ``reuse_reads`` and the sign already read, go there on the map built so far."""
+    def episode(self, state, planner, goal, rng, observer: Observer | None = None, reuse_reads: bool = False,
+                decide=ask):
+        """Search for sign ``goal`` from ``state`` (a new belief when it has none), each decision
+        answered by ``decide``. With ``reuse_reads`` and the sign already read, go there on the
+        map built so far."""
         if state.belief is None:
             state.belief = self.new_belief()
         d0, s0 = state.distance, state.steps
         target = read_position(state.belief, goal) if reuse_reads else None
         search = GoToRead(self, goal, rng, target) if target is not None else DoorSearch(self, planner, goal, rng, observer)
         search.start_distance = d0
-        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
+        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(), decide=decide)
         if outcome == "stuck" and isinstance(search, GoToRead):  # the map built so far has no path: search again
             search = DoorSearch(self, planner, goal, rng, observer)
             search.start_distance = d0
-            outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
+            outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(),
+                               decide=decide)
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def describe(self):

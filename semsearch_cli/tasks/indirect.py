@@ -20,7 +20,6 @@ detection table gives a chance of detecting it (A is not seen from every side).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,9 +35,26 @@ from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.indirect import SemanticCamera, YawMemory
 from ..world.rooms import OBJECT_GAP, WALL_MARGIN, Room, estimate_relations, generate_rooms, read_rooms
-from .base import Event, Observer, Outcome, RobotState, RunResult, Task, checked_point, register_task
-from .episodes import Episode, check_hash, draw_starts, episode_seed, given_episodes, label_words
+from .base import Event, Observer, Outcome, RobotState, Task, checked_point, register_task
+from .episodes import Episode, check_hash, draw_starts, given_episodes, label_words
+from .decisions import Codec, DecisionPoint, ask
 from .loop import run_loop
+
+
+def _encode(goal: Goal):
+    """An indirect choice in a few bytes: ``[x, y, heading]`` (m, rad), ``[x, y]`` without a
+    heading to turn to."""
+    xy = [float(goal.x), float(goal.y)]
+    return xy if goal.heading is None else [*xy, float(goal.heading)]
+
+
+def _decode(item) -> Goal:
+    if not isinstance(item, list) or len(item) not in (2, 3) or not all(isinstance(v, (int, float)) for v in item):
+        raise ValueError("expected [x, y] or [x, y, heading]")
+    return Goal(float(item[0]), float(item[1]), float(item[2]) if len(item) == 3 else None, {})
+
+
+INDIRECT_CODEC = Codec(_encode, _decode)
 
 
 @dataclass
@@ -256,6 +272,10 @@ class IndirectSearch:
         return path_done or self.frames_since_plan >= self.replan_frames or (event and self.planner.replan_on_detection)
 
     def plan(self, st: RobotState):
+        """A re-plan, the indirect search's decision point (a generator, see
+        :class:`~semsearch_cli.tasks.loop.Session`): the map of A brought up to date, then a goal
+        pose (any cell the robot can stand on, and a heading or None), driven to along the
+        standing cells."""
         g, spec = self.grid, self.task.spec
         st.belief.flush()
         lengths = None
@@ -276,8 +296,9 @@ class IndirectSearch:
                               spec.replan_every, self.rng, dict(self.seen), set(self.latest),
                               np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
                               self.task.cooccurrence)
-        goal = self.planner.plan(ctx)
+        goal = yield DecisionPoint("indirect", ctx, g.stand, g.stand, lambda: self.planner.plan(ctx), INDIRECT_CODEC, self.rng)
         checked_point(self.planner.name, goal.x, goal.y, g.frame, goal.heading)
+        goal = Goal(float(goal.x), float(goal.y), None if goal.heading is None else float(goal.heading), goal.info)
         self.frames_since_plan = 0
         self.since_plan = []
         new = self.goal is None or (goal.x, goal.y, goal.heading) != (self.goal.x, self.goal.y, self.goal.heading)
@@ -578,21 +599,17 @@ class IndirectTask(Task):
         return out
 
     # ---- running ----------------------------------------------------------------------------
-    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None) -> RunResult:
-        t0 = time.perf_counter()
-        ep = self.as_episode(ep)
+    def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng, seat, observer: Observer | None) -> Outcome:
+        """One room's search at the episode's scale; the result adds the simulated time, and the
+        distance left is measured in the room."""
         scale = float(ep.goal)
-        rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
-        st = self.start_state(ep, rng)
-        heading = st.heading
-        out, st = self.episode(st, variant.build(), scale, rng, observer, room=ep.room)
-        left = 0.0 if out.outcome == "found" else self.shortest_of(ep.room, scale, st.x, st.y)
-        return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), [],
-                         message="the robot could not move" if out.outcome == "stuck" else "",
-                         time_s=out.steps / self.spec.camera.fps, left_m=left, start_heading=heading)
+        out, st = self.episode(st, seat.planner(variant), scale, rng, observer, room=ep.room, decide=seat.decide)
+        out.left_m = 0.0 if out.outcome == "found" else self.shortest_of(ep.room, scale, st.x, st.y)
+        out.time_s = out.steps / self.spec.camera.fps
+        out.message = "the robot could not move" if out.outcome == "stuck" else ""
+        return out
 
-    def episode(self, state, planner, goal, rng, observer: Observer | None = None, room: int = 0):
+    def episode(self, state, planner, goal, rng, observer: Observer | None = None, room: int = 0, decide=ask):
         """Search room ``room`` for A at view scale ``goal`` from ``state`` (a new map of A when it
         has none); the time limit counts from the state's steps (camera frames)."""
         spec = self.spec
@@ -601,7 +618,7 @@ class IndirectTask(Task):
             state.belief = search.new_belief()
         d0, s0 = state.distance, state.steps
         max_steps = s0 + int(round(spec.time_limit * spec.camera.fps))
-        outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move)
+        outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move, decide=decide)
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def describe(self):

@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Generator
 from typing import Protocol
 
 from ..navigation import advance
 from .base import RobotState
+from .decisions import DecisionPoint, ask
 
 STALL_STEPS = 50  # steps without moving before a run is stuck
 PROGRESS_S = 10.0  # s of wall-clock time between the lines a long run prints about itself
@@ -52,7 +54,9 @@ class Search(Protocol):
 
     def plan(self, st: RobotState):
         """Waypoints ``(xs, ys)`` (m) from the robot's position, or the outcome that ends the
-        episode when there is nowhere to go (``found`` when looking around saw the target)."""
+        episode when there is nowhere to go (``found`` when looking around saw the target); as a
+        generator, after yielding each :class:`~semsearch_cli.tasks.decisions.DecisionPoint` it
+        needs answered (the one place a run stops for a decision)."""
 
 
 class Stepper:
@@ -130,11 +134,61 @@ class Stepper:
         return None
 
 
-def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None) -> str:
+class Session:
+    """One episode driven decision by decision: the :class:`Stepper` loop, with the kind's
+    re-plan (``Search.plan``: a generator that yields
+    :class:`~semsearch_cli.tasks.decisions.DecisionPoint` and is sent the choice, or a function
+    that returns the plan outright) suspended at each decision point.
+
+    :meth:`start` and :meth:`answer` run the episode to its next decision point (returned) or to
+    its end (the outcome, a string). :func:`run_loop` answers every point with ``decide`` (the
+    batch, a recording, a replay); a Gymnasium environment answers with the agent's actions. Both
+    are this one loop."""
+
+    def __init__(self, search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None):
+        self.search, self.st = search, st
+        self.stepper = Stepper(search, st, step, max_distance, max_steps, move)
+        self.point: DecisionPoint | None = None  # the decision the episode waits for
+        self.outcome: str | None = None
+        self._plan = None  # the suspended re-plan
+
+    def start(self):
+        """Run to the first decision point (returned) or the end (the outcome)."""
+        return self._go(self.stepper.advance())
+
+    def answer(self, choice):
+        """Take ``choice`` at the pending decision point; run to the next one or the end."""
+        if self._plan is None:
+            raise RuntimeError("no decision is pending")
+        try:
+            self.point = self._plan.send(choice)
+            return self.point
+        except StopIteration as stop:
+            self._plan = None
+            return self._go(self.stepper.follow(stop.value))
+
+    def _go(self, out):
+        while out is None:
+            plan = self.search.plan(self.st)
+            if isinstance(plan, Generator):
+                try:
+                    self.point = next(plan)
+                    self._plan = plan
+                    return self.point
+                except StopIteration as stop:
+                    plan = stop.value
+            out = self.stepper.follow(plan)
+        self.point, self.outcome = None, out
+        return out
+
+
+def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None,
+             decide=ask) -> str:
     """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
-    :meth:`Search.plan` returns when there is nowhere to go (see :class:`Stepper`)."""
-    s = Stepper(search, st, step, max_distance, max_steps, move)
-    out = s.advance()
-    while out is None:
-        out = s.follow(search.plan(st))
-    return out
+    :meth:`Search.plan` returns when there is nowhere to go (see :class:`Stepper`), each decision
+    point answered by ``decide`` (by default the seated planner)."""
+    session = Session(search, st, step, max_distance, max_steps, move)
+    point = session.start()
+    while isinstance(point, DecisionPoint):
+        point = session.answer(decide(point))
+    return point

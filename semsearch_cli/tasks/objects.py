@@ -33,7 +33,7 @@ from __future__ import annotations
 import io
 import zlib
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 from pathlib import Path
 
 import cv2
@@ -50,6 +50,7 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..world.buildings.office import office_image, office_scenario
 from .base import Event, Observer, Outcome, RobotState, Task, checked_point, register_task
+from .decisions import Codec, DecisionPoint, ask
 from .loop import run_loop
 from ..files import read_user_text, temp_path, user_file
 
@@ -134,13 +135,60 @@ class ObjectSearch:
 
     def __init__(self, task: "ObjectTask", targets, cls: str, instances: list, camera: PlaceCamera, ctx: ObjectContext,
                  rng: np.random.Generator, observer: Observer | None = None):
-        """``targets``: an iterator of (x, y, info); ``instances``: [(class, place)] in the world."""
-        self.task, self.targets, self.cls, self.instances = task, targets, cls, instances
+        """``targets``: a function giving the iterator of (x, y, info) that answers the decisions
+        (called at the first one: ``planner.targets(ctx)``); ``instances``: [(class, place)] in
+        the world."""
+        self.task, self.make_targets, self.cls, self.instances = task, targets, cls, instances
         self.camera, self.ctx, self.rng, self.observer = camera, ctx, rng, observer
+        self.targets = None
         self.look = False  # look around on arriving at the current target
         self.decisions = 0
         self.start_distance = 0.0
         self.planner_name = ""  # for the checks of its targets
+        self.names = list(task.places)
+        self.place = None  # the index of the place the current target is, if it is one
+        self.here = None  # the place the robot arrived at and looked around, if any
+        self.codec = Codec(self._encode, self._decode)
+
+    def _encode(self, target):
+        """An object choice in a few bytes: ``[k]`` for place k of ``objects.places``, ``[x, y]``
+        (m) for another point; a trailing ``0`` when the robot is not to look around there
+        (``info["look"]`` False); null for no target."""
+        if target is None:
+            return None
+        x, y, info = target
+        xy = (float(x), float(y))
+        k = next((k for k, n in enumerate(self.names) if self.task.places[n] == xy), None)
+        return ([k] if k is not None else [*xy]) + ([] if info.get("look", True) else [0])
+
+    def _decode(self, item):
+        if item is None:
+            return None
+        place = isinstance(item, list) and len(item) > 0 and isinstance(item[0], int) and not isinstance(item[0], bool)
+        n = 1 if place else 2
+        if not isinstance(item, list) or len(item) not in (n, n + 1) or item[n:] not in ([], [0]):
+            raise ValueError("expected [place], [x, y], or either with a trailing 0")
+        if place:
+            if not 0 <= item[0] < len(self.names):
+                raise ValueError(f"no place {item[0]}")
+            x, y = self.task.places[self.names[item[0]]]
+        else:
+            x, y = float(item[0]), float(item[1])
+        return x, y, {} if len(item) == n else {"look": False}
+
+    def next_target(self):
+        """The planner's answer: its next target, or None when it has none left."""
+        if self.targets is None:
+            self.targets = iter(self.make_targets())
+        return next(self.targets, None)
+
+    def point(self) -> DecisionPoint:
+        """The decision: a target (a place, or any point), or None; every place is legal but the
+        one the robot has just looked around at."""
+        mask = np.ones(len(self.names), bool)
+        if self.here is not None:
+            mask[self.here] = False
+        return DecisionPoint("objects", self.ctx, self.task.places, mask, self.next_target, self.codec, self.rng)
 
     def sense(self, st):
         seen, detected = self.camera.look(st.x, st.y, st.heading, self.rng)
@@ -161,12 +209,19 @@ class ObjectSearch:
         return False
 
     def plan(self, st):
+        """A re-plan, the object search's decision point (a generator, see
+        :class:`~semsearch_cli.tasks.loop.Session`): on arriving at a target, look around there
+        (three quarter turns); then ask for the next target and drive there on the recorded map
+        (a target with no path, or where the robot stands, asks again); no target left is
+        ``not_found``."""
         known = self.task.known_map
+        if self.place is not None:  # the path to the last target was used up: the robot is there
+            self.here = self.place
         while True:
             if self.look and self._look_around(st):
                 return "found"
             self.look = False
-            nxt = next(self.targets, None)
+            nxt = yield self.point()
             if nxt is None:
                 return "not_found"
             x, y, info = nxt
@@ -179,6 +234,8 @@ class ObjectSearch:
                 continue
             self.look = info.get("look", True)
             if len(p[0]) >= 2:
+                self.place = next((k for k, n in enumerate(self.names) if self.task.places[n] == (x, y)), None)
+                self.here = None
                 return self.task.world.frame.to_world(p[0], p[1])
 
 
@@ -189,7 +246,7 @@ class Patrol(ObjectSearch):
         camera = PlaceCamera(task.world, task.spec.camera, task.places, task.facing, instances)
         ctx = ObjectContext(task.world.frame, task.known, task.places, task.route, None, "", hour,
                             pd.DataFrame(columns=LOG_COLUMNS), rng)
-        super().__init__(task, targets, "", instances, camera, ctx, rng)
+        super().__init__(task, lambda: targets, "", instances, camera, ctx, rng)
         self.hour, self.day = hour, day
         self.rows: list[dict] = []
         self.logged: set[int] = set()
@@ -281,21 +338,24 @@ class ObjectTask(Task):
     def goals(self) -> list:
         return [r.label for r in self.requests]
 
-    def episode(self, state, planner, goal, rng, observer: Observer | None = None):
+    def episode(self, state, planner, goal, rng, observer: Observer | None = None, decide=ask):
         """Answer the request labelled ``goal`` from ``state``."""
         req = self.request(goal)
         return self.search_episode(state, planner, req.cls, req.hour, self.request_instances(req), self.logs[req.case],
-                                   self.route, self.world.start_xy, rng, observer)
+                                   self.route, self.world.start_xy, rng, observer, decide)
 
-    def search_episode(self, state, planner, cls, hour, instances, log, route, home, rng, observer: Observer | None = None):
+    def search_episode(self, state, planner, cls, hour, instances, log, route, home, rng, observer: Observer | None = None,
+                       decide=ask):
         """Search for ``cls`` among ``instances`` [(class, place)] with the places of ``route``."""
         d0, s0 = state.distance, state.steps
         camera = PlaceCamera(self.world, self.spec.camera, self.places, self.facing, instances)
         ctx = ObjectContext(self.world.frame, self.known, self.places, list(route), home, cls, hour, log, rng)
-        search = ObjectSearch(self, planner.targets(ctx), cls, instances, camera, ctx, rng, observer)
+        search = ObjectSearch(self, partial(planner.targets, ctx) if hasattr(planner, "targets") else None, cls, instances,
+                              camera, ctx, rng, observer)
         search.planner_name = planner.name
         search.start_distance = d0
-        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
+        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(),
+                           decide=decide)
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def write_inputs(self, out: Path) -> None:

@@ -1,0 +1,226 @@
+"""The one decision point of every run, and who answers it.
+
+A run stops for a decision in one place: a kind's re-plan (``Search.plan``, a generator) yields a
+:class:`DecisionPoint` and is sent back the choice. Whoever drives the run answers it the same way:
+
+- the batch (:class:`Seat`): the run's planner answers (``point.ask()``);
+- a recording batch (:class:`Recording`, ``semsearch run --decisions``): the planner answers, and
+  the choice is kept in a few bytes (``point.encode``), with the random generator's state after
+  the planner's turn when the planner drew from it;
+- a replay (:class:`Replay`, ``semsearch verify``): the recorded choices answer, decoded
+  (``point.decode``), the generator put back where the planner left it; no planner runs;
+- a Gymnasium environment (``semsearch_cli.envs``): the agent's action answers, through
+  :class:`~semsearch_cli.tasks.loop.Session`.
+
+A replay is exact because a run's randomness is the run's one generator (sensing and planners
+draw from it) and everything else is deterministic: the same choices, with the generator restored
+after each, give the same path, distance, steps and outcome. What a planner is besides its
+choices (door planners' ``replan_on_signs``, indirect planners' masks) shapes the run too; each
+kind's planner protocol names those attributes (``run_attributes``), the recording keeps them,
+and a replay seats a :class:`StandIn` that has them.
+
+The record of a run (``decisions/<run>.json``)::
+
+    {"format": "semsearch-decisions", "version": 1, "kind": "doors", "planner": "nsos[alpha=0.9]",
+     "goal": "148", "episode": 0, "seed": 0, "fingerprint": "...",
+     "seats": {"nsos[alpha=0.9]": {"replan_on_signs": false}},
+     "decisions": [[412, 1033], 0, [398, 1100], null], "rng": {"3": "<state>.<has_uint32>.<uinteger>"}}
+
+``decisions`` holds one item per decision point in the order the run met them (a chain's stages,
+kept and from scratch, in the order they ran): each kind's code of the choice (see its
+``Codec``), or ``0`` for "the same choice as the decision before"; ``rng`` the generator's state
+(PCG64, hexadecimal) after the decisions at which the planner drew from it.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+FORMAT = "semsearch-decisions"
+VERSION = 1
+SAME = 0  # a decision's item: the same choice as the decision before
+
+
+class ReplayError(Exception):
+    """A replay that cannot go on: the run asked for a decision the record does not have, or a
+    recorded choice that the run cannot take."""
+
+
+@dataclass(frozen=True)
+class Codec:
+    """How a kind writes a choice in a few bytes (``encode``: a JSON value) and reads it back
+    (``decode``); ``decode(encode(c))`` is a choice the run takes exactly as it took ``c``."""
+
+    encode: Callable[[Any], Any]
+    decode: Callable[[Any], Any]
+
+
+@dataclass
+class DecisionPoint:
+    """A run stopped for a decision.
+
+    kind : the kind of search that asks (doors, objects, indirect); observation : what a planner
+    of that kind reads (``DoorContext``, ``ObjectContext``, ``IndirectContext``); choices : what
+    may be chosen (door search: the frontier ``Candidates``; object search: the places, name ->
+    (x, y) m; indirect search: the (H, W) cells the robot may stand on); mask : bool, the choices
+    legal now (one per candidate, per place, per cell); ask : the seated planner's answer;
+    codec : the kind's :class:`Codec`; rng : the run's generator. A choice may also be None: no
+    target (door search: look at the unread walls; object search: nothing left to look at)."""
+
+    kind: str
+    observation: Any
+    choices: Any
+    mask: np.ndarray
+    ask: Callable[[], Any]
+    codec: Codec
+    rng: np.random.Generator
+
+    def encode(self, choice) -> Any:
+        return self.codec.encode(choice)
+
+    def decode(self, item) -> Any:
+        return self.codec.decode(item)
+
+
+def ask(point: DecisionPoint):
+    """The batch's answer to a decision point: the seated planner's."""
+    return point.ask()
+
+
+# ---- who sits in the planner's seat -------------------------------------------------------------
+class Seat:
+    """The batch's seat: each search's planner is the variant's, built afresh, and it answers."""
+
+    def planner(self, variant):
+        return variant.build()
+
+    def decide(self, point: DecisionPoint):
+        return point.ask()
+
+
+def run_attributes(planner) -> dict:
+    """The attributes of ``planner`` that shape a run besides its choices (its protocol's
+    ``run_attributes``), as JSON values."""
+    out = {}
+    for a in getattr(planner, "run_attributes", ()):
+        v = getattr(planner, a)
+        out[a] = v.item() if isinstance(v, np.generic) else v
+    return out
+
+
+class Recording(Seat):
+    """The batch's seat, keeping each choice (see the module docstring): :meth:`record`."""
+
+    def __init__(self):
+        self.items: list = []
+        self.rng: dict[str, str] = {}
+        self.seats: dict[str, dict] = {}
+        self._last = None
+
+    def planner(self, variant):
+        p = variant.build()
+        self.seats.setdefault(variant.label, run_attributes(p))
+        return p
+
+    def decide(self, point: DecisionPoint):
+        before = rng_word(point.rng)
+        choice = point.ask()
+        code = point.encode(choice)
+        after = rng_word(point.rng)
+        k = len(self.items)
+        self.items.append(SAME if k and code == self._last else code)
+        self._last = code
+        if after != before:
+            self.rng[str(k)] = after
+        return choice
+
+    def record(self, kind: str) -> dict:
+        """The run's record (without its identity, which the runner adds)."""
+        return {"format": FORMAT, "version": VERSION, "kind": kind, "seats": self.seats, "decisions": self.items,
+                "rng": self.rng}
+
+
+@dataclass
+class StandIn:
+    """What sits in a planner's seat in a replay: its label and its run attributes, no code."""
+
+    name: str
+    attributes: dict = field(default_factory=dict)
+
+    def __getattr__(self, key):
+        try:
+            return self.__dict__["attributes"][key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+
+class Replay(Seat):
+    """A recorded run's choices answering its decision points (see the module docstring);
+    :meth:`finish` checks that every one was asked for."""
+
+    def __init__(self, record: dict):
+        check_record(record)
+        self.items = list(record["decisions"])
+        self.rng = {int(k): v for k, v in record.get("rng", {}).items()}
+        self.seats = record.get("seats", {})
+        self.k = 0
+        self._last = None
+
+    def planner(self, variant):
+        if variant.label not in self.seats:
+            raise ReplayError(f"the record seats no planner {variant.label!r} (it seats {', '.join(self.seats) or 'none'})")
+        return StandIn(variant.label, dict(self.seats[variant.label]))
+
+    def decide(self, point: DecisionPoint):
+        if self.k >= len(self.items):
+            raise ReplayError(f"the run asks for decision {self.k + 1}, and the record holds {len(self.items)}")
+        item = self.items[self.k]
+        if item == SAME and not isinstance(item, bool) and self.k:
+            item = self._last
+        try:
+            choice = point.decode(item)
+        except (TypeError, ValueError, IndexError, KeyError) as exc:
+            raise ReplayError(f"decision {self.k + 1}: {json.dumps(item)[:60]} is not a {point.kind} choice ({exc})") from None
+        if self.k in self.rng:
+            set_rng(point.rng, self.rng[self.k])
+        self._last = item
+        self.k += 1
+        return choice
+
+    def finish(self) -> None:
+        if self.k != len(self.items):
+            raise ReplayError(f"the run asked for {self.k} decisions, and the record holds {len(self.items)}")
+
+
+def check_record(record) -> None:
+    """A :class:`ReplayError` unless ``record`` is a decisions record this version reads."""
+    if not isinstance(record, dict) or record.get("format") != FORMAT:
+        raise ReplayError(f"not a decisions record (no \"format\": \"{FORMAT}\")")
+    if record.get("version") != VERSION:
+        raise ReplayError(f"a decisions record of version {record.get('version')!r}; this semsearch reads version {VERSION}")
+    if not isinstance(record.get("decisions"), list) or not isinstance(record.get("rng", {}), dict) \
+            or not isinstance(record.get("seats", {}), dict):
+        raise ReplayError("a decisions record holds a list \"decisions\" and the objects \"rng\" and \"seats\"")
+
+
+# ---- the generator's state ------------------------------------------------------------------------
+def rng_word(rng: np.random.Generator) -> str:
+    """The state of a run's generator (PCG64) as one short word: the 128-bit state, then the
+    buffered 32-bit half (a flag and its value), in hexadecimal."""
+    s = rng.bit_generator.state
+    return f"{s['state']['state']:x}.{s['has_uint32']}.{s['uinteger']:x}"
+
+
+def set_rng(rng: np.random.Generator, word: str) -> None:
+    """Put ``rng`` in the state :func:`rng_word` wrote (its increment, fixed for a run, kept)."""
+    try:
+        state, has, u = word.split(".")
+        s = rng.bit_generator.state
+        s["state"]["state"], s["has_uint32"], s["uinteger"] = int(state, 16), int(has), int(u, 16)
+        rng.bit_generator.state = s
+    except (AttributeError, ValueError, TypeError, KeyError) as exc:
+        raise ReplayError(f"a generator state {str(word)[:40]!r} that does not read ({exc})") from None
