@@ -22,6 +22,7 @@ from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import BatchOptions, Loaded, check_folder, expand, folder_lock, make_executor, run_batch, run_rows
+from .runner.verify import Verdict, verify_folder
 from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
@@ -98,6 +99,38 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
         if not (Path(f) / "runs.csv").is_file():
             raise ScenarioError(str(f), "", "no runs.csv here: give a folder written by `semsearch run`")
     return report_build.build_report([Path(f) for f in folders], output_folder(out) if out is not None else None, formats, replay)
+
+
+@dataclass
+class VerifyOutput:
+    folder: Path
+    scenario: Path
+    verdict: Verdict
+
+
+def verify(folder: str | Path, scenario: str | Path | None = None, progress=None) -> VerifyOutput:
+    """Replay every run of a results folder that has a decisions record (``run --decisions``)
+    from its decisions alone, no planner built, and check outcome, distance and steps against its
+    rows (:mod:`semsearch_cli.runner.verify`). ``scenario``: the scenario the rows were made with
+    (default: the one meta.json names); its planners' files are not needed."""
+    folder = Path(folder)
+    if not (folder / "runs.csv").is_file():
+        raise ScenarioError(str(folder), "", "no runs.csv here: give a folder written by `semsearch run`")
+    if scenario is None:
+        path = report_build.scenario_of(folder, report_build.read_meta(folder))
+        path = path.resolve() if path is not None else None
+        if path is None:
+            raise ScenarioError(str(folder / "meta.json"), "scenario", "names no scenario file that exists; give the "
+                                "scenario the rows were made with, --scenario FILE")
+    else:
+        path = scenario_file(scenario)
+    loaded = Loaded.load(path, planners=False)
+    verdict = verify_folder(folder, loaded, progress)
+    if not verdict.verified and not verdict.failed:
+        raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "
+                            "batch with --decisions (the runs already done are not recorded again; run them into a fresh "
+                            "folder)")
+    return VerifyOutput(folder, path, verdict)
 
 
 def sweep_alpha(scenario: str | Path, alphas: list[float], options: BatchOptions = BatchOptions(), progress=None) -> RunOutput:

@@ -97,13 +97,15 @@ GOALS = typer.Option(None, "--goal", help="Only these goals (repeat or comma-sep
 PLANNERS = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate).")
 TRACE = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl.")
 FRAMES = typer.Option(False, "--frames", help="Also write each run's replay frames to frames/<run>.npz: the report then replays any run from them, without re-running it.")
+DECISIONS = typer.Option(False, "--decisions", help="Also write each run's decisions to decisions/<run>.json (a few bytes each): `semsearch verify` then replays every run from them, without its planner.")
 FORCE = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak, its runs' paths, traces and frames in runs.<n>.bak/.")
 OVERSUBSCRIBE = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O).")
 EXECUTOR = typer.Option("processes", "--executor", help="processes (a pool on this machine) or dask (a Dask cluster: --scheduler, or a local one of --workers).")
 SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, tcp://HOST:PORT (with --executor dask).")
 
 
-def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames=False) -> BatchOptions:
+def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames=False,
+             decisions=False) -> BatchOptions:
     """The batch options of the command line (a bad --goal or --planner list exits with status 2)."""
     try:
         goals, planners = _split(goal, "--goal"), _split(planner, "--planner", labels=False)
@@ -111,7 +113,7 @@ def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe
         _fail(exc)
     return BatchOptions(seeds=seeds, goals=goals, planners=planners, out=out_dir, workers=workers,
                         oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace, force=force,
-                        frames=frames)
+                        frames=frames, decisions=decisions)
 
 
 @app.command()
@@ -124,6 +126,7 @@ def run(
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = TRACE,
     frames: bool = FRAMES,
+    decisions: bool = DECISIONS,
     force: bool = FORCE,
     oversubscribe: bool = OVERSUBSCRIBE,
     executor: str = EXECUTOR,
@@ -132,7 +135,8 @@ def run(
     """Run a scenario's experiment: episodes x planner variants x repeats; rows are appended to
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
-    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames)
+    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames,
+                    decisions)
     _batch(lambda tick: api.run(scenario, opts, progress=tick))
 
 
@@ -145,6 +149,7 @@ def sweep_alpha(
     goal: Optional[List[str]] = GOALS,
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>)."),
     trace: bool = TRACE,
+    decisions: bool = DECISIONS,
     force: bool = FORCE,
     oversubscribe: bool = OVERSUBSCRIBE,
     executor: str = EXECUTOR,
@@ -159,7 +164,7 @@ def sweep_alpha(
         _fail(ScenarioError("<command line>", "--alphas", f"expected comma-separated numbers, got {alphas!r}"))
     if not values or any(not 0.0 <= a <= 1.0 for a in values):
         _fail(ScenarioError("<command line>", "--alphas", f"alphas must lie in [0, 1], got {alphas!r}"))
-    opts = _options(seeds, workers, goal, None, out_dir, trace, force, oversubscribe, executor, scheduler)
+    opts = _options(seeds, workers, goal, None, out_dir, trace, force, oversubscribe, executor, scheduler, decisions=decisions)
     res = _batch(lambda tick: api.sweep_alpha(scenario, values, opts, progress=tick))
     out.print(f"alpha plot: {res.out / 'plots' / 'alpha_sweep.png'}")
 
@@ -175,6 +180,7 @@ def sweep(
     planner: Optional[List[str]] = PLANNERS,
     out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="Output folder (default results/<name>-sweep-<param>)."),
     trace: bool = TRACE,
+    decisions: bool = DECISIONS,
     force: bool = FORCE,
     oversubscribe: bool = OVERSUBSCRIBE,
     executor: str = EXECUTOR,
@@ -188,7 +194,8 @@ def sweep(
         name, values = api.parse_param(param)
     except ScenarioError as exc:
         _fail(exc)
-    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler)
+    opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler,
+                    decisions=decisions)
     res = _with_progress(lambda tick: api.sweep(scenario, name, values, opts, progress=tick))
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
@@ -358,6 +365,32 @@ def record(
         _fail(exc)
     for f, n in written:
         out.print(f"wrote {f} ({n} detections)")
+
+
+@app.command()
+def verify(
+    folder: Path = typer.Argument(..., help="A results folder (runs.csv, and decisions/ from `semsearch run --decisions`)."),
+    scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the rows were made with (default: the one "
+                                            "meta.json names)."),
+):
+    """Replay every run of a results folder that has its decisions (`semsearch run --decisions`),
+    without its planner, and check its outcome, distance and steps exactly: each run that does
+    not replay is named, and the status is 1."""
+
+    try:
+        res = api.verify(folder, scenario)
+    except ScenarioError as exc:
+        _fail(exc)
+    v = res.verdict
+    for name, why in v.failed:
+        out.print(f"does not replay: {name}: {why}")
+    skipped = f"; {v.unrecorded} without decisions (not recorded with --decisions, or an error or timeout) not checked" \
+        if v.unrecorded else ""
+    out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance and steps "
+              f"recorded{skipped} (scenario {res.scenario})")
+    if v.failed:
+        out.print(f"{len(v.failed)} run(s) do not replay")
+        raise typer.Exit(1)
 
 
 @app.command()

@@ -28,7 +28,7 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
     ``codes`` (planner label -> code hash, :func:`~semsearch_cli.planners.code_of`): rows of
     those planners made by other code (an edited planner file, another semsearch) are never
     reused: they are moved to ``runs.superseded.csv`` (appended, so nothing is lost), their runs'
-    files (paths, traces, frames) to ``superseded/<n>/``, said so on standard error, and their runs
+    files (paths, traces, frames, decisions) to ``superseded/<n>/``, said so on standard error, and their runs
     run again; ``force`` keeps another scenario's runs.csv as ``runs.<n>.csv.bak`` and its runs'
     files in ``runs.<n>.bak/``. Before anything: the files and folders a batch and
     its report write are of the kind they will be written as (:func:`~semsearch_cli.files.check_outputs`)."""
@@ -107,11 +107,11 @@ def _supersede(out: Path, which, why: str) -> None:
         for f in files:
             (aside / f.parent.name).mkdir(parents=True, exist_ok=True)
             os.replace(f, aside / f.parent.name / f.name)
-        where = f", and their {len(files)} file(s) (paths, traces, frames) to {aside.relative_to(out)}/"
+        where = f", and their {len(files)} file(s) (paths, traces, frames, decisions) to {aside.relative_to(out)}/"
     print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}{where}; their runs run again", file=sys.stderr)
 
 
-RUN_FILES = (("paths", ".npz"), ("traces", ".jsonl"), ("frames", ".npz"))  # a run's files, by its stem
+RUN_FILES = (("paths", ".npz"), ("traces", ".jsonl"), ("frames", ".npz"), ("decisions", ".json"))  # a run's files, by its stem
 
 
 def _next_free(folder: Path) -> Path:
@@ -124,7 +124,7 @@ def _next_free(folder: Path) -> Path:
 
 # what a batch, and the report that follows it, write into a results folder
 BATCH_FILES = ("runs.csv", "runs.superseded.csv", "meta.json", "summary.csv", "report.md", "report.html")
-BATCH_FOLDERS = ("paths", "traces", "frames", "superseded", "tables", "figures", "logs")
+BATCH_FOLDERS = ("paths", "traces", "frames", "decisions", "superseded", "tables", "figures", "logs")
 MANY_RUNS = 10_000  # a batch this large says how many runs it has before it starts
 LARGE_RUN = 1e9  # bytes: a batch whose runs need more than this each says so before it starts
 
@@ -165,7 +165,8 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: Batc
     Of the :class:`BatchOptions`, ``workers`` (None: one), ``executor``, ``scheduler`` and
     ``start_method`` say where the runs run (see :func:`make_executor`: rows do not depend on it,
     and a batch started on one resumes on another); ``trace`` writes each run's decision trace to
-    ``out/traces/``, ``frames`` its replay's frames to ``out/frames/``; ``force`` is below.
+    ``out/traces/``, ``frames`` its replay's frames to ``out/frames/``, ``decisions`` its decisions
+(the choices that replay it, ``semsearch verify``) to ``out/decisions/``; ``force`` is below.
     ``runner``, an executor the caller made (and entered), e.g. one Dask cluster for every value of
     a sweep, replaces the executor options. ``progress(row, done, total)`` is called as each run
     finishes, with the runs finished so far and the runs this batch has to do. The specs are
@@ -178,7 +179,7 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: Batc
     ``runs.<n>.csv.bak``) and starts afresh."""
     runs_csv = out / "runs.csv"
     workers, executor = options.workers or 1, options.executor
-    watch = Watch(options.trace, options.frames)
+    watch = Watch(options.trace, options.frames, options.decisions)
     fp = loaded.fingerprint
     variants = specs.variants if hasattr(specs, "variants") else list({s.variant for s in specs})
     codes = {v.label: code_of(v)["hash"] for v in variants}

@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import RunTimeout
 from ..kernels import announce_compiling
 from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
+from ..tasks.decisions import Recording
 from ..tasks.loop import running
 from .specs import Loaded, RunSpec
 from .store import save_run_files
@@ -24,11 +25,14 @@ from .store import save_run_files
 
 @dataclass(frozen=True)
 class Watch:
-    """What a batch keeps of each run beside its rows: its decisions' ``trace`` (traces/<run>.jsonl)
-    and its replay's ``frames`` (frames/<run>.npz, which a report replays without re-running)."""
+    """What a batch keeps of each run beside its rows: its decisions' ``trace`` (traces/<run>.jsonl),
+    its replay's ``frames`` (frames/<run>.npz, which a report replays without re-running) and its
+    ``decisions`` (decisions/<run>.json, the choices that replay it without its planner:
+    :mod:`semsearch_cli.tasks.decisions`, ``semsearch verify``)."""
 
     trace: bool = False
     frames: bool = False
+    decisions: bool = False
 
 
 def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list[dict], RunResult]:
@@ -45,7 +49,11 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
         with wall_clock_limit(limit):
             tracer = TraceObserver() if watch.trace else None
             recorder = FrameRecorder() if watch.frames else None
-            res = task.run(spec.variant, spec.episode, spec.seed, Observers(tracer, recorder) if tracer or recorder else None)
+            seat = Recording() if watch.decisions else None
+            res = task.run(spec.variant, spec.episode, spec.seed, Observers(tracer, recorder) if tracer or recorder else None,
+                           seat)
+            if seat is not None:
+                res.decisions_record = {**seat.record(task.kind), **identity(loaded, spec)}
             if tracer is not None:
                 res.trace = tracer.rows
             if recorder is not None:
@@ -60,6 +68,13 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
     finally:
         running(None)
     return task.rows(spec.variant, spec.episode, spec.seed, res), res
+
+
+def identity(loaded: Loaded, spec: RunSpec) -> dict:
+    """What names a run in its decisions record: the scenario (name, fingerprint), the planner
+    variant's label, the goal (as written), the episode and the repeat."""
+    return {"scenario": loaded.sc.name, "fingerprint": loaded.fingerprint, "planner": spec.variant.label,
+            "goal": str(spec.episode.goal), "episode": int(spec.episode.index), "seed": int(spec.seed)}
 
 
 @contextmanager

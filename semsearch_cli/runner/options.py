@@ -27,7 +27,8 @@ class BatchOptions:
     cluster of ``workers``; ``start_method``: the worker processes' (see
     :class:`~semsearch_cli.runner.ProcessExecutor`); ``trace``: write each run's decisions to
     ``traces/``; ``frames``: write each run's replay frames to ``frames/`` (a report then replays
-    any run without re-running it); ``force``: start afresh in a folder holding rows of another scenario (the old
+    any run without re-running it); ``decisions``: write each run's decisions to ``decisions/``
+    (``semsearch verify`` replays them without the planner); ``force``: start afresh in a folder holding rows of another scenario (the old
     runs.csv is kept as ``runs.<n>.csv.bak``)."""
 
     seeds: int | None = None
@@ -41,6 +42,7 @@ class BatchOptions:
     start_method: str | None = None
     trace: bool = False
     frames: bool = False
+    decisions: bool = False
     force: bool = False
 
     def replace(self, **changes) -> "BatchOptions":

@@ -74,11 +74,15 @@ class Loaded:
     _fingerprint: str | None = field(default=None, repr=False, compare=False)
 
     @classmethod
-    def load(cls, path: str | Path, data: dict | None = None) -> "Loaded":
+    def load(cls, path: str | Path, data: dict | None = None, planners: bool = True) -> "Loaded":
         """Load the scenario file ``path``, or the document ``data`` in its place (a sweep's
-        variation of it: paths in it are relative to ``path``'s folder)."""
+        variation of it: paths in it are relative to ``path``'s folder). Without ``planners`` its
+        planner entries are left out (their files are not loaded): what a replay from decisions
+        needs (the fingerprint does not depend on them)."""
         path = Path(path)
         sc = load_scenario(path) if data is None else parse_scenario(data, path)
+        if not planners:
+            sc = sc.model_copy(update={"planners": []})
         world = build_world(sc, path.parent, str(path))
         task = build_task(sc, world, path)
         check_file_stems(task, str(path))

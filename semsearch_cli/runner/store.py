@@ -19,6 +19,7 @@ import pandas as pd
 from ..errors import ScenarioError, did_you_mean
 from ..metrics import CAUSES, COLUMNS
 from ..planners.base import MAX_INFO_DEPTH
+from ..tasks.decisions import ReplayError, check_record
 from ..files import temp_path
 
 
@@ -231,6 +232,36 @@ def save_run_files(out: Path, stem: str, res) -> None:
         os.replace(tmp, traces / f"{stem}.jsonl")
     if res.frames:
         write_frames(out / "frames" / f"{stem}.npz", res.frames)
+    if res.decisions_record is not None:
+        write_decisions(out / "decisions" / f"{stem}.json", res.decisions_record)
+
+
+def write_decisions(path: Path, record: dict) -> None:
+    """A run's decisions record (:mod:`semsearch_cli.tasks.decisions`) as compact JSON, atomically."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = temp_path(path)
+    with open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n")
+    os.replace(tmp, path)
+
+
+MAX_DECISIONS_BYTES = 200_000_000  # a decisions file larger than this is not one semsearch wrote
+
+
+def read_decisions(path: Path) -> dict:
+    """A decisions record written by :func:`write_decisions`; a :class:`ScenarioError` naming the
+    file when it is not one (too large, not JSON, not a record this version reads)."""
+    from_file = "not a decisions file semsearch wrote"
+    try:
+        if path.stat().st_size > MAX_DECISIONS_BYTES:
+            raise ScenarioError(str(path), "", f"{from_file} (larger than {MAX_DECISIONS_BYTES:,} bytes)")
+        record = json.loads(path.read_text(encoding="utf-8"))
+        check_record(record)
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise ScenarioError(str(path), "", f"{from_file} ({type(exc).__name__}: {str(exc)[:80]})") from None
+    except ReplayError as exc:
+        raise ScenarioError(str(path), "", f"{from_file}: {exc}") from None
+    return record
 
 
 def write_frames(path: Path, frames: list[dict]) -> None:

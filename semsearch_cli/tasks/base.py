@@ -177,6 +177,7 @@ class RunResult:
     time_s: float = float("nan")  # simulated seconds, for tasks with a clock
     left_m: float = float("nan")  # geodesic distance left to the goal where the run ended (0 when found)
     start_heading: float = float("nan")  # rad, the heading the run started with
+    decisions_record: dict | None = None  # the run's decisions, when recorded (runner.execute; tasks.decisions)
 
 
 def checked_cell(planner: str, row, col, free: np.ndarray) -> tuple[int, int]:

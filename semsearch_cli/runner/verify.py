@@ -1,0 +1,116 @@
+"""Verify a results folder by replaying its runs from their decisions (``semsearch verify``).
+
+Each run's row that has a decisions record (``decisions/<run>.json``, written by ``semsearch run
+--decisions``) is run again with the record answering every decision point
+(:class:`~semsearch_cli.tasks.decisions.Replay`): no planner is built, so a run of a planner whose
+code is not at hand (a learned policy, a language model, a colleague's planner) is checked all
+the same. The replay's rows must equal the folder's in outcome, distance and steps (and decisions,
+and a chain's stage rows), exactly as written; any other result, or a replay that cannot go on,
+names the run."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from ..errors import PlannerError, ScenarioError
+from ..planners import Variant
+from ..tasks.decisions import Replay, ReplayError
+from .specs import Loaded, file_stem
+from .store import read_decisions, read_runs
+
+COMPARED = ("outcome", "distance_m", "steps", "decisions")  # what a replay must give exactly, per row
+
+
+@dataclass
+class Verdict:
+    """What :func:`verify_folder` found: ``verified`` runs replayed to their rows; ``failed``:
+    (the run, why) of each that did not; ``unrecorded``: runs without a decisions record."""
+
+    runs: int = 0
+    verified: int = 0
+    failed: list = field(default_factory=list)
+    unrecorded: int = 0
+
+
+def run_name(planner, goal, episode, seed) -> str:
+    return f"{planner} goal {goal} episode {episode} seed {seed}"
+
+
+def _same(a, b) -> bool:
+    """Equal as written: numbers by value (NaN equal to NaN), anything else as text."""
+    if isinstance(a, numbers.Number) and isinstance(b, numbers.Number):
+        fa, fb = float(a), float(b)
+        return fa == fb or (math.isnan(fa) and math.isnan(fb))
+    return str(a) == str(b)
+
+
+def verify_folder(folder: Path, loaded: Loaded, progress=None) -> Verdict:
+    """Replay every run of ``folder/runs.csv`` that has a decisions record, on ``loaded`` (the
+    scenario the rows were made with: their fingerprint must be its own); ``progress(done,
+    total)`` after each run."""
+    rows = read_runs(Path(folder) / "runs.csv", as_written=True)
+    if not len(rows):
+        raise ScenarioError(str(Path(folder) / "runs.csv"), "", "holds no rows to verify")
+    own = rows[rows["stage"] == ""]
+    fp = loaded.fingerprint
+    other = own["fingerprint"].astype(str) != fp
+    if other.any():
+        raise ScenarioError(str(loaded.path), "fingerprint", f"{int(other.sum())} of the {len(own)} runs were made with another "
+                            f"scenario (fingerprint {own.loc[other, 'fingerprint'].iloc[0]}, this one's {fp}): give the "
+                            "scenario they were made with (--scenario)")
+    task = loaded.task
+    episodes = {(str(e.goal), e.index): e for e in task.episodes}
+    verdict = Verdict(runs=len(own))
+    by_run = rows.groupby(["planner", "goal", "episode", "seed"], sort=False)
+    for n, ((planner, goal, episode, seed), group) in enumerate(by_run, 1):
+        name = run_name(planner, goal, episode, seed)
+        f = Path(folder) / "decisions" / f"{file_stem(str(planner), goal, int(seed), int(episode))}.json"
+        if not f.is_file():
+            verdict.unrecorded += 1
+        else:
+            why = _replay(task, f, str(planner), str(goal), int(episode), int(seed), group, episodes)
+            if why:
+                verdict.failed.append((name, why))
+            else:
+                verdict.verified += 1
+        if progress:
+            progress(n, verdict.runs)
+    return verdict
+
+
+def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, group: pd.DataFrame, episodes: dict) -> str:
+    """Why the run's replay does not give its rows, or "" when it does."""
+    try:
+        record = read_decisions(f)
+    except ScenarioError as exc:
+        return exc.message
+    named = (str(record.get("planner")), str(record.get("goal")), record.get("episode"), record.get("seed"))
+    if named != (planner, goal, episode, seed):
+        return f"{f.name} records another run ({run_name(*named)})"
+    ep = episodes.get((goal, episode))
+    if ep is None:
+        return f"the scenario has no episode {episode} of goal {goal}"
+    variant = Variant(planner, ())  # the label alone: the replay builds no planner
+    try:
+        replay = Replay(record)
+        res = task.run(variant, ep, seed, seat=replay)
+        replay.finish()
+    except (ReplayError, PlannerError) as exc:
+        return f"the replay stopped: {exc}"
+    if res.outcome == "error":  # pragma: no cover - a replay raises rather than records
+        return f"the replay ended in an error: {res.message}"
+    got = task.rows(variant, ep, seed, res)
+    want = group.to_dict("records")
+    if len(got) != len(want):
+        return f"the replay gives {len(got)} rows, the folder holds {len(want)}"
+    for g, w in zip(got, want):
+        for c in COMPARED:
+            if not _same(g[c], w[c]):
+                where = f" (stage {w['stage']}, map {w['map']})" if w.get("stage") else ""
+                return f"{c}{where}: {w[c]} recorded, {g[c]} replayed"
+    return ""

@@ -1,0 +1,151 @@
+"""Runs replay from their decisions: every built-in planner of every kind, on the golden scenarios,
+recorded with ``--decisions`` and replayed without its planner, gives the rows it gave, exactly;
+``semsearch verify`` names a run that does not replay."""
+
+import json
+import textwrap
+
+import gymnasium as gym
+import semsearch_cli.envs  # noqa: F401  (registers the environments)
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from semsearch_cli import api
+from semsearch_cli.cli import app
+from semsearch_cli.planners import Variant
+from semsearch_cli.runner import BatchOptions, Loaded, RunSpec, file_stem, run_batch
+from semsearch_cli.runner.verify import verify_folder
+from semsearch_cli.tasks import TASKS
+from semsearch_cli.tasks.decisions import Recording, Replay, ReplayError
+from tests.golden.cases import CASES, FILE, IGNORED, ROOT, planners
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    """The golden cases run with their decisions recorded, one folder per config; and the chain
+    kind's example (doors 452, 304, 452 again), greedy and nsos, two repeats."""
+    out = tmp_path_factory.mktemp("recorded")
+    folders = {}
+    for config, kind, episodes, repeats in CASES:
+        L = Loaded.load(ROOT / "configs" / f"{config}.yaml")
+        specs = [RunSpec(L.task.episodes[k], v, s) for v in planners(kind) for k in episodes for s in repeats]
+        run_batch(L, specs, out / config, BatchOptions(workers=1, decisions=True))
+        folders[config] = (out / config, L)
+    chain = TASKS["chain"].example(out / "chain_src", "greedy")
+    L = Loaded.load(chain)
+    specs = [RunSpec(L.task.episodes[0], v, s) for v in (Variant("greedy", ()), Variant("nsos", (("alpha", 0.9),)))
+             for s in (0, 1)]
+    run_batch(L, specs, out / "chain", BatchOptions(workers=1, decisions=True))
+    folders["chain"] = (out / "chain", L)
+    return folders
+
+
+def test_recording_the_decisions_moves_no_golden_row(recorded):
+    want = pd.read_csv(FILE, dtype=str, keep_default_na=False)
+    got = pd.concat([pd.read_csv(recorded[c][0] / "runs.csv", dtype=str, keep_default_na=False) for c, *_ in CASES],
+                    ignore_index=True).drop(columns=list(IGNORED))
+    got = got.sort_values(["scenario", "planner", "goal", "episode", "seed", "stage"], kind="stable").reset_index(drop=True)
+    assert got.equals(want)
+
+
+@pytest.mark.parametrize("config", [c for c, *_ in CASES] + ["chain"])
+def test_every_built_in_planner_replays_exactly_from_its_decisions(recorded, config):
+    folder, _ = recorded[config]
+    verdict = verify_folder(folder, Loaded.load(recorded[config][1].path, planners=False))
+    assert verdict.failed == [] and verdict.unrecorded == 0
+    assert verdict.verified == verdict.runs == len(list((folder / "decisions").glob("*.json")))
+    if config == "chain":  # stage rows compared too: 2 planners x 2 repeats x (1 + 3 stages x kept/scratch)
+        assert len(pd.read_csv(folder / "runs.csv")) == 4 * 7
+
+
+def test_a_decision_costs_a_few_bytes(recorded):
+    folder, _ = recorded["hospital"]
+    sizes = []
+    for f in (folder / "decisions").glob("*.json"):
+        d = json.loads(f.read_text())
+        sizes.append(len(json.dumps(d["decisions"], separators=(",", ":"))) / len(d["decisions"]))
+    assert max(sizes) < 12  # [412,1033], and a 0 for a re-plan that asks the same
+
+
+def test_the_replay_is_the_run_path_and_all(recorded):
+    folder, L = recorded["indirect_quick"]
+    ep, v = L.task.episodes[139], Variant("ISUP", ())  # a planner that draws from the generator at every decision
+    rec = Recording()
+    a = L.task.run(v, ep, 0, seat=rec)
+    record = json.loads(json.dumps(rec.record("indirect")))
+    assert len(record["rng"]) == len(record["decisions"]) > 5
+    b = L.task.run(v, ep, 0, seat=Replay(record))
+    assert (a.outcome, a.distance_m, a.steps, a.decisions) == (b.outcome, b.distance_m, b.steps, b.decisions)
+    assert (a.path == b.path).all()
+    short = {**record, "decisions": record["decisions"][:3]}
+    with pytest.raises(ReplayError, match="the record holds 3"):
+        L.task.run(v, ep, 0, seat=Replay(short))
+
+
+def test_verify_names_a_run_whose_decisions_or_rows_were_changed(recorded, tmp_path):
+    import shutil
+
+    folder = tmp_path / "demo"
+    shutil.copytree(recorded["demo"][0], folder)
+    f = sorted((folder / "decisions").glob("greedy__goal452__ep1__seed0.json"))[0]
+    d = json.loads(f.read_text())
+    d["decisions"][2] = [d["decisions"][2][0] + 9, d["decisions"][2][1]]  # another target on the third decision
+    f.write_text(json.dumps(d))
+    scenario = ["--scenario", str(recorded["demo"][1].path)]  # a copied folder: meta.json's relative path is lost
+    res = CliRunner().invoke(app, ["verify", str(folder), *scenario])
+    assert res.exit_code == 1, res.output
+    assert "does not replay: greedy goal 452 episode 1 seed 0:" in res.output
+    assert "19 of 20 runs replayed" in res.output  # 5 planners x 2 episodes x 2 repeats
+
+    (folder / "decisions").rename(tmp_path / "gone")
+    res = CliRunner().invoke(app, ["verify", str(folder), *scenario])
+    assert res.exit_code == 2 and "has a decisions record: run the batch with --decisions" in res.output
+
+
+def test_a_planner_whose_code_is_gone_is_verified_by_its_decisions(tmp_path):
+    """A planner of one's own that draws from the run's generator: recorded with ``semsearch run
+    --decisions``, its file deleted, and the results verified without it."""
+    src = TASKS["doors"].example(tmp_path / "s", "greedy")
+    (src.parent / "coin.py").write_text(textwrap.dedent('''
+        from semsearch_cli.planners import Decision, DoorPlanner, register_planner
+
+        @register_planner("coin_for_verify")
+        class Coin(DoorPlanner):
+            """A frontier candidate at random."""
+            def choose(self, ctx, cands):
+                if len(cands) == 0:
+                    return None
+                k = int(ctx.rng.integers(len(cands)))
+                return Decision(int(cands.rows[k]), int(cands.cols[k]))
+    '''))
+    text = src.read_text().replace("name: greedy", "name: coin_for_verify\n  module: coin.py")
+    src.write_text(text)
+    out = tmp_path / "r"
+    res = CliRunner().invoke(app, ["run", str(src), "--seeds", "2", "--workers", "1", "--decisions", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    (src.parent / "coin.py").unlink()
+    verdict = api.verify(out).verdict
+    assert (verdict.verified, verdict.runs, verdict.failed) == (2, 2, [])
+    assert all(json.loads(f.read_text())["rng"] for f in (out / "decisions").glob("*.json"))
+
+
+def test_an_environment_answers_the_batchs_decision_points(recorded):
+    """The object environment's agent, answering with the places an object planner chose in the
+    batch, travels what the batch recorded: the same decision points, driven another way."""
+    folder, L = recorded["office"]
+    rows = pd.read_csv(folder / "runs.csv")
+    env = gym.make("semsearch/ObjectSearch-v0", scenario=str(L.path)).unwrapped
+    checked = 0
+    for _, row in rows[rows["planner"] == "brute_force"].iterrows():
+        stem = file_stem("brute_force", row["goal"], int(row["seed"]), int(row["episode"]))
+        items = json.loads((folder / "decisions" / f"{stem}.json").read_text())["decisions"]
+        if not all(isinstance(i, list) and len(i) == 1 for i in items):
+            continue  # a target that is not a place (the home): no action names it
+        env.reset(options={"episode": int(row["episode"]), "repeat": int(row["seed"])})
+        for (k,) in items:
+            *_, info = env.step(k)
+        assert (info["outcome"], info["steps"]) == (row["outcome"], row["steps"])
+        assert info["distance_m"] == pytest.approx(row["distance_m"], abs=1e-3)
+        checked += 1
+    assert checked >= 2
