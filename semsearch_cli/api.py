@@ -6,7 +6,7 @@ import json
 import os
 import re
 import shutil
-from contextlib import nullcontext
+from contextlib import ExitStack, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,12 +16,17 @@ import yaml
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .errors import ScenarioError
 from .world.ground_truth import DuplicateSigns
+from .world.buildings import numbered
+from .world.importers import kth, mobilesim, ros
+from .world.rooms import generate_rooms as make_rooms, write_rooms
+from .belief.presence import presence_scores, read_counts
+from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points
 from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.plots import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import BatchOptions, Loaded, check_folder, expand, folder_lock, make_executor, run_batch, run_rows
+from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows
 from .runner.verify import Verdict, verify_folder
 from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
@@ -70,11 +75,10 @@ def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=N
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
     out_dir = default_out(loaded, options.out)
-    with folder_lock(out_dir):
-        check_folder(loaded, out_dir, options.force)
+    with Batch(loaded, specs, out_dir, options) as batch:  # the folder held and its rows checked, once
         report_build.write_meta(out_dir, loaded)
         loaded.task.write_inputs(out_dir)
-        runs = run_batch(loaded, specs, out_dir, options, progress)
+        runs = batch.run(progress)
         summary = write_summary(runs, out_dir)
         if plots:
             report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
@@ -228,21 +232,21 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
     # one Dask cluster (or client) for every value; the process pool starts per value (a fork costs little)
     shared = (make_executor(options.workers, None, options.executor, options.scheduler) if options.executor != "processes"
               else nullcontext())
-    with folder_lock(out_dir), shared as runner:
+    with folder_lock(out_dir), shared as runner, ExitStack() as held:
         check_outputs(out_dir, ("sweep.csv", "sweep.md", "sweep.png"))
         subs = [inside(out_dir, f"{param}={v}") for v in values]
-        for ld, sub in zip(loaded, subs):  # refuse foreign rows before anything runs
-            check_folder(ld, sub, options.force)
-        frames = []
-        for v, ld, sub in zip(values, loaded, subs):
+        batches = []
+        for ld, sub in zip(loaded, subs):  # every value's folder held and checked (foreign rows refused) before anything runs
             specs = expand(ld, options.seeds, options.goals, options.planners)
             if not specs:
                 raise ScenarioError("<command line>", "--planner", f"no planner variant matches {options.planners}")
-            with folder_lock(sub):
-                report_build.write_meta(sub, ld)
-                ld.task.write_inputs(sub)
-                runs = run_batch(ld, specs, sub, options, progress, runner=runner)
-                write_summary(runs, sub)
+            batches.append(held.enter_context(Batch(ld, specs, sub, options)))
+        frames = []
+        for v, ld, sub, batch in zip(values, loaded, subs, batches):
+            report_build.write_meta(sub, ld)
+            ld.task.write_inputs(sub)
+            runs = batch.run(progress, runner=runner)
+            write_summary(runs, sub)
             frames.append(run_rows(runs).assign(value=v))
         runs = pd.concat(frames, ignore_index=True)
         table = sweep_table(runs, param)
@@ -418,3 +422,86 @@ def init(name: str, folder: str | Path, force: bool = False) -> list[Path]:
     written = shipped.init(name, output_folder(folder, "DIR"), force)
     Loaded.load(written[0])
     return written
+
+
+# ---- hours, buildings, rooms and maps of one's own -------------------------------------------------
+LAYOUTS, SCHEMES = numbered.LAYOUTS, numbered.SCHEMES  # generate_building's layouts and numbering schemes
+KTH_CORRIDOR_TYPES = kth.CORRIDOR_TYPES  # import_kth's default corridor types
+
+
+def presence(counts: str | Path, hours, out: str | Path | None = None) -> pd.DataFrame:
+    """Every place's presence score at each request hour from hourly counts (thesis 5.3.5,
+    Eq. 5.3): a DataFrame, one row per hour, one column per place; with ``out``, also written as
+    CSV (atomically) with the highest place of each hour."""
+    hours = list(hours)
+    if not hours or any(not 0 <= h < 24 for h in hours):
+        raise ScenarioError("<command line>", "--hours", f"hours must lie in 0-23, got {','.join(f'{h:g}' for h in hours)!r}")
+    path = output_file(out, "--out", (".csv",)) if out is not None else None
+    scores = presence_scores(read_counts(Path(counts)), hours)
+    if path is not None:
+        atomic_text(path, scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv())
+    return scores
+
+
+def generate_building(layout: str, numbering: str, seed: int, out: str | Path, spacing: float = 2.5, signs: int | None = None,
+                      goals: list | None = None, name: str | None = None, scale: float = 1.0) -> Path:
+    """Write a generated building into ``out`` (map.png, doors.csv and a scenario that runs as it
+    is); returns the scenario's path. ``goals``: door numbers (default: four spread by distance)."""
+    if goals and any(not isinstance(g, int) or isinstance(g, bool) for g in goals):
+        raise ScenarioError("<command line>", "--goals", f"expected door numbers, got {','.join(map(str, goals))!r}")
+    return numbered.generate_building(layout, numbering, seed, output_folder(out), spacing=spacing, signs=signs, goals=goals,
+                                      name=name, scale=scale)
+
+
+def _among(items, valid: tuple, flag: str) -> tuple:
+    """``items`` (None: all of ``valid``), each checked to be one of ``valid``."""
+    if items is None:
+        return valid
+    items = tuple(items)
+    bad = [t for t in items if t not in valid]
+    if bad or not items:
+        raise ScenarioError("<command line>", flag, f"unknown value(s) {bad or list(items)}; valid: {', '.join(valid)}")
+    return items
+
+
+def generate_batch(out: str | Path, seeds: int = 3, runs: int = 3, layouts=None, schemes=None) -> list[Path]:
+    """Every layout x numbering scheme x seed (``layouts``, ``schemes``: None for all) into ``out``,
+    one sub-folder each and index.txt: a robustness set. Returns the scenarios' paths."""
+    return numbered.generate_batch(output_folder(out), seeds=seeds, runs=runs, layouts=_among(layouts, LAYOUTS, "--layouts"),
+                                   schemes=_among(schemes, SCHEMES, "--schemes"))
+
+
+def generate_rooms(n: int, seed: int, out: str | Path, size: tuple[float, float] = (6.0, 6.0),
+                   obstacles: int = 0) -> tuple[Path, list]:
+    """``n`` rooms for indirect search as the paper's (Loncomilla et al. 2018, Section 4.5) into
+    ``out``/rooms.yaml; returns (its path, the rooms)."""
+    w, d = size
+    if not (1.0 <= w <= 50.0 and 1.0 <= d <= 50.0):
+        raise ScenarioError("<command line>", "--size", f"W and D must lie between 1 and 50 m (got {w:g},{d:g})")
+    spec = IndirectSpec()
+    try:
+        rooms = make_rooms(n, seed, spec.relations, spec.masks, spec.target, (w, d), obstacles)
+    except ValueError as exc:  # no free place for an object: the boxes took it, or the room is too small for the rings
+        raise ScenarioError("<command line>", "--obstacles" if obstacles else "--size",
+                            f"{exc}" + ("" if obstacles else f" (a {w:g} x {d:g} m room is too small for the objects' "
+                                                             "rings; give a larger --size)")) from None
+    return write_rooms(output_folder(out) / "rooms.yaml", rooms), rooms
+
+
+def import_mobilesim(map_file: str | Path, doors_file: str | Path, out: str | Path, **options) -> tuple[Path, list[str]]:
+    """A MobileSim map and door file as a scenario in ``out`` (see
+    :func:`~semsearch_cli.world.importers.mobilesim.import_mobilesim` for ``options``), validated
+    before it is written (:func:`imported`); returns (the scenario's path, notes)."""
+    return imported(mobilesim.import_mobilesim, out, Path(map_file), Path(doors_file), **options)
+
+
+def import_ros(map_file: str | Path, doors_file: str | Path, out: str | Path, **options) -> tuple[Path, list[str]]:
+    """A scenario over a ROS map (map_server YAML) and a doors CSV in ``out`` (see
+    :func:`~semsearch_cli.world.importers.ros.import_ros`), validated before it is written."""
+    return imported(ros.import_ros, out, Path(map_file), Path(doors_file), **options)
+
+
+def import_kth(xml_file: str | Path, out: str | Path, **options) -> tuple[Path, list[str]]:
+    """A KTH campus floor plan as a scenario in ``out`` (see
+    :func:`~semsearch_cli.world.importers.kth.import_kth`), validated before it is written."""
+    return imported(kth.import_kth, out, Path(xml_file), **options)

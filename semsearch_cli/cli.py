@@ -21,22 +21,11 @@ from rich.text import Text
 from . import api
 from .provenance import version_line
 from .runner import BatchOptions
-from .belief.presence import presence_scores, read_counts
 from .config.base import MAX_SEEDS, sign_label
-from .config.indirect import IndirectSpec
 from .kernels import announce_compiling
 from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated, did_you_mean
 from .report.build import console_tables
-from .world.buildings.numbered import LAYOUTS, SCHEMES
-from .world.buildings.numbered import generate_batch as gen_batch
-from .world.buildings.numbered import generate_building as gen_building
-from .world.rooms import generate_rooms as gen_rooms
-from .world.rooms import write_rooms
-from .world.importers.kth import CORRIDOR_TYPES as KTH_CORRIDOR_TYPES
-from .world.importers.kth import import_kth as imp_kth
-from .world.importers.mobilesim import import_mobilesim as imp_mobilesim
-from .world.importers.ros import import_ros as imp_ros
-from .files import atomic_text, output_file, output_folder
+from .files import output_folder
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 import_app = typer.Typer(no_args_is_help=True, help="Convert maps from other tools into scenarios.")
@@ -329,11 +318,7 @@ def presence(
             hs = [float(h) for h in hours.split(",") if h.strip()]
         except ValueError:
             raise ScenarioError("<command line>", "--hours", f"expected comma-separated hours, got {hours!r}") from None
-        if not hs or any(not 0 <= h < 24 for h in hs):
-            raise ScenarioError("<command line>", "--hours", f"hours must lie in 0-23, got {hours!r}")
-        scores = presence_scores(read_counts(counts_file), hs)
-        if out_file:
-            out_file = output_file(out_file, "--out", (".csv",))
+        scores = api.presence(counts_file, hs, out_file)
     except ScenarioError as exc:
         _fail(exc)
     t = Table(title="presence score per place (sum of counts x W, Eq. 5.3), * = highest")
@@ -345,7 +330,6 @@ def presence(
         t.add_row(f"{rh:g}", *[f"{v:.2f}" + ("*" if c == best else "") for c, v in row.items()])
     out.print(t)
     if out_file:
-        atomic_text(out_file, scores.assign(highest=scores.idxmax(axis=1)).round(3).to_csv())
         out.print(f"wrote {out_file}")
 
 
@@ -472,7 +456,7 @@ app.add_typer(generate_app, name="generate")
 @generate_app.command("building")
 def generate_building(
     layout: str = typer.Option(..., "--layout", help="grid, wings, angled or single."),
-    numbering: str = typer.Option(..., "--numbering", help=", ".join(SCHEMES) + "."),
+    numbering: str = typer.Option(..., "--numbering", help=", ".join(api.SCHEMES) + "."),
     seed: int = typer.Option(0, "--seed", min=0, max=2**32 - 1, help="Seed of the layout's variations (and of random numbering)."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
     spacing: float = typer.Option(2.5, "--spacing", callback=_finite, min=0.5, max=50.0, help="m between door slots along a wall."),
@@ -485,10 +469,8 @@ def generate_building(
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
         wanted = _split([goals], "--goals") if goals is not None else None
-        if wanted and any(not isinstance(g, int) for g in wanted):
-            raise ScenarioError("<command line>", "--goals", f"expected door numbers, got {goals!r}")
-        path = gen_building(layout, numbering, seed, output_folder(out_dir), spacing=spacing, signs=signs, goals=wanted,
-                            name=name, scale=scale)
+        path = api.generate_building(layout, numbering, seed, out_dir, spacing=spacing, signs=signs, goals=wanted, name=name,
+                                     scale=scale)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")
@@ -497,14 +479,9 @@ def generate_building(
 MAX_BATCH_SEEDS = 100  # generate batch: 2,800 buildings at most
 
 
-def _choices(text: Optional[str], valid: tuple, flag: str) -> tuple:
-    if text is None:
-        return valid
-    items = tuple(t.strip() for t in text.split(",") if t.strip())
-    bad = [t for t in items if t not in valid]
-    if bad or not items:
-        raise ScenarioError("<command line>", flag, f"unknown value(s) {bad or [text]}; valid: {', '.join(valid)}")
-    return items
+def _items(text: Optional[str]) -> Optional[list]:
+    """Comma-separated values, None when not given."""
+    return None if text is None else [t.strip() for t in text.split(",") if t.strip()]
 
 
 @generate_app.command("batch")
@@ -518,9 +495,7 @@ def generate_batch(
 ):
     """Every layout x numbering scheme x seed: a robustness set (4 x 7 x 3 = 84 buildings by default)."""
     try:
-        lays = _choices(layouts, LAYOUTS, "--layouts")
-        schs = _choices(schemes, SCHEMES, "--schemes")
-        paths = gen_batch(output_folder(out_dir), seeds=seeds, runs=runs, layouts=lays, schemes=schs)
+        paths = api.generate_batch(out_dir, seeds=seeds, runs=runs, layouts=_items(layouts), schemes=_items(schemes))
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {len(paths)} scenarios under {out_dir} (listed in {out_dir / 'index.txt'})")
@@ -538,16 +513,7 @@ def generate_rooms(
     uniform, each secondary object in a ring drawn from its co-occurrences (Table 2)."""
     try:
         w, d = _xy(size, "--size", "W,D in metres")
-        if not (1.0 <= w <= 50.0 and 1.0 <= d <= 50.0):
-            raise ScenarioError("<command line>", "--size", f"W and D must lie between 1 and 50 m (got {size!r})")
-        spec = IndirectSpec()
-        try:
-            rooms = gen_rooms(n, seed, spec.relations, spec.masks, spec.target, (w, d), obstacles)
-        except ValueError as exc:  # no free place for an object: the boxes took it, or the room is too small for the rings
-            raise ScenarioError("<command line>", "--obstacles" if obstacles else "--size",
-                                f"{exc}" + ("" if obstacles else f" (a {w:g} x {d:g} m room is too small for the objects' "
-                                                                 "rings; give a larger --size)")) from None
-        path = write_rooms(output_folder(out_dir) / "rooms.yaml", rooms)
+        path, rooms = api.generate_rooms(n, seed, out_dir, (w, d), obstacles)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {len(rooms)} rooms of {w:g} x {d:g} m to {path}")
@@ -580,7 +546,7 @@ def import_mobilesim(
 ):
     """Convert a MobileSim map and door file into a scenario that runs as it is."""
     try:
-        path, notes = api.imported(imp_mobilesim, out_dir, map_file, doors_file, res=resolution, start=_xy(start, "--start"),
+        path, notes = api.import_mobilesim(map_file, doors_file, out_dir, res=resolution, start=_xy(start, "--start"),
                                    goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta,
                                    duplicates=duplicates)
     except ScenarioError as exc:
@@ -615,7 +581,7 @@ def import_ros(
 ):
     """Make a scenario over a ROS map (the format of every ROS user's SLAM maps), keeping the map as it is."""
     try:
-        path, notes = api.imported(imp_ros, out_dir, map_file, doors_file, start=_xy(start, "--start"),
+        path, notes = api.import_ros(map_file, doors_file, out_dir, start=_xy(start, "--start"),
                                    goals=_split([goals], "--goals") if goals is not None else None, density_delta=density_delta,
                                    clean=clean, duplicates=duplicates)
     except ScenarioError as exc:
@@ -629,14 +595,14 @@ def import_kth(
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
     resolution: float = typer.Option(0.1, "--resolution", callback=_finite, min=0.01, max=1.0, help="m per cell."),
     goals: Optional[str] = typer.Option(None, "--goals", help="Comma-separated goal numbers (default: four spread by distance, among readable signs)."),
-    corridor_types: str = typer.Option(",".join(KTH_CORRIDOR_TYPES), "--corridor-types",
+    corridor_types: str = typer.Option(",".join(api.KTH_CORRIDOR_TYPES), "--corridor-types",
                                        help="Comma-separated space types the robot drives in (untyped spaces joined to several others count too)."),
     duplicates: str = DUPLICATES,
 ):
     """Convert a KTH floor plan: circulation spaces become free space, each room-to-corridor portal a sign."""
     try:
         types = tuple(t.strip().upper() for t in corridor_types.split(",") if t.strip())
-        path, notes = api.imported(imp_kth, out_dir, xml_file, res=resolution,
+        path, notes = api.import_kth(xml_file, out_dir, res=resolution,
                                    goals=_split([goals], "--goals") if goals is not None else None, corridor_types=types,
                                    duplicates=duplicates)
     except ScenarioError as exc:

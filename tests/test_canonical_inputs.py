@@ -181,12 +181,12 @@ def test_an_output_of_the_wrong_kind_is_refused_before_anything_runs(demo_dir, t
 def test_a_superseded_run_takes_its_files_aside_and_force_keeps_what_it_replaces(demo_dir, tmp_path, capsys):
     out = tmp_path / "out"
     loaded = Loaded.load(_scenario(demo_dir, tmp_path))
-    run_batch(loaded, expand(loaded, 2), out, BatchOptions(workers=1, frames=True, trace=True))
+    run_batch(loaded, expand(loaded, 2), out, BatchOptions(workers=1, frames=True, trace=True, decisions=True))
     stems = sorted(p.stem for p in (out / "paths").iterdir())
     assert len(stems) == 2
     batch._supersede(out, lambda rows: rows["seed"].astype(int) == 0, "were made by other code (a test)")
-    assert "and their 3 file(s) (paths, traces, frames) to superseded/1/" in " ".join(capsys.readouterr().err.split())
-    assert sorted(p.name for p in (out / "superseded" / "1").iterdir()) == ["frames", "paths", "traces"]
+    assert "and their 4 file(s) (paths, traces, frames, decisions) to superseded/1/" in " ".join(capsys.readouterr().err.split())
+    assert sorted(p.name for p in (out / "superseded" / "1").iterdir()) == ["decisions", "frames", "paths", "traces"]
     assert [p.stem for p in (out / "paths").iterdir()] == [stems[1]]
     run_batch(loaded, expand(loaded, 2), out, BatchOptions(workers=1, frames=True))  # the superseded run runs again
     assert sorted(p.stem for p in (out / "paths").iterdir()) == stems

@@ -37,6 +37,14 @@ API = {
     "scenarios": [],
     "default_out": ["loaded", "out"],
     "init": ["name", "folder", "force"],
+    "verify": ["folder", "scenario", "progress"],
+    "presence": ["counts", "hours", "out"],
+    "generate_building": ["layout", "numbering", "seed", "out", "spacing", "signs", "goals", "name", "scale"],
+    "generate_batch": ["out", "seeds", "runs", "layouts", "schemes"],
+    "generate_rooms": ["n", "seed", "out", "size", "obstacles"],
+    "import_mobilesim": ["map_file", "doors_file", "out", "options"],
+    "import_ros": ["map_file", "doors_file", "out", "options"],
+    "import_kth": ["xml_file", "out", "options"],
 }
 DEPRECATED = [(planners, "PlanContext", "DoorContext"), (planners_base, "PlanContext", "DoorContext"),
               (belief, "Belief", "DoorBelief"), (belief_doors, "Belief", "DoorBelief")]

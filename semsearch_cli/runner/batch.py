@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -107,7 +108,8 @@ def _supersede(out: Path, which, why: str) -> None:
         for f in files:
             (aside / f.parent.name).mkdir(parents=True, exist_ok=True)
             os.replace(f, aside / f.parent.name / f.name)
-        where = f", and their {len(files)} file(s) (paths, traces, frames, decisions) to {aside.relative_to(out)}/"
+        kinds = ", ".join(d for d, _ in RUN_FILES if any(f.parent.name == d for f in files))
+        where = f", and their {len(files)} file(s) ({kinds}) to {aside.relative_to(out)}/"
     print(f"{int(moved.sum())} row(s) in {runs_csv} {why}: moved to {side.name}{where}; their runs run again", file=sys.stderr)
 
 
@@ -158,41 +160,55 @@ def check_memory(loaded: Loaded, workers: int) -> None:
               "prints its progress every few seconds", file=sys.stderr)
 
 
-def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
-              progress: Callable[[dict, int, int], None] | None = None, runner: Executor | None = None) -> pd.DataFrame:
-    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
+class Batch:
+    """One batch into one folder, held and checked once for the whole command: entering takes the
+    folder's lock (:func:`folder_lock`) and checks its rows (:func:`check_folder`, with each
+    variant's code hash, so rows of a changed planner are set aside); :meth:`run` then runs the
+    specs not yet done. A command that writes more into the folder (meta.json, the logs a scenario
+    records) does so inside the ``with``, after the check::
 
-    Of the :class:`BatchOptions`, ``workers`` (None: one), ``executor``, ``scheduler`` and
-    ``start_method`` say where the runs run (see :func:`make_executor`: rows do not depend on it,
-    and a batch started on one resumes on another); ``trace`` writes each run's decision trace to
-    ``out/traces/``, ``frames`` its replay's frames to ``out/frames/``, ``decisions`` its decisions
-(the choices that replay it, ``semsearch verify``) to ``out/decisions/``; ``force`` is below.
-    ``runner``, an executor the caller made (and entered), e.g. one Dask cluster for every value of
-    a sweep, replaces the executor options. ``progress(row, done, total)`` is called as each run
-    finishes, with the runs finished so far and the runs this batch has to do. The specs are
-    streamed to the executor, never listed whole (a :class:`~semsearch_cli.runner.specs.RunList`
-    of any length costs no memory).
+        with Batch(loaded, specs, out, options) as batch:
+            write_meta(out, loaded)
+            rows = batch.run(progress)
+    """
 
-    The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's
-    fingerprint (:attr:`Loaded.fingerprint`); rows of another scenario (or an edited one) in the
-    folder are refused, unless ``force``, which moves that runs.csv aside (kept as
-    ``runs.<n>.csv.bak``) and starts afresh."""
-    runs_csv = out / "runs.csv"
-    workers, executor = options.workers or 1, options.executor
-    watch = Watch(options.trace, options.frames, options.decisions)
-    fp = loaded.fingerprint
-    variants = specs.variants if hasattr(specs, "variants") else list({s.variant for s in specs})
-    codes = {v.label: code_of(v)["hash"] for v in variants}
-    with folder_lock(out):
-        done = check_folder(loaded, out, options.force, codes)
+    def __init__(self, loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions()):
+        self.loaded, self.specs, self.out, self.options = loaded, specs, Path(out), options
+        self.variants = specs.variants if hasattr(specs, "variants") else list(dict.fromkeys(s.variant for s in specs))
+        self.codes = {v.label: code_of(v)["hash"] for v in self.variants}
+        self.done: pd.DataFrame | None = None
+        self._stack: ExitStack | None = None
+
+    def __enter__(self) -> "Batch":
+        with ExitStack() as stack:
+            stack.enter_context(folder_lock(self.out))
+            self.done = check_folder(self.loaded, self.out, self.options.force, self.codes)
+            self._stack = stack.pop_all()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        stack, self._stack = self._stack, None
+        if stack is not None:
+            stack.close()
+
+    def run(self, progress: Callable[[dict, int, int], None] | None = None, runner: Executor | None = None) -> pd.DataFrame:
+        """Run the specs not yet in runs.csv (see :func:`run_batch`); returns every row of the
+        file afterwards."""
+        if self._stack is None:
+            raise RuntimeError("run a Batch inside its with block (the folder held and checked)")
+        loaded, specs, out, options, done = self.loaded, self.specs, self.out, self.options, self.done
+        runs_csv = out / "runs.csv"
+        workers, executor = options.workers or 1, options.executor
+        watch = Watch(options.trace, options.frames, options.decisions)
+        fp = loaded.fingerprint
+        codes = self.codes
         have = {(str(p), str(g), int(e), int(s)) for p, g, e, s in zip(done["planner"], done["goal"], done["episode"], done["seed"])} \
             if len(done) else set()
         has = getattr(specs, "has_key", None) or {s.key for s in specs}.__contains__
         total = len(specs) - sum(1 for k in have if has(k))
         todo = (s for s in specs if s.key not in have)
         if total >= MANY_RUNS:
-            n_var = len(variants)
-            print(f"runs: {total:,} to do ({n_var:,} planner variant(s) x goals, episodes and seeds)", file=sys.stderr)
+            print(f"runs: {total:,} to do ({len(self.variants):,} planner variant(s) x goals, episodes and seeds)", file=sys.stderr)
         if total and executor == "processes" and runner is None:
             check_memory(loaded, max(1, min(workers, total)))
         if runner is None:
@@ -221,3 +237,25 @@ def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: Batc
                 pass
         return read_runs(runs_csv)
 
+
+def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
+              progress: Callable[[dict, int, int], None] | None = None, runner: Executor | None = None) -> pd.DataFrame:
+    """Run the specs not yet in ``out/runs.csv``; returns all rows of the file afterwards.
+
+    Of the :class:`BatchOptions`, ``workers`` (None: one), ``executor``, ``scheduler`` and
+    ``start_method`` say where the runs run (see :func:`make_executor`: rows do not depend on it,
+    and a batch started on one resumes on another); ``trace`` writes each run's decision trace to
+    ``out/traces/``, ``frames`` its replay's frames to ``out/frames/``, ``decisions`` its decisions
+    (the choices that replay it, ``semsearch verify``) to ``out/decisions/``; ``force`` is below.
+    ``runner``, an executor the caller made (and entered), e.g. one Dask cluster for every value of
+    a sweep, replaces the executor options. ``progress(row, done, total)`` is called as each run
+    finishes, with the runs finished so far and the runs this batch has to do. The specs are
+    streamed to the executor, never listed whole (a :class:`~semsearch_cli.runner.specs.RunList`
+    of any length costs no memory).
+
+    The folder is locked for the batch (see :func:`folder_lock`). Rows carry the scenario's
+    fingerprint (:attr:`Loaded.fingerprint`); rows of another scenario (or an edited one) in the
+    folder are refused, unless ``force``, which moves that runs.csv aside (kept as
+    ``runs.<n>.csv.bak``) and starts afresh."""
+    with Batch(loaded, specs, out, options) as batch:
+        return batch.run(progress, runner)

@@ -241,6 +241,7 @@ class Task:
         self.shortest: dict = {}  # goal -> shortest path (m) from the scenario's start, set by each kind's build
         self._episodes: list[Episode] | None = None
         self._fields: dict[str, np.ndarray] = {}  # goal -> distance field, only while episodes are drawn
+        self._variants: tuple | None = None  # (the planner entries, their variants)
 
     # ---- built from the scenario ------------------------------------------------------
     @property
@@ -249,8 +250,14 @@ class Task:
         return list(self.sc.goals)
 
     def variants(self, specs=None) -> list[Variant]:
-        """The scenario's planner entries (or ``specs``) as variants, checked for this kind."""
-        return expand_variants(self.sc.planners if specs is None else specs, self.file, self.planner_kind, self.path.parent)
+        """The scenario's planner entries (or ``specs``) as variants, checked for this kind; the
+        scenario's own expanded once (their files loaded once), then kept."""
+        if specs is not None:
+            return expand_variants(specs, self.file, self.planner_kind, self.path.parent)
+        entries = self.sc.planners
+        if self._variants is None or self._variants[0] is not entries:  # sc replaced (Loaded.with_planners): expand again
+            self._variants = (entries, expand_variants(entries, self.file, self.planner_kind, self.path.parent))
+        return list(self._variants[1])
 
     def planner_labels(self, most: int = 12):
         """The variants' labels for `validate`; a long sweep as its count and its first and last."""
