@@ -22,9 +22,10 @@ from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points
+from .plugins import load_kinds
 from .report import build as report_build
 from .report.document import atomic_text, markdown_table
-from .report.plots import plot_alpha_sweep, plot_sweep
+from .report.figures.distances import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows
 from .runner.verify import Verdict, verify_folder
@@ -116,19 +117,25 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
     """Replay every run of a results folder that has a decisions record (``run --decisions``)
     from its decisions alone, no planner built, and check outcome, distance and steps against its
     rows (:mod:`semsearch_cli.runner.verify`). ``scenario``: the scenario the rows were made with
-    (default: the one meta.json names); its planners' files are not needed."""
+    (default: the one meta.json names, with the parameter a sweep set in that folder); its
+    planners' files are not needed."""
     folder = Path(folder)
     if not (folder / "runs.csv").is_file():
         raise ScenarioError(str(folder), "", "no runs.csv here: give a folder written by `semsearch run`")
+    meta = report_build.read_meta(folder)
     if scenario is None:
-        path = report_build.scenario_of(folder, report_build.read_meta(folder))
+        path = report_build.scenario_of(folder, meta)
         path = path.resolve() if path is not None else None
         if path is None:
             raise ScenarioError(str(folder / "meta.json"), "scenario", "names no scenario file that exists; give the "
                                 "scenario the rows were made with, --scenario FILE")
     else:
         path = scenario_file(scenario)
-    loaded = Loaded.load(path, planners=False)
+    varied = meta.get("varied")  # a sweep's value: its parameter set as the sweep set it
+    if isinstance(varied, dict) and isinstance(varied.get("param"), str):
+        loaded = Loaded.load(path, with_param(read_yaml(path), varied["param"], varied.get("value"), path), planners=False)
+    else:
+        loaded = Loaded.load(path, planners=False)
     verdict = verify_folder(folder, loaded, progress)
     if not verdict.verified and not verdict.failed:
         raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "
@@ -243,7 +250,7 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
             batches.append(held.enter_context(Batch(ld, specs, sub, options)))
         frames = []
         for v, ld, sub, batch in zip(values, loaded, subs, batches):
-            report_build.write_meta(sub, ld)
+            report_build.write_meta(sub, ld, {"param": param, "value": v})
             ld.task.write_inputs(sub)
             runs = batch.run(progress, runner=runner)
             write_summary(runs, sub)
@@ -386,6 +393,7 @@ def planners(scenario: str | Path | None = None) -> list[dict]:
     """Every planner semsearch can run: built-in, from installed packages (entry points) and,
     with ``scenario``, from the files it names; each with its kind of search, where it comes
     from, its description and its parameters (name, type, default, description)."""
+    load_kinds()
     load_entry_points()
     own = {}
     if scenario is not None:

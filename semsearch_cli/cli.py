@@ -358,8 +358,8 @@ def verify(
                                             "meta.json names)."),
 ):
     """Replay every run of a results folder that has its decisions (`semsearch run --decisions`),
-    without its planner, and check its outcome, distance and steps exactly: each run that does
-    not replay is named, and the status is 1."""
+    without its planner, and check its outcome, distance, steps and decisions exactly: each run
+    that does not replay is named, and the status is 1."""
 
     try:
         res = api.verify(folder, scenario)
@@ -370,8 +370,8 @@ def verify(
         out.print(f"does not replay: {name}: {why}")
     skipped = f"; {v.unrecorded} without decisions (not recorded with --decisions, or an error or timeout) not checked" \
         if v.unrecorded else ""
-    out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance and steps "
-              f"recorded{skipped} (scenario {res.scenario})")
+    out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance, steps and "
+              f"decisions recorded{skipped} (scenario {res.scenario})")
     if v.failed:
         out.print(f"{len(v.failed)} run(s) do not replay")
         raise typer.Exit(1)

@@ -5,9 +5,23 @@ from __future__ import annotations
 import json
 import math
 
+# the columns of runs.csv as 0.2.0 wrote them, for every kind: the ones every kind writes, and the
+# built-in kinds' own (room and time_s: indirect search; stage and map: chains), each in its place.
+# A runs.csv holds all of them through 0.2.x; a kind's columns beyond these (a kind from another
+# package, Task.columns) follow them, in the folders of that kind (columns_for).
 COLUMNS = ["kind", "scenario", "planner", "params", "goal", "episode", "seed", "start_x", "start_y", "start_heading",
            "room", "stage", "map", "outcome", "cause", "success", "distance_m", "shortest_m", "ratio", "spl", "soft_spl",
            "left_m", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint", "code"]
+BUILT_IN_KIND_COLUMNS = ("room", "stage", "map", "time_s")
+SHARED = [c for c in COLUMNS if c not in BUILT_IN_KIND_COLUMNS]  # what every kind's run row holds (run_row)
+
+
+def columns_for(kind_columns) -> list[str]:
+    """The columns of a runs.csv whose runs are of kinds with these own columns: :data:`COLUMNS`,
+    then the kinds' columns it lacks, before the provenance columns (navigator onwards)."""
+    extra = [c for c in dict.fromkeys(kind_columns) if c not in COLUMNS]
+    k = COLUMNS.index("navigator")
+    return COLUMNS[:k] + extra + COLUMNS[k:]
 
 # the failure cause of each outcome (empty for a run that found its goal)
 CAUSES = {"found": "", "not_found": "explored", "stuck": "stuck", "budget": "budget", "error": "error",
@@ -44,13 +58,14 @@ def result_columns(outcome: str, distance: float, shortest: float, steps: int, d
             "wall_s": round(wall_s, 3)}
 
 
-def run_row(kind: str, scenario: str, variant, ep, seed: int, result, navigator: str, room: str = "") -> dict:
-    """One row: the run's identity (kind, scenario, planner label and parameters, goal, episode,
-    repeat and start), its outcome and, when it failed, why (``cause``: budget, stuck, explored
-    (nowhere left to look), error), its distance beside the episode's shortest path, SPL, SoftSPL,
-    the distance left to the goal, and counts. ``stage`` and ``map`` are empty here; per-stage rows
-    of chains fill them. ``time_s`` is the simulated time of a task with a clock (indirect
-    search), empty for the others; ``room`` the room an indirect search searched."""
+def run_row(kind: str, scenario: str, variant, ep, seed: int, result, navigator: str) -> dict:
+    """One row's :data:`SHARED` columns, what every kind writes: the run's identity (kind,
+    scenario, planner label and parameters, goal, episode, repeat and start), its outcome and, when
+    it failed, why (``cause``: budget, stuck, explored (nowhere left to look), error), its distance
+    beside the episode's shortest path, SPL, SoftSPL, the distance left to the goal (empty when the
+    kind does not know it), and counts. A kind adds its own columns (``Task.record``: indirect
+    search its room and simulated time; chains their stage rows); a column a row lacks is written
+    empty."""
     success = result.outcome == "found"
     d = result.distance_m
     shortest = ep.shortest_m
@@ -66,13 +81,9 @@ def run_row(kind: str, scenario: str, variant, ep, seed: int, result, navigator:
         "start_x": round(ep.x, 4),
         "start_y": round(ep.y, 4),
         "start_heading": round(math.degrees(result.start_heading), 3) if result.start_heading == result.start_heading else "",
-        "room": room,
-        "stage": "",
-        "map": "",
         **result_columns(result.outcome, d, shortest, result.steps, result.decisions, result.wall_s),
         "soft_spl": round(soft_spl(shortest, d, 0.0 if success else left), 4) if d == d else float("nan"),
         "left_m": round(left, 3) if left == left else "",
-        "time_s": round(result.time_s, 2) if result.time_s == result.time_s else "",
         "navigator": navigator,
         "message": result.message,
     }

@@ -7,7 +7,7 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 
-from semsearch_cli.report import plots  # noqa: E402
+from semsearch_cli.report.figures import common  # noqa: E402
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 REF = SHARED / "reference_maps"
@@ -46,7 +46,7 @@ def _console_width(monkeypatch):
 def drawn(monkeypatch):
     """The figures the plot functions draw, kept open instead of written (closed after the test)."""
     figs = []
-    monkeypatch.setattr(plots, "_save", lambda fig, out, formats=("png",), dpi=plots.PNG_DPI: figs.append(fig) or [])
+    monkeypatch.setattr(common, "_save", lambda fig, out, formats=("png",), dpi=common.PNG_DPI: figs.append(fig) or [])
     yield figs
     for f in figs:
         plt.close(f)

@@ -3,6 +3,7 @@ recorded with ``--decisions`` and replayed without its planner, gives the rows i
 ``semsearch verify`` names a run that does not replay."""
 
 import json
+import shutil
 import textwrap
 
 import gymnasium as gym
@@ -59,13 +60,28 @@ def test_every_built_in_planner_replays_exactly_from_its_decisions(recorded, con
         assert len(pd.read_csv(folder / "runs.csv")) == 4 * 7
 
 
+def test_a_path_that_reuses_the_planners_search_replays(tmp_path):
+    """nsos searches the belief from the robot to every candidate, and the path to the target it
+    chose reuses that search; the record keeps the search (``left``) so that the replay, with no
+    planner, plans the same path. Hospital chain night, episode 3: a replay that searched afresh
+    took another path at one of its 2,082 re-plans."""
+    L = Loaded.load(ROOT / "configs" / "hospital.yaml")
+    ep = next(e for e in L.task.episodes if str(e.goal) == "night")
+    specs = [RunSpec(ep, Variant("nsos", (("alpha", 0.9),)), s) for s in (0, 1)]
+    run_batch(L, specs, tmp_path / "r", BatchOptions(workers=1, decisions=True))
+    records = [json.loads(f.read_text()) for f in sorted((tmp_path / "r" / "decisions").glob("*.json"))]
+    assert all(len(r["left"]) > 0.9 * len(r["decisions"]) for r in records)  # nsos leaves its search at nearly every decision
+    verdict = verify_folder(tmp_path / "r", Loaded.load(L.path, planners=False))
+    assert (verdict.verified, verdict.failed) == (2, [])
+
+
 def test_a_decision_costs_a_few_bytes(recorded):
     folder, _ = recorded["hospital"]
     sizes = []
     for f in (folder / "decisions").glob("*.json"):
         d = json.loads(f.read_text())
         sizes.append(len(json.dumps(d["decisions"], separators=(",", ":"))) / len(d["decisions"]))
-    assert max(sizes) < 12  # [412,1033], and a 0 for a re-plan that asks the same
+    assert max(sizes) < 12  # [412,1033] (a 0 for a re-plan that asks the same), beside the search kept in "left"
 
 
 def test_the_replay_is_the_run_path_and_all(recorded):
@@ -84,8 +100,6 @@ def test_the_replay_is_the_run_path_and_all(recorded):
 
 
 def test_verify_names_a_run_whose_decisions_or_rows_were_changed(recorded, tmp_path):
-    import shutil
-
     folder = tmp_path / "demo"
     shutil.copytree(recorded["demo"][0], folder)
     f = sorted((folder / "decisions").glob("greedy__goal452__ep1__seed0.json"))[0]
@@ -110,7 +124,7 @@ def test_a_planner_whose_code_is_gone_is_verified_by_its_decisions(tmp_path):
     (src.parent / "coin.py").write_text(textwrap.dedent('''
         from semsearch_cli.planners import Decision, DoorPlanner, register_planner
 
-        @register_planner("coin_for_verify")
+        @register_planner("verify_coin")
         class Coin(DoorPlanner):
             """A frontier candidate at random."""
             def choose(self, ctx, cands):
@@ -119,7 +133,7 @@ def test_a_planner_whose_code_is_gone_is_verified_by_its_decisions(tmp_path):
                 k = int(ctx.rng.integers(len(cands)))
                 return Decision(int(cands.rows[k]), int(cands.cols[k]))
     '''))
-    text = src.read_text().replace("name: greedy", "name: coin_for_verify\n  module: coin.py")
+    text = src.read_text().replace("name: greedy", "name: verify_coin\n  module: coin.py")
     src.write_text(text)
     out = tmp_path / "r"
     res = CliRunner().invoke(app, ["run", str(src), "--seeds", "2", "--workers", "1", "--decisions", "--out", str(out)])

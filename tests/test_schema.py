@@ -49,3 +49,9 @@ def test_the_command_prints_or_writes_the_schema(tmp_path):
     assert r.exit_code == 0 and (tmp_path / "s.json").read_text() == api.schema_text()
     r = runner.invoke(app, ["schema", "--out", str(tmp_path / "s.txt")])
     assert r.exit_code == 2 and "--out" in r.output
+
+
+def test_the_shipped_schema_is_the_one_the_models_give():
+    """configs/scenario.schema.json is what `semsearch schema` writes (rewrite it with
+    `semsearch schema --out configs/scenario.schema.json` after changing a model)."""
+    assert SHIPPED.read_text() == api.schema_text()

@@ -151,6 +151,7 @@ class DoorBelief:
         self.version = 0  # bumped whenever passable/cost change
         self.lost = 0  # cells that were free and are no longer (a wall seen where the map had free space)
         self._search_key = None
+        self.last_search = None  # (r, c, version, t_rows, t_cols, n_stop) of the search search_state holds
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
@@ -446,6 +447,7 @@ class DoorBelief:
         n += set_joins(passable, mask, np.array([r], np.int64), np.array([c], np.int64), rad, self._joins[n:])
         gs = self.search_state
         self._search_key = (r, c, self.version)
+        self.last_search = (r, c, self.version, t_rows, t_cols, n_stop)
         try:
             settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop)
         finally:

@@ -4,7 +4,7 @@ Importing this package registers every kind."""
 
 from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
-from .scenario import (KINDS, OnMap, Scenario, all_fields, kind_of, load_scenario, parse_scenario, read_yaml, register_kind,
+from .scenario import (KINDS, SIGN_SECTIONS, OnMap, Scenario, SignSections, all_fields, kind_of, load_scenario, parse_scenario, read_yaml, register_kind,
                        scenario_schema, with_param)
 from .doors import DoorScenario
 from .objects import (CaseSpec, ClassCameraSpec, DetectTable, ObjectCameraSpec, ObjectScenario, ObjectsSpec, PlaceSpec,
@@ -15,5 +15,5 @@ from .indirect import IndirectScenario
 __all__ = ["BeliefSpec", "CaseSpec", "ChainScenario", "ChainSpec", "ClassCameraSpec", "DetectTable", "DoorCameraSpec",
            "DoorScenario", "DoorSpec", "ExperimentSpec", "IndirectScenario", "KINDS", "LaserSpec", "MapSpec",
            "NavigationSpec", "ObjectCameraSpec", "ObjectScenario", "ObjectsSpec", "OnMap", "PlaceSpec", "PlannerSpec",
-           "RequestSpec", "RobotSpec", "Scenario", "StageSpec", "StartSpec", "Strict", "all_fields", "kind_of",
+           "RequestSpec", "RobotSpec", "SIGN_SECTIONS", "Scenario", "SignSections", "StageSpec", "StartSpec", "Strict", "all_fields", "kind_of",
            "load_scenario", "parse_scenario", "read_yaml", "register_kind", "scenario_schema", "with_param"]

@@ -10,7 +10,7 @@ from pydantic import Field, model_validator
 
 from .base import Label, Strict
 from .objects import ObjectsSpec
-from .scenario import OnMap, register_kind
+from .scenario import OnMap, SignSections, register_kind
 
 NAME = r"^[A-Za-z0-9_\-]+$"
 
@@ -38,7 +38,7 @@ class ChainSpec(Strict):
 
 
 @register_kind("chain")
-class ChainScenario(OnMap):
+class ChainScenario(SignSections, OnMap):
     """Chained searches (thesis ch. 6): door signs, then objects in the rooms behind them."""
 
     section = "chains"

@@ -7,11 +7,11 @@ from typing import Literal
 from pydantic import Field, field_validator
 
 from .base import Label
-from .scenario import OnMap, register_kind
+from .scenario import OnMap, SignSections, register_kind
 
 
 @register_kind("doors", default=True)
-class DoorScenario(OnMap):
+class DoorScenario(SignSections, OnMap):
     """A door-search scenario: a map, its door signs, a start, and the sign numbers to find."""
 
     section = "goals"

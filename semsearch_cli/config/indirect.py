@@ -14,7 +14,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from .base import MAX_RANGE, Strict
-from .scenario import Scenario, register_kind
+from .scenario import SIGN_SECTIONS, Scenario, register_kind
 
 Length = Annotated[float, Field(gt=0.0, le=MAX_RANGE)]
 
@@ -260,6 +260,7 @@ class IndirectScenario(Scenario):
 
     section = "indirect"
     needs = "an indirect section"
+    retired = (*SIGN_SECTIONS, "robot")  # its robot, camera and rooms are in the indirect section
 
     kind: Literal["indirect"] = "indirect"
     indirect: IndirectSpec = Field(description="indirect search with secondary objects (Loncomilla et al. 2018)")

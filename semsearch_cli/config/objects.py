@@ -8,7 +8,7 @@ from typing import Annotated, Literal, Union
 from pydantic import ConfigDict, Field, model_validator
 
 from .base import Label, MAX_RANGE, Angle, Coord, Strict
-from .scenario import OnMap, register_kind
+from .scenario import SIGN_SECTIONS, OnMap, register_kind
 
 NAME = r"^[A-Za-z0-9_\-]+$"
 Hour = Annotated[float, Field(ge=0.0, lt=24.0, description="hour of the day, 0 <= h < 24")]
@@ -122,6 +122,7 @@ class ObjectScenario(OnMap):
 
     section = "objects"
     needs = "an objects section"
+    retired = SIGN_SECTIONS  # the robot drives the recorded map with its object camera: no signs, laser or belief
 
     kind: Literal["objects"] = "objects"
     objects: ObjectsSpec = Field(description="places, timelines, requests and the object camera")

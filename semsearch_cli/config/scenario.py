@@ -17,30 +17,67 @@ from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal, Union, get_args
 
 import yaml
-from pydantic import BaseModel, Field, Tag, TypeAdapter, ValidationError
+from pydantic import BaseModel, Field, PrivateAttr, Tag, TypeAdapter, ValidationError
 
+from .. import deprecation
 from ..errors import ScenarioError, did_you_mean
 from ..files import read_user_text
+from ..plugins import load_kinds
 from ..registry import Registry
 from .base import (BeliefSpec, DoorCameraSpec, DoorSpec, EpisodesSpec, ExperimentSpec, LaserSpec, MapSpec, NavigationSpec,
                    PlannerSpec, RobotSpec, StartSpec, Strict)
 
 class Scenario(Strict):
-    """The sections every kind of search shares. A kind's model adds its own section (named by
-    ``section``) and sets ``kind`` to a one-value Literal with that value as its default."""
+    """The sections every kind of search takes: ``kind``, ``name``, ``planners``, ``episodes``
+    and ``experiment``. A kind's model adds its own section (named by ``section``), the shared
+    sections it takes (:class:`OnMap`: ``map``, ``start``, ``robot``; :class:`SignSections`: the
+    door signs, their sensors, belief and navigation), and sets ``kind`` to a one-value Literal
+    with that value as its default. A section the kind does not take is refused, naming it.
+
+    ``retired``: sections the kind's model took in 0.2.0 without using them; given, each is
+    ignored with a DeprecationWarning (refused from 0.3.0), and counted in the fingerprint as 0.2.0
+    counted it (a results folder of 0.2.0 resumes)."""
 
     section: ClassVar[str] = ""  # the field whose presence makes a document this kind
     needs: ClassVar[str] = ""  # what to write when that section is missing, e.g. "door numbers under goals"
+    retired: ClassVar[tuple[str, ...]] = ()
 
     kind: str
     name: str = Field(pattern=r"^[A-Za-z0-9_\-][A-Za-z0-9_.\-]*$", max_length=200,
                       description="letters, digits, _ - . (not first): it names the output folder")
-    doors: Union[str, list[DoorSpec]] = Field(default_factory=list, description="the door signs: a CSV file (number, x, y, facing) or a list")
-    duplicates: Literal["error", "keep-first", "any"] = Field(
-        "error", description="signs sharing a number: refuse them, keep the first of each, or accept any as the goal")
     planners: list[PlannerSpec] = Field(default_factory=lambda: [PlannerSpec(name="greedy")], min_length=1)
     episodes: EpisodesSpec | None = Field(None, description="start/goal problems (default: one per goal, from start)")
     experiment: ExperimentSpec = ExperimentSpec()
+    _retired: dict = PrivateAttr(default_factory=dict)  # the retired sections as 0.2.0 read them (the fingerprint's)
+
+
+class OnMap(Scenario):
+    """A kind searched on a map of the scenario's own, from a start pose, by a robot of a radius
+    that moves a step at a time."""
+
+    map: MapSpec = Field(description="the occupancy map: an image with its resolution and origin, or a ROS map_server YAML")
+    start: StartSpec = Field(description="where the robot starts (m, degrees)")
+    robot: RobotSpec = RobotSpec()
+
+
+class SignSections(Strict):
+    """The sections of a kind that reads door signs: the signs, the laser and door cameras that
+    build its map, the belief and the navigation (door search and chains)."""
+
+    doors: Union[str, list[DoorSpec]] = Field(default_factory=list, description="the door signs: a CSV file (number, x, y, facing) or a list")
+    duplicates: Literal["error", "keep-first", "any"] = Field(
+        "error", description="signs sharing a number: refuse them, keep the first of each, or accept any as the goal")
+    laser: LaserSpec = LaserSpec()
+    door_camera: DoorCameraSpec = DoorCameraSpec()
+    belief: BeliefSpec = BeliefSpec()
+    navigation: NavigationSpec = NavigationSpec()
+
+
+class _Retired(Strict):
+    """Every section some kind has retired, as 0.2.0's common model read it."""
+
+    doors: Union[str, list[DoorSpec]] = Field(default_factory=list)
+    duplicates: Literal["error", "keep-first", "any"] = "error"
     robot: RobotSpec = RobotSpec()
     laser: LaserSpec = LaserSpec()
     door_camera: DoorCameraSpec = DoorCameraSpec()
@@ -48,11 +85,24 @@ class Scenario(Strict):
     navigation: NavigationSpec = NavigationSpec()
 
 
-class OnMap(Scenario):
-    """A kind searched on a map of the scenario's own, from a start pose."""
+SIGN_SECTIONS = tuple(SignSections.model_fields)  # retired by the kinds that read no signs
 
-    map: MapSpec = Field(description="the occupancy map: an image with its resolution and origin, or a ROS map_server YAML")
-    start: StartSpec = Field(description="where the robot starts (m, degrees)")
+
+def _retire(model: type[Scenario], data: dict, file) -> tuple[dict, dict]:
+    """``data`` without the sections ``model`` has retired (each given one warned about), and
+    those sections as 0.2.0 read them (defaults for the ones not given)."""
+    names = [k for k in model.retired if k not in model.model_fields]
+    given = {k: data[k] for k in names if k in data}
+    if not names:
+        return data, {}
+    for k in given:
+        deprecation.warn(f"the {k} section of a scenario of kind {model.model_fields['kind'].default} ({file}), which that "
+                         "kind never used,", "remove it (it is ignored)", since="0.3.0", until="0.4.0", stacklevel=5)
+    try:
+        old = _Retired.model_validate(given).model_dump(mode="json")
+    except ValidationError:  # a value 0.2.0 would have refused: the section is ignored all the same
+        old = _Retired().model_dump(mode="json") | {k: None for k in given}
+    return {k: v for k, v in data.items() if k not in given}, {k: old[k] for k in names}
 
 
 KINDS = Registry("scenario kind", Scenario)  # kind -> its scenario model, in registration order
@@ -83,7 +133,8 @@ def _sections() -> dict[str, str]:
 
 def kind_of(data: dict) -> str | None:
     """The kind a scenario document is of (see the module's docstring); None for ``kind:`` naming
-    no registered kind."""
+    no registered kind. The kinds of installed packages are registered first (:mod:`~semsearch_cli.plugins`)."""
+    load_kinds()
     given = data.get("kind")
     if given is not None:
         return given if isinstance(given, str) and given in KINDS else None
@@ -94,9 +145,9 @@ def kind_of(data: dict) -> str | None:
     return (taken or present)[0]
 
 
-def all_fields() -> set[str]:
-    """Every top-level field of every kind's model."""
-    return {f for cls in KINDS.values() for f in cls.model_fields}
+def all_fields(built_in: bool = False) -> set[str]:
+    """Every top-level field of every kind's model (``built_in``: of semsearch's own kinds only)."""
+    return {f for cls in KINDS.values() if not built_in or cls.__module__.startswith("semsearch_cli.") for f in cls.model_fields}
 
 
 _ADAPTER: TypeAdapter | None = None
@@ -164,8 +215,11 @@ def parse_scenario(data: Any, file: str | Path) -> Scenario:
     if kind is None:
         raise ScenarioError(str(file), "kind", f"unknown kind {data.get('kind')!r}; known: {', '.join(KINDS)}")
     model = KINDS[kind]
+    data, retired = _retire(model, data, file)
     try:
-        return model.model_validate(data)
+        sc = model.model_validate(data)
+        sc._retired = retired
+        return sc
     except ValidationError as exc:
         errs = exc.errors()
         err = errs[0]

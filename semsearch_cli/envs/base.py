@@ -42,7 +42,6 @@ from ..errors import ScenarioError, did_you_mean
 from ..tasks import Task, build_task
 from ..tasks.decisions import DecisionPoint
 from ..tasks.episodes import Episode, episode_seed
-from ..world.ground_truth import build_world
 
 SUCCESS_BONUS = 100.0
 BIG = 1e6  # bound of the observations' coordinates (m), as config.base.MAX_COORD, and of sign numbers
@@ -71,7 +70,7 @@ def load_task(scenario: str | Path, kind: str) -> Task:
     task = _TASKS.get(key)
     if task is None:
         sc = load_scenario(path)
-        task = build_task(sc, build_world(sc, path.parent, str(path)), path)
+        task = build_task(sc, None, path)
         _TASKS[key] = task
     if task.kind != kind:
         raise ScenarioError(str(path), "kind", f"a {task.kind} scenario; this environment runs {kind} scenarios")

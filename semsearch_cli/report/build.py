@@ -27,6 +27,7 @@ from ..files import check_outputs, read_user_text
 from ..runner import Loaded, read_runs, run_rows
 from ..tasks.episodes import set_hash
 from . import doors, objects, chain, indirect  # noqa: F401  (each registers its section)
+from ..plugins import load_kinds
 from .sections import SECTIONS, replaying
 from .stats import episodes
 from .tables import goal_key, planner_order
@@ -99,7 +100,7 @@ def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
                         f"({eps}); seeds {span(rows['seed'])}. Give one of those, or --no-replay.")
 
 
-def write_meta(out_dir: Path, loaded: Loaded) -> None:
+def write_meta(out_dir: Path, loaded: Loaded, varied: dict | None = None) -> None:
     """Record, beside runs.csv, what produced (or extended) it: the commands, the scenario (its
     path relative to the folder, the hash of its bytes, its fingerprint and its episode set),
     each planner's code (:func:`~semsearch_cli.planners.code_of`), and semsearch's version, code
@@ -111,6 +112,8 @@ def write_meta(out_dir: Path, loaded: Loaded) -> None:
     scenario = Path(loaded.path).resolve()
     meta["scenario"] = os.path.relpath(scenario, out_dir.resolve())
     meta["scenario_sha256"] = hashlib.sha256(scenario.read_bytes()).hexdigest()
+    if varied is not None:  # a sweep's value: the scenario with this parameter set (semsearch verify loads it so)
+        meta["varied"] = varied
     meta["fingerprint"] = loaded.fingerprint
     eps = loaded.task.episodes
     meta["episodes"] = {"count": len(eps), "hash": set_hash(eps)}
@@ -251,6 +254,7 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     ``results/report``). ``replay``: False (none), True (each section's default run) or the run to
     replay (a :class:`ReplayChoice` or its ``PLANNER,GOAL,EPISODE,SEED`` text), checked against
     the rows before anything is written. Returns the report files written."""
+    load_kinds()  # the sections of the kinds installed packages add
     if isinstance(replay, str):
         replay = parse_replay(replay)
     t0 = time.perf_counter()

@@ -11,7 +11,9 @@ import pandas as pd
 from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import image_formats, planner_colors, plot_chain_stages, plot_path_panels, plot_scenario
+from .figures.chain import plot_chain_stages
+from .figures.common import image_formats, planner_colors
+from .figures.paths import plot_path_panels, plot_scenario
 from .runfiles import load_paths, median_panel, safe_name, start_points
 
 

@@ -12,8 +12,10 @@ from . import stats as S
 from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import (animate_run, budget_curve, episode_mean, image_formats, swept_values, plot_alpha_sweep, plot_boxes, plot_budget,
-                    plot_path_panels, plot_scenario, planner_colors)
+from .figures.common import episode_mean, image_formats, planner_colors
+from .figures.distances import budget_curve, plot_alpha_sweep, plot_boxes, plot_budget, swept_values
+from .figures.paths import plot_path_panels, plot_scenario
+from .figures.replay import animate_run
 from .runfiles import load_paths, median_label, median_panel, replay_frames, row_variant, safe_name, start_points, stems
 from .tables import goal_key
 

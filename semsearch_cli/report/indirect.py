@@ -15,7 +15,8 @@ from . import stats as S
 from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import animate_probability, image_formats, plot_rooms, plot_success_by_scale
+from .figures.common import image_formats
+from .figures.indirect import animate_probability, plot_rooms, plot_success_by_scale
 from .runfiles import replay_frames, row_variant, stems
 
 # The paper's Table 3: success rate (%) per method and view scale (m), 200 trials each

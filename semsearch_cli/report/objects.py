@@ -17,7 +17,9 @@ from ..tasks.objects import parse_label, read_log
 from . import tables as T
 from .sections import Section, register_section
 from .document import Document, atomic_text, markdown_table, write_table
-from .plots import image_formats, planner_colors, plot_heat, plot_heat_steps, plot_object_bars, plot_path_panels
+from .figures.common import image_formats, planner_colors
+from .figures.objects import plot_heat, plot_heat_steps, plot_object_bars
+from .figures.paths import plot_path_panels
 from .runfiles import load_paths, median_panel, start_points
 
 def object_table(runs: pd.DataFrame) -> pd.DataFrame:

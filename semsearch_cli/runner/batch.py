@@ -13,6 +13,7 @@ import pandas as pd
 
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
+from ..metrics import columns_for
 from ..planners import code_of
 from .execution import Executor, Watch
 from .executors import SerialExecutor, make_executor
@@ -215,7 +216,7 @@ class Batch:
             serial = total == 0 or (executor == "processes" and total == 1)
             runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), options.start_method, executor,
                                                                    options.scheduler)
-        writer = RowWriter(runs_csv)
+        writer = RowWriter(runs_csv, columns_for(loaded.task.columns))
         n = 0
         try:
             for rows in runner.rows(loaded, todo, out, watch):

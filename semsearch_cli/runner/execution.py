@@ -50,8 +50,9 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
             tracer = TraceObserver() if watch.trace else None
             recorder = FrameRecorder() if watch.frames else None
             seat = Recording() if watch.decisions else None
-            res = task.run(spec.variant, spec.episode, spec.seed, Observers(tracer, recorder) if tracer or recorder else None,
-                           seat)
+            watching = Observers(tracer, recorder) if tracer or recorder else None
+            res = (task.run(spec.variant, spec.episode, spec.seed, watching) if seat is None
+                   else task.run(spec.variant, spec.episode, spec.seed, watching, seat=seat))
             if seat is not None:
                 res.decisions_record = {**seat.record(task.kind), **identity(loaded, spec)}
             if tracer is not None:

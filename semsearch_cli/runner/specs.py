@@ -18,7 +18,7 @@ from ..files import safe_chars
 from ..planners import Variant
 from ..tasks import Task, build_task
 from ..tasks.episodes import Episode
-from ..world.ground_truth import World, build_world
+from ..world.ground_truth import World
 
 
 @dataclass(frozen=True)
@@ -83,8 +83,7 @@ class Loaded:
         sc = load_scenario(path) if data is None else parse_scenario(data, path)
         if not planners:
             sc = sc.model_copy(update={"planners": []})
-        world = build_world(sc, path.parent, str(path))
-        task = build_task(sc, world, path)
+        task = build_task(sc, None, path)  # in the world its kind builds
         check_file_stems(task, str(path))
         return cls(path, sc, task)
 
@@ -113,7 +112,8 @@ class Loaded:
         if self._fingerprint is None:
             # one canonical form whatever the kind's model: every kind's sections (null where this
             # kind has none), and ``kind`` only as written (null when the sections said it)
-            d = dict.fromkeys(all_fields()) | self.sc.model_dump(mode="json")
+            # (semsearch's own kinds' fields: a kind another package adds moves no other kind's fingerprint)
+            d = dict.fromkeys(all_fields(built_in=True)) | self.sc._retired | self.sc.model_dump(mode="json")
             if "kind" not in self.sc.model_fields_set:
                 d["kind"] = None
             for key in ("planners", "goals"):  # the name stays: rows of a renamed copy are not resumed under the old name

@@ -17,8 +17,10 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError, did_you_mean
-from ..metrics import CAUSES, COLUMNS
+from ..metrics import CAUSES, COLUMNS, columns_for
 from ..planners.base import MAX_INFO_DEPTH
+from ..plugins import load_kinds
+from ..tasks import TASKS
 from ..tasks.decisions import ReplayError, check_record
 from ..files import temp_path
 
@@ -64,9 +66,11 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
         for c in KEY_TEXT:
             if c in df.columns:
                 df[c] = _lossless(df[c])
-    extra = [c for c in df.columns if c not in COLUMNS]
+    load_kinds()
+    known = columns_for(c for t in TASKS.values() for c in t.columns)  # every registered kind's
+    extra = [c for c in df.columns if c not in known]
     if extra:
-        raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), COLUMNS)} "
+        raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), known)} "
                             "(edited by hand?); remove it, or write into another folder with --out")
     for c in NUMBERS:
         if c in df.columns and not pd.api.types.is_numeric_dtype(df[c]):  # a cell that is not a number
@@ -138,13 +142,15 @@ def run_rows(df: pd.DataFrame) -> pd.DataFrame:
 class RowWriter:
     """Appends rows to runs.csv, flushing each to disk as it arrives."""
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, columns: list[str] | None = None):
+        """``columns``: a new file's (default :data:`~semsearch_cli.metrics.COLUMNS`; a batch
+        gives :func:`~semsearch_cli.metrics.columns_for` its kind); a file that exists keeps its own."""
         path.parent.mkdir(parents=True, exist_ok=True)
         if path.is_file():  # drop a last line cut by an interruption
             with open(path, "rb+") as fh:
                 fh.truncate(_whole_lines(fh))
         new = not path.is_file() or path.stat().st_size == 0
-        fields = COLUMNS
+        fields = list(columns or COLUMNS)
         if not new:  # keep the file's columns
             with open(path, newline="") as fh:
                 fields = next(csv.reader(fh))
@@ -245,7 +251,7 @@ def write_decisions(path: Path, record: dict) -> None:
     os.replace(tmp, path)
 
 
-MAX_DECISIONS_BYTES = 200_000_000  # a decisions file larger than this is not one semsearch wrote
+MAX_DECISIONS_BYTES = 50_000_000  # a decisions file larger than this is not one semsearch wrote (a run's: kilobytes)
 
 
 def read_decisions(path: Path) -> dict:

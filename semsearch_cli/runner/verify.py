@@ -66,9 +66,13 @@ def verify_folder(folder: Path, loaded: Loaded, progress=None) -> Verdict:
     task = loaded.task
     episodes = {(str(e.goal), e.index): e for e in task.episodes}
     verdict = Verdict(runs=len(own))
-    by_run = rows.groupby(["planner", "goal", "episode", "seed"], sort=False)
+    by_run = rows.groupby(["planner", "goal", "episode", "seed"], sort=False, dropna=False)
     for n, ((planner, goal, episode, seed), group) in enumerate(by_run, 1):
         name = run_name(planner, goal, episode, seed)
+        whole = [v for v in (episode, seed) if isinstance(v, numbers.Integral) or (isinstance(v, float) and v.is_integer())]
+        if len(whole) < 2 or not all(0 <= v < 10**9 for v in whole):
+            verdict.failed.append((name, "its episode and seed are not whole numbers from 0 to 999,999,999 (edited by hand?)"))
+            continue
         f = Path(folder) / "decisions" / f"{file_stem(str(planner), goal, int(seed), int(episode))}.json"
         if not f.is_file():
             verdict.unrecorded += 1
@@ -102,6 +106,8 @@ def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, gro
         replay.finish()
     except (ReplayError, PlannerError) as exc:
         return f"the replay stopped: {exc}"
+    except Exception as exc:  # noqa: BLE001  a recorded choice the kind's code could not take: named, never a traceback
+        return f"the replay stopped: {type(exc).__name__}: {str(exc)[:120]}"
     if res.outcome == "error":  # pragma: no cover - a replay raises rather than records
         return f"the replay ended in an error: {res.message}"
     got = task.rows(variant, ep, seed, res)

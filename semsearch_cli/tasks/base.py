@@ -27,7 +27,7 @@ from ..metrics import run_row
 from ..registry import Registry
 from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
-from ..world.ground_truth import World
+from ..world.ground_truth import World, build_world
 from .decisions import Seat, ask
 from .episodes import Episode, check_hash, draw_starts, episode_seed, given_episodes, label_words, region_mask
 
@@ -70,6 +70,7 @@ class Outcome:
     time_s: float = float("nan")
     message: str = ""
     stages: list = field(default_factory=list)
+    record: dict = field(default_factory=dict)  # the kind's own columns of the run's row (Task.columns)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -178,6 +179,7 @@ class RunResult:
     left_m: float = float("nan")  # geodesic distance left to the goal where the run ended (0 when found)
     start_heading: float = float("nan")  # rad, the heading the run started with
     decisions_record: dict | None = None  # the run's decisions, when recorded (runner.execute; tasks.decisions)
+    record: dict = field(default_factory=dict)  # the kind's own columns of the run's row (Outcome.record)
 
 
 def checked_cell(planner: str, row, col, free: np.ndarray) -> tuple[int, int]:
@@ -217,13 +219,18 @@ def checked_point(planner: str, x, y, frame, heading=None) -> tuple[float, float
 
 
 class Task:
-    """One kind of search over a scenario. Subclasses set ``kind``, ``planner_kind`` (which
-    registered planners answer it) and implement :meth:`episode` (and usually :meth:`goals`)."""
+    """One kind of search over a scenario, whatever its world. Subclasses set ``kind``,
+    ``planner_kind`` (which registered planners answer it), ``columns`` (its own row columns
+    beyond every kind's, filled by :meth:`record`) and ``records`` (the columns it fills on every
+    row), and implement :meth:`build_world`, :meth:`build`,
+    :meth:`build_episodes` and :meth:`episode` (and usually :attr:`goals`); a kind on a map
+    subclasses :class:`OnMapTask`, which does the world and the episodes."""
 
     kind: ClassVar[str] = ""
     planner_kind: ClassVar[str] = ""  # the ``task`` of the registered planners that answer it
     noun: ClassVar[str] = ""  # what the kind searches for, in a sentence ("door signs")
-    records: ClassVar[tuple[str, ...]] = ()  # the row columns this kind fills beyond every kind's own
+    records: ClassVar[tuple[str, ...]] = ()  # the row columns this kind fills with a value on every row
+    columns: ClassVar[tuple[str, ...]] = ()  # the kind's own row columns, beyond every kind's (metrics.SHARED)
 
     def episode_row(self, ep: Episode) -> dict:
         """An episode as a row of ``semsearch episodes``' CSV."""
@@ -235,12 +242,12 @@ class Task:
         ``folder`` and return its YAML file: seconds to run, for the tests every kind shares."""
         raise NotImplementedError
 
-    def __init__(self, sc: Scenario, world: World, path: Path):
+    def __init__(self, sc: Scenario, world, path: Path):
+        """``world``: what :meth:`build_world` built (a kind's own type)."""
         self.sc, self.world, self.path = sc, world, Path(path)
         self.file = str(path)
         self.shortest: dict = {}  # goal -> shortest path (m) from the scenario's start, set by each kind's build
         self._episodes: list[Episode] | None = None
-        self._fields: dict[str, np.ndarray] = {}  # goal -> distance field, only while episodes are drawn
         self._variants: tuple | None = None  # (the planner entries, their variants)
 
     # ---- built from the scenario ------------------------------------------------------
@@ -280,6 +287,123 @@ class Task:
         if self._episodes is None:
             self._episodes = self.build_episodes()
         return self._episodes
+
+    # ---- the kind's world and episodes ---------------------------------------------------
+    @classmethod
+    def build_world(cls, sc: Scenario, base: Path, file: str):  # pragma: no cover
+        """The world a scenario of this kind is searched in, built from it (paths relative to
+        ``base``) and checked: each kind builds its own (:class:`OnMapTask`: a map, its signs and
+        a start; indirect search: its rooms)."""
+        raise NotImplementedError
+
+    def build_episodes(self) -> list[Episode]:  # pragma: no cover
+        """The scenario's episode set (a kind defines it; see :mod:`.episodes`)."""
+        raise NotImplementedError
+
+    def as_episode(self, ep) -> Episode:
+        """``ep`` itself when it is an :class:`Episode`, else a goal's first episode, or the one
+        :meth:`from_start` gives for a goal the set lacks (a convenience for scripts and tests:
+        ``task.run(variant, 148, 0)``)."""
+        if isinstance(ep, Episode):
+            return ep
+        for e in self.episodes:
+            if str(e.goal) == str(ep) or (isinstance(ep, float) and str(e.goal) == f"{ep:g}"):
+                return e
+        return self.from_start(ep)
+
+    def from_start(self, goal) -> Episode:
+        """The episode of a goal the episode set lacks (a kind on a map starts it at the
+        scenario's start); here: a :class:`ScenarioError`."""
+        raise ScenarioError(self.file, "goals", f"no episode of goal {goal}")
+
+    def distance_left(self, goal, x: float, y: float) -> float:
+        """The distance (m) from (x, y) to ``goal``, where a run that did not find it ended:
+        NaN (unknown) unless the kind measures it."""
+        return math.nan
+
+    def memory_per_run(self) -> int:
+        """Bytes one run of this scenario holds at its peak, about (0: not known; the batch checks
+        the workers' memory against it)."""
+        return 0
+
+    # ---- running ----------------------------------------------------------------------
+    def start_state(self, ep: Episode, rng: np.random.Generator) -> RobotState:
+        """The robot at the episode's start (a heading left to each repeat draws from ``rng``)."""
+        heading = math.radians(ep.heading) if ep.heading is not None else float(rng.uniform(-np.pi, np.pi))
+        return RobotState(ep.x, ep.y, heading, trail=[(ep.x, ep.y)])
+
+    def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
+                observer: Observer | None = None, decide=ask) -> tuple[Outcome, RobotState]:  # pragma: no cover
+        """One search for ``goal`` by ``planner`` from ``state``, its decisions answered by
+        ``decide`` (:mod:`.decisions`)."""
+        raise NotImplementedError
+
+    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None,
+            seat: Seat | None = None) -> RunResult:
+        """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode): the start state, then
+        the kind's search (:meth:`search`), its events shown to ``observer`` and its decisions
+        answered by ``seat`` (default: the variant's planner; a
+        :class:`~semsearch_cli.tasks.decisions.Recording` keeps them, a
+        :class:`~semsearch_cli.tasks.decisions.Replay` answers from a record). Every kind's run."""
+        t0 = time.perf_counter()
+        ep = self.as_episode(ep)
+        rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
+        st = self.start_state(ep, rng)
+        heading = st.heading
+        out = self.search(variant, ep, seed, st, rng, Seat() if seat is None else seat, observer)
+        left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
+        return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
+                         np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=out.stages,
+                         message=out.message, time_s=out.time_s, left_m=left, start_heading=heading,
+                         record=dict(out.record))
+
+    def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng: np.random.Generator, seat: Seat,
+               observer: Observer | None) -> Outcome:
+        """One run's search from ``st`` (changed in place): by default one :meth:`episode` of the
+        variant's planner (as ``seat`` seats it) for the episode's goal."""
+        out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
+        return out
+
+    def rows(self, variant: Variant, ep: Episode, seed: int, res: RunResult) -> list[dict]:
+        """The rows of one finished run: its own, then any per-stage rows."""
+        row = run_row(self.kind, self.sc.name, variant, ep, seed, res, self.navigator) | self.record(ep, res)
+        return [row] + [{**row, **s} for s in res.stages]
+
+    def record(self, ep: Episode, res: RunResult) -> dict:
+        """The kind's own columns of a run's row (:attr:`columns`), beside every kind's
+        (:func:`~semsearch_cli.metrics.run_row`): by default what its search put in
+        :attr:`Outcome.record`."""
+        return dict(res.record)
+
+    @property
+    def navigator(self) -> str:
+        """The navigator the rows name: ``navigation.navigator`` for a kind that takes the
+        navigation section; else ``geodesic``, as 0.2.0 wrote it (object search drives geodesic
+        paths on the recorded map, indirect search any-angle paths over its room's cells)."""
+        nav = getattr(self.sc, "navigation", None)
+        return nav.navigator if nav is not None else "geodesic"
+
+    # ---- beside the runs --------------------------------------------------------------
+    def write_inputs(self, out: Path) -> None:
+        """Write what the runs read besides the scenario (detection logs) into ``out``."""
+
+    def describe(self) -> dict:
+        """What ``semsearch validate`` prints."""
+        return {"name": self.sc.name, "kind": self.kind, "planners": self.planner_labels()}
+
+class OnMapTask(Task):
+    """A kind searched on a map of the scenario's own (door search, object search, chains): the
+    world is the map with its signs and start (:func:`~semsearch_cli.world.ground_truth.build_world`);
+    a goal's shortest path and the distance left are geodesics on it; episodes start from the
+    scenario's start, or are drawn or given on the map (:mod:`.episodes`)."""
+
+    def __init__(self, sc: Scenario, world: World, path: Path):
+        super().__init__(sc, world, path)
+        self._fields: dict[str, np.ndarray] = {}  # goal -> distance field, only while episodes are drawn
+
+    @classmethod
+    def build_world(cls, sc: Scenario, base: Path, file: str) -> World:
+        return build_world(sc, base, file)
 
     def goal_field(self, goal) -> np.ndarray:
         """(H, W) float, m: the ground-truth geodesic distance from every cell to ``goal`` (to the
@@ -345,7 +469,7 @@ class Task:
             if k not in shortest:
                 by_goal.setdefault(str(goal), []).append(k)
         for key, ks in by_goal.items():
-            if len(ks) > 1 and type(self).shortest_from is Task.shortest_from:  # a kind measuring its own way skips it
+            if len(ks) > 1 and type(self).shortest_from is OnMapTask.shortest_from:  # a kind measuring its own way skips it
                 self.goal_field(goals[ks[0]])
             for k in ks:
                 shortest[k] = self.shortest_from(goals[k], eps[k]["x"], eps[k]["y"])
@@ -401,72 +525,10 @@ class Task:
             out.sort(key=lambda e: [str(g) for g in self.goals].index(str(e["goal"])))
         return out
 
-    def as_episode(self, ep) -> Episode:
-        """``ep`` itself when it is an :class:`Episode`, else a goal's first episode, or one from
-        the scenario's start for a goal the set lacks (a convenience for scripts and tests:
-        ``task.run(variant, 148, 0)``)."""
-        if isinstance(ep, Episode):
-            return ep
-        for e in self.episodes:
-            if str(e.goal) == str(ep) or (isinstance(ep, float) and str(e.goal) == f"{ep:g}"):
-                return e
-        e = self.start_episode(ep)  # a goal without episodes: from the scenario's start
-        return Episode(-1, ep, e["x"], e["y"], e["heading"], None, e.get("shortest", self.shortest_from(ep, e["x"], e["y"])))
-
-    # ---- running ----------------------------------------------------------------------
-    def start_state(self, ep: Episode, rng: np.random.Generator) -> RobotState:
-        """The robot at the episode's start (a heading left to each repeat draws from ``rng``)."""
-        heading = math.radians(ep.heading) if ep.heading is not None else float(rng.uniform(-np.pi, np.pi))
-        return RobotState(ep.x, ep.y, heading, trail=[(ep.x, ep.y)])
-
-    def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
-                observer: Observer | None = None, decide=ask) -> tuple[Outcome, RobotState]:  # pragma: no cover
-        """One search for ``goal`` by ``planner`` from ``state``, its decisions answered by
-        ``decide`` (:mod:`.decisions`)."""
-        raise NotImplementedError
-
-    BYTES_PER_CELL: ClassVar[int] = 110  # measured: one run on a 25-million-cell map took 2.6 GB
-
-    def memory_per_run(self) -> int:
-        """Bytes one run of this scenario holds at its peak, about: the map's cells times what a
-        run keeps per cell (the belief's layers, the searches' state)."""
-        f = self.world.frame
-        return int(f.height * f.width * self.BYTES_PER_CELL)
-
-    def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None,
-            seat: Seat | None = None) -> RunResult:
-        """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode): the start state, then
-        the kind's search (:meth:`search`), its events shown to ``observer`` and its decisions
-        answered by ``seat`` (default: the variant's planner; a
-        :class:`~semsearch_cli.tasks.decisions.Recording` keeps them, a
-        :class:`~semsearch_cli.tasks.decisions.Replay` answers from a record). Every kind's run."""
-        t0 = time.perf_counter()
-        ep = self.as_episode(ep)
-        rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
-        st = self.start_state(ep, rng)
-        heading = st.heading
-        out = self.search(variant, ep, seed, st, rng, Seat() if seat is None else seat, observer)
-        left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
-        return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=out.stages,
-                         message=out.message, time_s=out.time_s, left_m=left, start_heading=heading)
-
-    def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng: np.random.Generator, seat: Seat,
-               observer: Observer | None) -> Outcome:
-        """One run's search from ``st`` (changed in place): by default one :meth:`episode` of the
-        variant's planner (as ``seat`` seats it) for the episode's goal."""
-        out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
-        return out
-
-    def rows(self, variant: Variant, ep: Episode, seed: int, res: RunResult) -> list[dict]:
-        """The rows of one finished run: its own, then any per-stage rows."""
-        row = run_row(self.kind, self.sc.name, variant, ep, seed, res, self.sc.navigation.navigator,
-                      self.room_name(ep))
-        return [row] + [{**row, **s} for s in res.stages]
-
-    def room_name(self, ep: Episode) -> str:
-        """The room an episode searches (indirect search), else empty."""
-        return ""
+    def from_start(self, goal) -> Episode:
+        """The episode of ``goal`` from the scenario's start (for a goal the episode set lacks)."""
+        e = self.start_episode(goal)
+        return Episode(-1, goal, e["x"], e["y"], e["heading"], None, e.get("shortest", self.shortest_from(goal, e["x"], e["y"])))
 
     def max_steps(self, max_distance: float | None = None) -> int:
         """The step limit: ``experiment.max_steps``, else 1.5 times the steps that
@@ -475,9 +537,13 @@ class Task:
         budget = e.max_distance if max_distance is None else max_distance
         return e.max_steps or int(np.ceil(budget / self.sc.robot.step * 1.5)) + 100
 
-    # ---- beside the runs --------------------------------------------------------------
-    def write_inputs(self, out: Path) -> None:
-        """Write what the runs read besides the scenario (detection logs) into ``out``."""
+    BYTES_PER_CELL: ClassVar[int] = 110  # measured: one run on a 25-million-cell map took 2.6 GB
+
+    def memory_per_run(self) -> int:
+        """Bytes one run of this scenario holds at its peak, about: the map's cells times what a
+        run keeps per cell (the belief's layers, the searches' state)."""
+        f = self.world.frame
+        return int(f.height * f.width * self.BYTES_PER_CELL)
 
     def describe(self) -> dict:
         """What ``semsearch validate`` prints."""
@@ -495,14 +561,19 @@ def register_task(cls):
     return TASKS.add(getattr(cls, "kind", ""), cls)
 
 
-def build_task(sc: Scenario, world: World, path: Path) -> Task:
-    """The task of a scenario's kind, built and checked."""
+def build_task(sc: Scenario, world, path: Path) -> Task:
+    """The task of a scenario's kind, built and checked, in ``world`` (None: the world the kind
+    builds from the scenario, :meth:`Task.build_world`)."""
     kind = sc.kind
     if kind not in TASKS:
         raise ScenarioError(str(path), "kind", f"no task of kind {kind!r}; known: {', '.join(sorted(TASKS))}")
-    if sc.navigation.navigator not in NAVIGATORS:
-        raise ScenarioError(str(path), "navigation.navigator", f"unknown navigator {sc.navigation.navigator!r}; valid: "
+    nav = getattr(sc, "navigation", None)
+    if nav is not None and nav.navigator not in NAVIGATORS:
+        raise ScenarioError(str(path), "navigation.navigator", f"unknown navigator {nav.navigator!r}; valid: "
                             f"{', '.join(NAVIGATORS)}")
-    task = TASKS[kind].build(sc, world, path)
+    cls = TASKS[kind]
+    if world is None:
+        world = cls.build_world(sc, Path(path).parent, str(path))
+    task = cls.build(sc, world, path)
     task.episodes  # built and checked now: a bad episode is an error of the scenario's
     return task

@@ -35,7 +35,7 @@ from ..errors import ScenarioError
 from ..metrics import result_columns
 from ..planners import PLANNERS, Variant
 from ..world.buildings.demo import write_demo
-from .base import Observer, Outcome, RobotState, StageObserver, Task, register_task
+from .base import Observer, Outcome, RobotState, StageObserver, OnMapTask, register_task
 from .decisions import Seat
 from .episodes import Episode, episode_seed
 from .doors import DoorTask
@@ -54,11 +54,12 @@ class Stage:
 
 
 @register_task
-class ChainTask(Task):
+class ChainTask(OnMapTask):
     kind = "chain"
     planner_kind = "doors"
     noun = "door signs one after another, and objects in the rooms behind them, from one robot state"
     records = ("map",)
+    columns = ("stage", "map")
 
     @classmethod
     def example(cls, folder, planner):

@@ -12,12 +12,15 @@ A run stops for a decision in one place: a kind's re-plan (``Search.plan``, a ge
 - a Gymnasium environment (``semsearch_cli.envs``): the agent's action answers, through
   :class:`~semsearch_cli.tasks.loop.Session`.
 
-A replay is exact because a run's randomness is the run's one generator (sensing and planners
-draw from it) and everything else is deterministic: the same choices, with the generator restored
-after each, give the same path, distance, steps and outcome. What a planner is besides its
-choices (door planners' ``replan_on_signs``, indirect planners' masks) shapes the run too; each
-kind's planner protocol names those attributes (``run_attributes``), the recording keeps them,
-and a replay seats a :class:`StandIn` that has them.
+A replay is exact when the run depends on its planner only through what the record keeps: the
+choices; the run's one generator (sensing and planners draw from it), restored after each
+decision at which the planner drew; what the planner leaves behind that the run goes on to read
+(door search: the path search a planner ran over the belief, which the path to its target reuses
+when it started from the robot's cell; the kind's ``DecisionPoint.keep`` and ``restore``); and
+what a planner is besides its choices (door planners' ``replan_on_signs``, indirect planners'
+masks: each kind's planner protocol names them, ``run_attributes``, and a replay seats a
+:class:`StandIn` that has them). A planner that changes the run any other way (writing into the
+belief it is shown) does not replay, and ``semsearch verify`` names its runs.
 
 The record of a run (``decisions/<run>.json``)::
 
@@ -29,7 +32,9 @@ The record of a run (``decisions/<run>.json``)::
 ``decisions`` holds one item per decision point in the order the run met them (a chain's stages,
 kept and from scratch, in the order they ran): each kind's code of the choice (see its
 ``Codec``), or ``0`` for "the same choice as the decision before"; ``rng`` the generator's state
-(PCG64, hexadecimal) after the decisions at which the planner drew from it.
+(PCG64, hexadecimal) after the decisions at which the planner drew from it; ``left`` what the
+planner left behind that the run reads (door search: the path search it ran, which the path to
+its target reuses), by decision.
 """
 
 from __future__ import annotations
@@ -52,8 +57,8 @@ class ReplayError(Exception):
 
 @dataclass(frozen=True)
 class Codec:
-    """How a kind writes a choice in a few bytes (``encode``: a JSON value) and reads it back
-    (``decode``); ``decode(encode(c))`` is a choice the run takes exactly as it took ``c``."""
+    """How a kind writes a choice in a few bytes (``encode``: a JSON list, or None) and reads it
+    back (``decode``); ``decode(encode(c))`` is a choice the run takes exactly as it took ``c``."""
 
     encode: Callable[[Any], Any]
     decode: Callable[[Any], Any]
@@ -69,7 +74,10 @@ class DecisionPoint:
     (x, y) m; indirect search: the (H, W) cells the robot may stand on); mask : bool, the choices
     legal now (one per candidate, per place, per cell); ask : the seated planner's answer;
     codec : the kind's :class:`Codec`; rng : the run's generator. A choice may also be None: no
-    target (door search: look at the unread walls; object search: nothing left to look at)."""
+    target (door search: look at the unread walls; object search: nothing left to look at).
+    keep, restore : what a planner leaves behind that the run goes on to read besides its choice
+    and the generator (door search: the path search it ran, which the path to its target reuses),
+    as a JSON list (or None), and how a replay puts it back."""
 
     kind: str
     observation: Any
@@ -78,6 +86,8 @@ class DecisionPoint:
     ask: Callable[[], Any]
     codec: Codec
     rng: np.random.Generator
+    keep: Callable[[], Any] | None = None  # what the planner left behind that the run reads (JSON list or None)
+    restore: Callable[[Any], None] | None = None  # put it back in a replay
 
     def encode(self, choice) -> Any:
         return self.codec.encode(choice)
@@ -118,6 +128,7 @@ class Recording(Seat):
     def __init__(self):
         self.items: list = []
         self.rng: dict[str, str] = {}
+        self.left: dict[str, list] = {}
         self.seats: dict[str, dict] = {}
         self._last = None
 
@@ -130,18 +141,24 @@ class Recording(Seat):
         before = rng_word(point.rng)
         choice = point.ask()
         code = point.encode(choice)
+        if code is not None and not isinstance(code, list):  # 0 stands for "the same again"
+            raise TypeError(f"the {point.kind} codec wrote {code!r}: a choice's code is a JSON list, or None")
+        left = point.keep() if point.keep is not None else None
+        json.dumps([code, left], allow_nan=False)  # a code that no record could hold fails its run, not the batch
         after = rng_word(point.rng)
         k = len(self.items)
         self.items.append(SAME if k and code == self._last else code)
         self._last = code
         if after != before:
             self.rng[str(k)] = after
+        if left is not None:
+            self.left[str(k)] = left
         return choice
 
     def record(self, kind: str) -> dict:
         """The run's record (without its identity, which the runner adds)."""
         return {"format": FORMAT, "version": VERSION, "kind": kind, "seats": self.seats, "decisions": self.items,
-                "rng": self.rng}
+                "rng": self.rng, "left": self.left}
 
 
 @dataclass
@@ -166,6 +183,7 @@ class Replay(Seat):
         check_record(record)
         self.items = list(record["decisions"])
         self.rng = {int(k): v for k, v in record.get("rng", {}).items()}
+        self.left = {int(k): v for k, v in record.get("left", {}).items()}
         self.seats = record.get("seats", {})
         self.k = 0
         self._last = None
@@ -185,6 +203,15 @@ class Replay(Seat):
             choice = point.decode(item)
         except (TypeError, ValueError, IndexError, KeyError) as exc:
             raise ReplayError(f"decision {self.k + 1}: {json.dumps(item)[:60]} is not a {point.kind} choice ({exc})") from None
+        if self.k in self.left:
+            if point.restore is None:
+                raise ReplayError(f"decision {self.k + 1}: the record keeps what the planner left behind, and a {point.kind} "
+                                  "decision has nothing to put back")
+            try:
+                point.restore(self.left[self.k])
+            except (TypeError, ValueError, IndexError, KeyError) as exc:
+                raise ReplayError(f"decision {self.k + 1}: {json.dumps(self.left[self.k])[:60]} does not put back what the "
+                                  f"planner left ({exc})") from None
         if self.k in self.rng:
             set_rng(point.rng, self.rng[self.k])
         self._last = item
@@ -202,9 +229,16 @@ def check_record(record) -> None:
         raise ReplayError(f"not a decisions record (no \"format\": \"{FORMAT}\")")
     if record.get("version") != VERSION:
         raise ReplayError(f"a decisions record of version {record.get('version')!r}; this semsearch reads version {VERSION}")
-    if not isinstance(record.get("decisions"), list) or not isinstance(record.get("rng", {}), dict) \
-            or not isinstance(record.get("seats", {}), dict):
-        raise ReplayError("a decisions record holds a list \"decisions\" and the objects \"rng\" and \"seats\"")
+    maps = {k: record.get(k, {}) for k in ("rng", "left", "seats")}
+    if not isinstance(record.get("decisions"), list) or not all(isinstance(m, dict) for m in maps.values()):
+        raise ReplayError("a decisions record holds a list \"decisions\" and the objects \"rng\", \"left\" and \"seats\"")
+    for name in ("rng", "left"):
+        bad = next((k for k in maps[name] if not (isinstance(k, str) and k.isascii() and k.isdigit() and len(k) <= 9)), None)
+        if bad is not None:
+            raise ReplayError(f"\"{name}\" is keyed by decision numbers (0, 1, ...), not {str(bad)[:20]!r}")
+    bad = next((k for k, v in maps["seats"].items() if not isinstance(v, dict)), None)
+    if bad is not None:
+        raise ReplayError(f"\"seats\" maps each planner to its attributes (an object), not {str(maps['seats'][bad])[:20]!r}")
 
 
 # ---- the generator's state ------------------------------------------------------------------------
@@ -222,5 +256,5 @@ def set_rng(rng: np.random.Generator, word: str) -> None:
         s = rng.bit_generator.state
         s["state"]["state"], s["has_uint32"], s["uinteger"] = int(state, 16), int(has), int(u, 16)
         rng.bit_generator.state = s
-    except (AttributeError, ValueError, TypeError, KeyError) as exc:
+    except (AttributeError, ValueError, TypeError, KeyError, OverflowError) as exc:
         raise ReplayError(f"a generator state {str(word)[:40]!r} that does not read ({exc})") from None

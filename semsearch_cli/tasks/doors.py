@@ -28,7 +28,7 @@ from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
 from ..world.buildings.demo import write_demo
-from .base import Event, Observer, Outcome, RobotState, Task, checked_cell, register_task
+from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_cell, register_task
 from .decisions import Codec, DecisionPoint, ask
 from .loop import run_loop
 
@@ -205,9 +205,33 @@ class DoorSearch(DoorSensing):
         return self.sweep(st, ctx)
 
     def point(self, ctx, cands) -> DecisionPoint:
-        """The decision: a target among ``cands`` (every one legal), or None."""
+        """The decision: a target among ``cands`` (every one legal), or None. What the planner
+        leaves behind that the run reads: the last path search it ran over the belief from the
+        robot's cell (the path to the target reuses it; :meth:`searched`, :meth:`search_again`)."""
         return DecisionPoint("doors", ctx, cands, np.ones(len(cands), bool), lambda: self.planner.choose(ctx, cands),
-                             DOOR_CODEC, self.rng)
+                             DOOR_CODEC, self.rng, keep=lambda: self.searched(ctx, cands),
+                             restore=lambda left: self.search_again(ctx, cands, left))
+
+    @staticmethod
+    def searched(ctx, cands) -> list | None:
+        """The search the planner left in the belief, if the path to its target may reuse it
+        (from the robot's cell, on the current maps): ``[n_stop]`` over the candidates, or
+        ``[n_stop, rows, cols]`` over other cells; None when there is none."""
+        b = ctx.belief
+        last = b.last_search
+        if last is None or b._search_key != (ctx.row, ctx.col, b.version) or last[:3] != b._search_key:
+            return None
+        _, _, _, rows, cols, n_stop = last
+        if np.array_equal(rows, cands.rows) and np.array_equal(cols, cands.cols):
+            return [int(n_stop)]
+        return [int(n_stop), [int(v) for v in rows], [int(v) for v in cols]]
+
+    @staticmethod
+    def search_again(ctx, cands, left) -> None:
+        """Run again the search :meth:`searched` recorded (a replay: the planner that ran it is absent)."""
+        n_stop, *cells = left
+        rows, cols = (cands.rows, cands.cols) if not cells else (np.asarray(cells[0], np.int64), np.asarray(cells[1], np.int64))
+        ctx.belief.search(ctx.row, ctx.col, rows, cols, int(n_stop))
 
     def prepare(self, st):
         """The first half of a re-plan: at a wall face the robot came to look at, look all round;
@@ -334,7 +358,7 @@ def read_position(belief: DoorBelief, goal) -> tuple[float, float] | None:
 
 
 @register_task
-class DoorTask(Task):
+class DoorTask(OnMapTask):
     """Door search: goals are door numbers; the shortest path of each is the ground-truth geodesic
     to the nearest pose that reads its sign."""
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
@@ -35,7 +36,7 @@ from ..kernels.raycast import line_of_sight
 from ..planners import Goal, IndirectContext, Variant
 from ..sensors.indirect import SemanticCamera, YawMemory
 from ..world.rooms import OBJECT_GAP, WALL_MARGIN, Room, estimate_relations, generate_rooms, read_rooms
-from .base import Event, Observer, Outcome, RobotState, Task, checked_point, register_task
+from .base import Event, Observer, Outcome, RobotState, RunResult, Task, checked_point, register_task
 from .episodes import Episode, check_hash, draw_starts, given_episodes, label_words
 from .decisions import Codec, DecisionPoint, ask
 from .loop import run_loop
@@ -126,6 +127,18 @@ class RoomGrid:
         xs, ys = np.asarray(xs, float), np.asarray(ys, float)
         xs[0], ys[0], xs[-1], ys[-1] = x, y, tx, ty
         return xs, ys
+
+
+@dataclass
+class Rooms:
+    """The world of indirect search: its rooms, each on the probability map's grid (one size)."""
+
+    grids: list[RoomGrid]
+    training: list[Room] | None = None  # indirect.learned's rooms, drawn as the test rooms, where relations are learned
+
+    @property
+    def rooms(self) -> list[Room]:
+        return [g.room for g in self.grids]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -296,7 +309,9 @@ class IndirectSearch:
                               spec.replan_every, self.rng, dict(self.seen), set(self.latest),
                               np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
                               self.task.cooccurrence)
-        goal = yield DecisionPoint("indirect", ctx, g.stand, g.stand, lambda: self.planner.plan(ctx), INDIRECT_CODEC, self.rng)
+        stand = g.stand.view()
+        stand.flags.writeable = False  # the room's own cells: a driver reads them, never writes
+        goal = yield DecisionPoint("indirect", ctx, stand, stand, lambda: self.planner.plan(ctx), INDIRECT_CODEC, self.rng)
         checked_point(self.planner.name, goal.x, goal.y, g.frame, goal.heading)
         goal = Goal(float(goal.x), float(goal.y), None if goal.heading is None else float(goal.heading), goal.info)
         self.frames_since_plan = 0
@@ -391,6 +406,7 @@ class IndirectTask(Task):
     planner_kind = "indirect"
     noun = "a target object in a room, through the secondary objects that co-occur with it"
     records = ("room", "time_s", "soft_spl", "left_m")
+    columns = ("room", "time_s")
 
     @classmethod
     def example(cls, folder, planner):
@@ -406,7 +422,7 @@ class IndirectTask(Task):
         super().__init__(sc, world, path)
         self.spec = sc.indirect
         self.camera = SemanticCamera(self.spec.camera)
-        self.grids: list[RoomGrid] = []
+        self.grids: list[RoomGrid] = world.grids
         self._masks: dict = {}
         self._cones: dict = {}
         self._views: dict = {}  # (room, scale) -> path length field to the cells that see A
@@ -426,41 +442,51 @@ class IndirectTask(Task):
         return int(H * W * (150 + 64 * len(self.spec.secondary)))
 
     @classmethod
-    def build(cls, sc, world, path):
-        task = cls(sc, world, path)
-        spec = task.spec
+    def build_world(cls, sc, base, file: str) -> "Rooms":
+        """The rooms of the scenario (read from its rooms file, or generated), each on the
+        probability map's grid, checked: one size, a grid a search can hold, divisible by
+        ``coarse``."""
+        spec = sc.indirect
         field = "indirect.rooms"
-        check_classes(spec, task.file)
+        check_classes(spec, file)
         if isinstance(spec.rooms, str):
-            rooms = read_rooms(task.path.parent / spec.rooms, spec.target, spec.secondary)
+            rooms = read_rooms(Path(base) / spec.rooms, spec.target, spec.secondary)
         else:
             g = spec.rooms
-            rooms = _generated(spec, task.file, "indirect.rooms.size", g.count, g.seed, g.size, g.obstacles)
+            rooms = _generated(spec, file, "indirect.rooms.size", g.count, g.seed, g.size, g.obstacles)
+        training = None
         if spec.learned is not None:  # training rooms of the test rooms' size (a rooms file's, or rooms.size)
             where = "indirect.rooms.size" if not isinstance(spec.rooms, str) else "indirect.learned"
-            training = _generated(spec, task.file, where, spec.learned.rooms, spec.learned.seed, rooms[0].size, 0,
+            training = _generated(spec, file, where, spec.learned.rooms, spec.learned.seed, rooms[0].size, 0,
                                   "a training room of indirect.learned: ")
-            task.believe(estimate_relations(training, spec.target, spec.secondary, spec.masks))
         if spec.ablation == "no_secondary":
             for r in rooms:
                 r.objects = {spec.target: r.objects[spec.target]}
         w, h = rooms[0].size
         cells = math.ceil(w / spec.resolution) * math.ceil(h / spec.resolution)
         if cells > MAX_ROOM_CELLS:
-            raise ScenarioError(task.file, "indirect.resolution", f"rooms of {w:g} x {h:g} m at {spec.resolution:g} m "
+            raise ScenarioError(file, "indirect.resolution", f"rooms of {w:g} x {h:g} m at {spec.resolution:g} m "
                                 f"cells are {cells:,} cells, more than the {MAX_ROOM_CELLS:,} a search holds in memory"
                                 "; take coarser cells or smaller rooms")
         try:
             bodies = spec.camera.diameters if spec.objects_block else None
-            task.grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius, bodies) for r in rooms]
+            grids = [RoomGrid.of(r, spec.resolution, spec.robot.radius, bodies) for r in rooms]
         except ValueError as exc:
-            raise ScenarioError(task.file, field, str(exc)) from None
-        if len({g.stand.shape for g in task.grids}) > 1:
-            raise ScenarioError(task.file, field, "the rooms differ in size; give rooms of one size")
-        H, W = task.grids[0].stand.shape
+            raise ScenarioError(file, field, str(exc)) from None
+        if len({g.stand.shape for g in grids}) > 1:
+            raise ScenarioError(file, field, "the rooms differ in size; give rooms of one size")
+        H, W = grids[0].stand.shape
         if H % spec.coarse or W % spec.coarse:
-            raise ScenarioError(task.file, "indirect.coarse", f"the map ({H} x {W} cells) must divide by coarse = "
+            raise ScenarioError(file, "indirect.coarse", f"the map ({H} x {W} cells) must divide by coarse = "
                                 f"{spec.coarse}; change the resolution or set coarse: 1")
+        return Rooms(grids, training)
+
+    @classmethod
+    def build(cls, sc, world, path):
+        task = cls(sc, world, path)
+        spec = task.spec
+        if world.training is not None:  # the co-occurrences the robot believes, learned in the training rooms
+            task.believe(estimate_relations(world.training, spec.target, spec.secondary, spec.masks))
         task.relations = {c: task.masks_for("soft")[c].full for c in spec.secondary}
         task.variants()
         return task
@@ -541,6 +567,10 @@ class IndirectTask(Task):
     # ---- episodes ---------------------------------------------------------------------------
     def room_name(self, ep: Episode) -> str:
         return self.grids[ep.room].room.name
+
+    def record(self, ep: Episode, res: RunResult) -> dict:
+        """The room searched and the simulated time (s) the search took."""
+        return {"room": self.room_name(ep), "time_s": round(res.time_s, 2) if res.time_s == res.time_s else ""}
 
     def episode_row(self, ep: Episode) -> dict:
         return ep.row() | {"room": self.room_name(ep)}

@@ -49,7 +49,7 @@ from ..navigation import KnownMap
 from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..world.buildings.office import office_image, office_scenario
-from .base import Event, Observer, Outcome, RobotState, Task, checked_point, register_task
+from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_point, register_task
 from .decisions import Codec, DecisionPoint, ask
 from .loop import run_loop
 from ..files import read_user_text, temp_path, user_file
@@ -264,7 +264,7 @@ class Patrol(ObjectSearch):
 
 
 @register_task
-class ObjectTask(Task):
+class ObjectTask(OnMapTask):
     """Everything an object-search scenario asks, checked against the world. Goals are request
     labels (``Static.mug@12``); each case's detection log is recorded (or read) once, when the
     task is built."""

@@ -15,7 +15,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..config import DoorSpec, OnMap, Scenario, read_yaml
+from ..config import DoorSpec, OnMap, Scenario, SignSections, read_yaml
 from ..config.base import label_column, number_text
 from ..errors import ScenarioError
 from ..files import read_user_text
@@ -266,9 +266,10 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
     extent = (f"the map spans x {origin[0]:g} to {origin[0] + W * res:g} m and y {origin[1]:g} to {origin[1] + H * res:g} m "
               f"({W} x {H} cells of {res:g} m" + (", map.resolution" if sc.map.image is not None else "") + ")")
 
-    doors = read_doors(base / sc.doors, owner=file) if isinstance(sc.doors, str) else list(sc.doors)
-    dfile = str(base / sc.doors) if isinstance(sc.doors, str) else file
-    doors, duplicates = apply_duplicates(doors, sc.duplicates, dfile)
+    signed = sc if isinstance(sc, SignSections) else SignSections()  # a kind that reads no signs: none
+    doors = read_doors(base / signed.doors, owner=file) if isinstance(signed.doors, str) else list(signed.doors)
+    dfile = str(base / signed.doors) if isinstance(signed.doors, str) else file
+    doors, duplicates = apply_duplicates(doors, signed.duplicates, dfile)
     labels = [d.number for d in doors]
     signs = Signs(
         number=tuple(labels),
@@ -278,8 +279,8 @@ def build_world(sc: Scenario, base: Path, file: str) -> World | None:
         facing=np.radians(np.array([d.facing for d in doors], np.float64)),
     )
     heading = None if sc.start.heading == "random" else float(np.radians(sc.start.heading))
-    world = World(frame, free, signs, (sc.start.x, sc.start.y), heading, sc.robot.radius, sc.door_camera.range,
-                  float(np.radians(sc.door_camera.fov)), duplicates)
+    world = World(frame, free, signs, (sc.start.x, sc.start.y), heading, sc.robot.radius, signed.door_camera.range,
+                  float(np.radians(signed.door_camera.fov)), duplicates)
     # every sign must sit next to free space, and the start where the robot fits
     r, c = frame.to_index(signs.x, signs.y)
     pad = np.pad(free, 2)
