@@ -27,7 +27,7 @@ from .report import build as report_build
 from .report.document import atomic_text, markdown_table
 from .report.figures.distances import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
-from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows
+from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows, workers_for
 from .runner.verify import Verdict, verify_folder
 from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
@@ -113,12 +113,13 @@ class VerifyOutput:
     verdict: Verdict
 
 
-def verify(folder: str | Path, scenario: str | Path | None = None, progress=None) -> VerifyOutput:
+def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None) -> VerifyOutput:
     """Replay every run of a results folder that has a decisions record (``run --decisions``)
     from its decisions alone, no planner built, and check outcome, distance and steps against its
     rows (:mod:`semsearch_cli.runner.verify`). ``scenario``: the scenario the rows were made with
     (default: the one meta.json names, with the parameter a sweep set in that folder); its
-    planners' files are not needed."""
+    planners' files are not needed. ``workers``: replaying processes (None: the CPU count, at
+    most 4; the verdict does not depend on it)."""
     folder = Path(folder)
     if not (folder / "runs.csv").is_file():
         raise ScenarioError(str(folder), "", "no runs.csv here: give a folder written by `semsearch run`")
@@ -136,7 +137,7 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
         loaded = Loaded.load(path, with_param(read_yaml(path), varied["param"], varied.get("value"), path), planners=False)
     else:
         loaded = Loaded.load(path, planners=False)
-    verdict = verify_folder(folder, loaded, progress)
+    verdict = verify_folder(folder, loaded, progress, workers_for(workers))
     if not verdict.verified and not verdict.failed:
         raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "
                             "batch with --decisions (the runs already done are not recorded again; run them into a fresh "

@@ -356,13 +356,14 @@ def verify(
     folder: Path = typer.Argument(..., help="A results folder (runs.csv, and decisions/ from `semsearch run --decisions`)."),
     scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the rows were made with (default: the one "
                                             "meta.json names)."),
+    workers: Optional[int] = WORKERS,
 ):
     """Replay every run of a results folder that has its decisions (`semsearch run --decisions`),
     without its planner, and check its outcome, distance, steps and decisions exactly: each run
     that does not replay is named, and the status is 1."""
 
     try:
-        res = api.verify(folder, scenario)
+        res = api.verify(folder, scenario, workers=workers)
     except ScenarioError as exc:
         _fail(exc)
     v = res.verdict

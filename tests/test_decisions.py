@@ -75,6 +75,18 @@ def test_a_path_that_reuses_the_planners_search_replays(tmp_path):
     assert (verdict.verified, verdict.failed) == (2, [])
 
 
+def test_the_verdict_is_the_same_in_one_process_or_two(recorded, tmp_path):
+    folder = tmp_path / "demo"
+    shutil.copytree(recorded["demo"][0], folder)
+    f = folder / "decisions" / "nsos_alpha0.9__goal304__ep0__seed1.json"
+    d = json.loads(f.read_text())
+    d["decisions"][0] = [1, 1]  # a wall: the replay stops there
+    f.write_text(json.dumps(d))
+    loaded = Loaded.load(recorded["demo"][1].path, planners=False)
+    one, two = verify_folder(folder, loaded, workers=1), verify_folder(folder, loaded, workers=2)
+    assert one == two and one.verified == 19 and [n for n, _ in one.failed] == ["nsos[alpha=0.9] goal 304 episode 0 seed 1"]
+
+
 def test_a_decision_costs_a_few_bytes(recorded):
     folder, _ = recorded["hospital"]
     sizes = []

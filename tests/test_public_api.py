@@ -37,7 +37,7 @@ API = {
     "scenarios": [],
     "default_out": ["loaded", "out"],
     "init": ["name", "folder", "force"],
-    "verify": ["folder", "scenario", "progress"],
+    "verify": ["folder", "scenario", "progress", "workers"],
     "presence": ["counts", "hours", "out"],
     "generate_building": ["layout", "numbering", "seed", "out", "spacing", "signs", "goals", "name", "scale"],
     "generate_batch": ["out", "seeds", "runs", "layouts", "schemes"],

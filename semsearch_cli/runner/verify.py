@@ -11,11 +11,13 @@ names the run."""
 from __future__ import annotations
 
 import math
+import multiprocessing as mp
 import numbers
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import pandas as pd
 
 from ..errors import PlannerError, ScenarioError
 from ..planners import Variant
@@ -49,10 +51,11 @@ def _same(a, b) -> bool:
     return str(a) == str(b)
 
 
-def verify_folder(folder: Path, loaded: Loaded, progress=None) -> Verdict:
+def verify_folder(folder: Path, loaded: Loaded, progress=None, workers: int = 1) -> Verdict:
     """Replay every run of ``folder/runs.csv`` that has a decisions record, on ``loaded`` (the
-    scenario the rows were made with: their fingerprint must be its own); ``progress(done,
-    total)`` after each run."""
+    scenario the rows were made with: their fingerprint must be its own), in ``workers``
+    processes (the verdict is the same whatever their number); ``progress(done, total)`` after
+    each run."""
     rows = read_runs(Path(folder) / "runs.csv", as_written=True)
     if not len(rows):
         raise ScenarioError(str(Path(folder) / "runs.csv"), "", "holds no rows to verify")
@@ -63,11 +66,10 @@ def verify_folder(folder: Path, loaded: Loaded, progress=None) -> Verdict:
         raise ScenarioError(str(loaded.path), "fingerprint", f"{int(other.sum())} of the {len(own)} runs were made with another "
                             f"scenario (fingerprint {own.loc[other, 'fingerprint'].iloc[0]}, this one's {fp}): give the "
                             "scenario they were made with (--scenario)")
-    task = loaded.task
-    episodes = {(str(e.goal), e.index): e for e in task.episodes}
     verdict = Verdict(runs=len(own))
+    jobs = []  # (name, decisions file, planner, goal, episode, seed, the run's rows as written)
     by_run = rows.groupby(["planner", "goal", "episode", "seed"], sort=False, dropna=False)
-    for n, ((planner, goal, episode, seed), group) in enumerate(by_run, 1):
+    for (planner, goal, episode, seed), group in by_run:
         name = run_name(planner, goal, episode, seed)
         whole = [v for v in (episode, seed) if isinstance(v, numbers.Integral) or (isinstance(v, float) and v.is_integer())]
         if len(whole) < 2 or not all(0 <= v < 10**9 for v in whole):
@@ -76,18 +78,48 @@ def verify_folder(folder: Path, loaded: Loaded, progress=None) -> Verdict:
         f = Path(folder) / "decisions" / f"{file_stem(str(planner), goal, int(seed), int(episode))}.json"
         if not f.is_file():
             verdict.unrecorded += 1
-        else:
-            why = _replay(task, f, str(planner), str(goal), int(episode), int(seed), group, episodes)
+            continue
+        jobs.append((name, f, str(planner), str(goal), int(episode), int(seed), group.to_dict("records")))
+    done = verdict.runs - len(jobs)
+    with _pool(loaded, min(workers, len(jobs))) as pool:
+        for (name, *_), why in zip(jobs, pool.map(_job, jobs) if pool is not None else map(_job, jobs)):
             if why:
                 verdict.failed.append((name, why))
             else:
                 verdict.verified += 1
-        if progress:
-            progress(n, verdict.runs)
+            done += 1
+            if progress:
+                progress(done, verdict.runs)
     return verdict
 
 
-def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, group: pd.DataFrame, episodes: dict) -> str:
+_TASK: list = []  # the task a process replays on: (task, its episodes by (goal, index))
+
+
+def _seat(loaded: Loaded) -> None:
+    task = loaded.task
+    _TASK[:] = [(task, {(str(e.goal), e.index): e for e in task.episodes})]
+
+
+@contextmanager
+def _pool(loaded: Loaded, workers: int):
+    """None (replay here) for one worker, else a process pool whose workers hold ``loaded``."""
+    _seat(loaded)
+    if workers <= 1:
+        yield None
+        return
+    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_seat, initargs=(loaded,)) as pool:
+        yield pool
+
+
+def _job(job) -> str:
+    name, f, planner, goal, episode, seed, rows = job
+    task, episodes = _TASK[0]
+    return _replay(task, f, planner, goal, episode, seed, rows, episodes)
+
+
+def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, want: list[dict], episodes: dict) -> str:
     """Why the run's replay does not give its rows, or "" when it does."""
     try:
         record = read_decisions(f)
@@ -111,7 +143,6 @@ def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, gro
     if res.outcome == "error":  # pragma: no cover - a replay raises rather than records
         return f"the replay ended in an error: {res.message}"
     got = task.rows(variant, ep, seed, res)
-    want = group.to_dict("records")
     if len(got) != len(want):
         return f"the replay gives {len(got)} rows, the folder holds {len(want)}"
     for g, w in zip(got, want):
