@@ -137,6 +137,9 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
         loaded = Loaded.load(path, with_param(read_yaml(path), varied["param"], varied.get("value"), path), planners=False)
     else:
         loaded = Loaded.load(path, planners=False)
+    cpus = os.cpu_count() or 1
+    if workers is not None and workers > cpus:
+        raise ScenarioError("<command line>", "--workers", f"{workers} replaying processes on {cpus} CPUs: at most {cpus}")
     verdict = verify_folder(folder, loaded, progress, workers_for(workers))
     if not verdict.verified and not verdict.failed:
         raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "

@@ -356,7 +356,8 @@ def verify(
     folder: Path = typer.Argument(..., help="A results folder (runs.csv, and decisions/ from `semsearch run --decisions`)."),
     scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the rows were made with (default: the one "
                                             "meta.json names)."),
-    workers: Optional[int] = WORKERS,
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Replaying processes (default: the CPU count, at "
+                                          "most 4; at most the CPU count). The verdict does not depend on it."),
 ):
     """Replay every run of a results folder that has its decisions (`semsearch run --decisions`),
     without its planner, and check its outcome, distance, steps and decisions exactly: each run
@@ -680,6 +681,16 @@ def _stopped(exc: BaseException) -> tuple[str, int]:
     return f"stopped: {exc}", getattr(exc, "status", 1)
 
 
+PACKAGE = str(Path(__file__).resolve().parent)  # semsearch's own files: a warning raised in them is shown without its line
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on standard error: its category and message, and where it was raised
+    when that is the user's code (a planner file written against an older API), not semsearch's."""
+    where = "" if str(Path(filename).resolve()).startswith(PACKAGE) else f"{filename}:{lineno}: "
+    err.print(f"{where}{category.__name__}: {message}", highlight=False, soft_wrap=True)
+
+
 def main() -> None:
     """The command line. Faults end with one paragraph and a status, never a traceback: Ctrl-C
     (130), SIGTERM (143), a batch stopped by a dead worker (1), a full disk (1)."""
@@ -688,6 +699,7 @@ def main() -> None:
     # semsearch's own deprecations (a user's planner written against an older API) are shown: the
     # user's code is what must change, and Python hides DeprecationWarning outside __main__
     warnings.filterwarnings("default", category=DeprecationWarning, message=".*deprecated since semsearch")
+    warnings.showwarning = _show_warning
     resume = "finished runs are kept in runs.csv; run the same command again to resume"
     if "stdout" in CLOSED:
         err.print("error: standard output is closed (>&-); give it a file, or /dev/null to discard what semsearch prints",

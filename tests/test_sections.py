@@ -4,6 +4,8 @@ alone. A section a kind does not take is refused, naming it; a section a kind to
 without using it is ignored with a DeprecationWarning, and the scenario's fingerprint is the one
 0.2.0 gave (a results folder of 0.2.0 resumes)."""
 
+import subprocess
+import sys
 import warnings
 
 import pytest
@@ -59,3 +61,14 @@ def test_a_section_the_kind_does_not_take_is_refused_naming_it(kind, section, va
     with pytest.raises(ScenarioError) as err:
         load_scenario(path)
     assert err.value.field == section and f"a {kind} scenario does not take {section}" in err.value.message
+
+
+def test_the_command_line_shows_the_warning_on_one_line_naming_the_file(tmp_path):
+    path = api.init("indirect_quick", tmp_path / "copy")[0]
+    path.write_text(path.read_text() + "laser:\n  range: 6.0\n")
+    res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "validate", str(path)],
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    line = next(ln for ln in res.stderr.splitlines() if "laser" in ln)
+    assert line.startswith("DeprecationWarning: the laser section of a scenario of kind indirect (") and str(path) in line
+    assert "specs.py" not in res.stderr  # semsearch's own line is not the user's business
