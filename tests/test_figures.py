@@ -14,10 +14,14 @@ from typer.testing import CliRunner
 
 from semsearch_cli.cli import app
 from semsearch_cli.metrics import COLUMNS
+from semsearch_cli.planners import Variant
 from semsearch_cli.report import plots, stats
 from semsearch_cli.report import tables as T
+from semsearch_cli.report.figures import indirect as fig_indirect
 from semsearch_cli.report.plots import PALETTE, budget_curve, image_formats, swept_values, planner_colors, thin_boxes
 from semsearch_cli.report.runfiles import load_paths, median_label, median_panel, stems
+from semsearch_cli.runner import Loaded
+from semsearch_cli.tasks import FrameRecorder
 from semsearch_cli.world.ground_truth import Signs
 
 MAGIC = {"png": b"\x89PNG", "pdf": b"%PDF", "svg": b"<?xml"}
@@ -359,3 +363,17 @@ def test_the_scenario_figure_writes_no_number_under_a_goal_star(demo_loaded, dra
     assert {"goal 304", "goal 452"} <= set(words) and "304" not in words and "452" not in words
     assert len(words) == len(w.signs) - 2 + 2  # every other number is shown
     assert overlapping(texts, fig.canvas.get_renderer()) == []
+
+
+def test_the_indirect_replay_has_a_key(monkeypatch, tmp_path):
+    """The probability replay says what its marks are (the robot's dot, the goal's cross, A's ring)."""
+
+    L = Loaded.load(Path(__file__).resolve().parents[1] / "configs" / "indirect_quick.yaml")
+    rec = FrameRecorder()
+    L.task.run(Variant("ISCG-PN-SM", ()), L.task.episodes[0], 0, rec)
+    figs = []
+    monkeypatch.setattr(fig_indirect, "_animate", lambda fig, draw, n, out, fps: (draw(n - 1), figs.append(fig)))
+    fig_indirect.animate_probability(L.task.grids[0].room, L.task.spec.target, rec.frames, "t", tmp_path / "r.gif")
+    labels = [t.get_text() for t in figs[0].legends[0].get_texts()]
+    assert labels == ["path", "robot", "objects seen", "goal", "A, the target"]
+    plt.close(figs[0])

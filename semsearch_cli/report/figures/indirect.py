@@ -99,8 +99,15 @@ def animate_probability(room, target: str, frames: list, title: str, out: Path, 
     each frame scaled to its own maximum), the path so far, the secondary objects seen, the goal;
     A itself ringed."""
     w, h = room.size
-    fig, ax = plt.subplots(figsize=(COLUMN_IN, COLUMN_IN * h / w + 0.35), layout="constrained")
+    fig, ax = plt.subplots(figsize=(COLUMN_IN, COLUMN_IN * h / w + 0.55), layout="constrained")
     target = room.objects[target]
+    key = [Line2D([], [], c=PALETTE[5], lw=1, label="path"),
+           Line2D([], [], ls="", marker="o", ms=5, c=PALETTE[2], mec="black", label="robot"),
+           Line2D([], [], ls="", marker="s", ms=5, c=PALETTE[4], label="objects seen"),
+           Line2D([], [], ls="", marker="x", ms=6, mew=1.8, c="black", label="goal"),
+           Line2D([], [], ls="", marker="o", ms=8, mfc="none", mec=GOAL_COLOR, mew=1.8, label="A, the target")]
+    fig.legend(handles=key, loc="outside lower center", ncol=5, fontsize=6.5, handlelength=1.0, columnspacing=0.7,
+               handletextpad=0.3)
 
     def draw(k):
         ax.clear()
