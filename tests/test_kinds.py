@@ -9,9 +9,11 @@ import yaml
 
 from semsearch_cli.config import KINDS, OnMap, Scenario, kind_of, parse_scenario, register_kind
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.planners import PLANNERS, DoorPlanner, Planner, register_planner
+from semsearch_cli.metrics import BUILT_IN_KIND_COLUMNS, COLUMNS, SHARED
+from semsearch_cli.planners import PLANNERS, DoorPlanner, Planner, Variant, register_planner
 from semsearch_cli.report import build  # noqa: F401  (registers every kind's report section)
 from semsearch_cli.report.sections import SECTIONS, Section, register_section
+from semsearch_cli.runner import Loaded
 from semsearch_cli.tasks import TASKS, Task, register_task
 
 
@@ -68,3 +70,14 @@ def test_the_registries_refuse_duplicates_and_wrong_base_classes():
     with pytest.raises(TypeError):
         register_section({"kind": "cats"})
     assert "cats" not in KINDS and "not-a-planner" not in PLANNERS and "no-kind" not in PLANNERS
+
+
+def test_the_shared_columns_and_the_kinds_own_add_up_to_the_rows(tmp_path):
+    """metrics.SHARED is what run_row writes (the batch adds fingerprint and code), and the 0.2.0
+    columns beyond it are exactly the built-in kinds' own (Task.columns)."""
+    own = {c for t in TASKS.values() if t.__module__.startswith("semsearch_cli.") for c in t.columns}
+    assert own == set(BUILT_IN_KIND_COLUMNS) and set(SHARED) | own == set(COLUMNS)
+    loaded = Loaded.load(TASKS["doors"].example(tmp_path / "d", "greedy"))
+    rows = loaded.task.rows(Variant("greedy", ()), loaded.task.episodes[0], 0,
+                            loaded.task.run(Variant("greedy", ()), loaded.task.episodes[0], 0))
+    assert set(rows[0]) == set(SHARED) - {"fingerprint", "code"}

@@ -150,8 +150,8 @@ class DoorBelief:
         self.search_state = GridSearch((H, W))
         self.version = 0  # bumped whenever passable/cost change
         self.lost = 0  # cells that were free and are no longer (a wall seen where the map had free space)
-        self._search_key = None
-        self.last_search = None  # (r, c, version, t_rows, t_cols, n_stop) of the search search_state holds
+        self._search_key = None  # (r, c, version) of the search search_state holds
+        self._search_of = None  # its (target rows, target cols, n_stop)
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
@@ -447,7 +447,7 @@ class DoorBelief:
         n += set_joins(passable, mask, np.array([r], np.int64), np.array([c], np.int64), rad, self._joins[n:])
         gs = self.search_state
         self._search_key = (r, c, self.version)
-        self.last_search = (r, c, self.version, t_rows, t_cols, n_stop)
+        self._search_of = (t_rows, t_cols, n_stop)
         try:
             settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop)
         finally:
@@ -455,6 +455,12 @@ class DoorBelief:
         if settled < need:
             gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop)
         return gs
+
+    def held_search(self, r: int, c: int):
+        """The search :meth:`path` would reuse from (r, c) on the current maps, as (target rows,
+        target cols, n_stop), or None: what a planner's own search leaves for the path to its
+        target (a decisions record keeps it, so that a replay without the planner runs it again)."""
+        return self._search_of if self._search_key == (r, c, self.version) else None
 
     def path(self, r: int, c: int, tr: int, tc: int):
         """Cheapest path (rows, cols) from (r, c) to (tr, tc), reusing the last search when it

@@ -108,8 +108,7 @@ class Seat:
     def planner(self, variant):
         return variant.build()
 
-    def decide(self, point: DecisionPoint):
-        return point.ask()
+    decide = staticmethod(ask)
 
 
 def run_attributes(planner) -> dict:

@@ -217,11 +217,10 @@ class DoorSearch(DoorSensing):
         """The search the planner left in the belief, if the path to its target may reuse it
         (from the robot's cell, on the current maps): ``[n_stop]`` over the candidates, or
         ``[n_stop, rows, cols]`` over other cells; None when there is none."""
-        b = ctx.belief
-        last = b.last_search
-        if last is None or b._search_key != (ctx.row, ctx.col, b.version) or last[:3] != b._search_key:
+        held = ctx.belief.held_search(ctx.row, ctx.col)
+        if held is None:
             return None
-        _, _, _, rows, cols, n_stop = last
+        rows, cols, n_stop = held
         if np.array_equal(rows, cands.rows) and np.array_equal(cols, cands.cols):
             return [int(n_stop)]
         return [int(n_stop), [int(v) for v in rows], [int(v) for v in cols]]

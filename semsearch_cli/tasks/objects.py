@@ -158,7 +158,7 @@ class ObjectSearch:
             return None
         x, y, info = target
         xy = (float(x), float(y))
-        k = next((k for k, n in enumerate(self.names) if self.task.places[n] == xy), None)
+        k = self.place_at(*xy)
         return ([k] if k is not None else [*xy]) + ([] if info.get("look", True) else [0])
 
     def _decode(self, item):
@@ -175,6 +175,10 @@ class ObjectSearch:
         else:
             x, y = float(item[0]), float(item[1])
         return x, y, {} if len(item) == n else {"look": False}
+
+    def place_at(self, x: float, y: float) -> int | None:
+        """The index of the place at exactly (x, y) m, or None."""
+        return next((k for k, n in enumerate(self.names) if self.task.places[n] == (x, y)), None)
 
     def next_target(self):
         """The planner's answer: its next target, or None when it has none left."""
@@ -234,7 +238,7 @@ class ObjectSearch:
                 continue
             self.look = info.get("look", True)
             if len(p[0]) >= 2:
-                self.place = next((k for k, n in enumerate(self.names) if self.task.places[n] == (x, y)), None)
+                self.place = self.place_at(x, y)
                 self.here = None
                 return self.task.world.frame.to_world(p[0], p[1])
 
