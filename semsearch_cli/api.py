@@ -33,7 +33,7 @@ from .tasks import TASKS
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import check_outputs, inside, output_file, output_folder, temp_path
-from . import shipped
+from . import bench, shipped
 from .shipped import scenario_file
 
 
@@ -109,18 +109,31 @@ def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", 
 @dataclass
 class VerifyOutput:
     folder: Path
-    scenario: Path
+    scenario: Path | str  # the scenario replayed on, or a bench's "SUITE SPLIT (hash ...)"
     verdict: Verdict
 
 
-def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None) -> VerifyOutput:
+def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None,
+           salt_file: str | Path | None = None) -> VerifyOutput:
     """Replay every run of a results folder that has a decisions record (``run --decisions``)
     from its decisions alone, no planner built, and check outcome, distance and steps against its
     rows (:mod:`semsearch_cli.runner.verify`). ``scenario``: the scenario the rows were made with
     (default: the one meta.json names, with the parameter a sweep set in that folder); its
     planners' files are not needed. ``workers``: replaying processes (None: the CPU count, at
-    most 4; the verdict does not depend on it)."""
+    most 4; the verdict does not depend on it). A bench folder (``semsearch bench run``) is verified
+    floor by floor on the suite's own floors (:func:`~semsearch_cli.bench.verify_bench`;
+    ``salt_file`` for a hidden split)."""
     folder = Path(folder)
+    cpus = os.cpu_count() or 1
+    if workers is not None and workers > cpus:
+        raise ScenarioError("<command line>", "--workers", f"{workers} replaying processes on {cpus} CPUs: at most {cpus}")
+    if bench.is_bench(folder):
+        if scenario is not None:
+            raise ScenarioError("<command line>", "--scenario", f"{folder} is a bench folder: its floors are the suite's "
+                                "(bench.json); give --salt-file for a hidden split, never a scenario")
+        return verify_bench(folder, salt_file, progress, workers)
+    if salt_file is not None:
+        raise ScenarioError("<command line>", "--salt-file", f"{folder} is not a bench folder (no bench.json)")
     if not (folder / "runs.csv").is_file():
         raise ScenarioError(str(folder), "", "no runs.csv here: give a folder written by `semsearch run`")
     meta = report_build.read_meta(folder)
@@ -137,9 +150,6 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
         loaded = Loaded.load(path, with_param(read_yaml(path), varied["param"], varied.get("value"), path), planners=False)
     else:
         loaded = Loaded.load(path, planners=False)
-    cpus = os.cpu_count() or 1
-    if workers is not None and workers > cpus:
-        raise ScenarioError("<command line>", "--workers", f"{workers} replaying processes on {cpus} CPUs: at most {cpus}")
     verdict = verify_folder(folder, loaded, progress, workers_for(workers))
     if not verdict.verified and not verdict.failed:
         raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "
@@ -517,3 +527,76 @@ def import_kth(xml_file: str | Path, out: str | Path, **options) -> tuple[Path, 
     """A KTH campus floor plan as a scenario in ``out`` (see
     :func:`~semsearch_cli.world.importers.kth.import_kth`), validated before it is written."""
     return imported(kth.import_kth, out, Path(xml_file), **options)
+
+
+def verify_bench(folder: Path, salt_file=None, progress=None, workers: int | None = None) -> VerifyOutput:
+    """:func:`verify` of a bench folder: the floors' verdicts as one, each run named with its floor."""
+    split, verdicts = bench.verify_bench(folder, salt_file, workers_for(workers), progress)
+    v = Verdict()
+    for fid, fv in verdicts.items():
+        v.runs += fv.runs
+        v.verified += fv.verified
+        v.unrecorded += fv.unrecorded
+        v.failed += [(f"floor {fid}: {name}", why) for name, why in fv.failed]
+    if not v.runs:
+        raise ScenarioError(str(folder), "", "holds no floor with rows to verify")
+    return VerifyOutput(folder, f"{split.suite.name} {split.name}, hash {split.hash[:16]}", v)
+
+
+_PLANNER = re.compile(r"(?P<name>[A-Za-z_][\w.-]*)(?:\[(?P<params>[^\[\]]*)\])?")
+
+
+def planner_spec(text: str, module: str | Path | None = None) -> PlannerSpec:
+    """A planner given on the command line, ``NAME`` or ``NAME[key=value,...]`` (as rows label
+    it: ``nsos[alpha=0.9]``), registered by ``module`` (a user's Python file) when given."""
+    m = _PLANNER.fullmatch(text.strip())
+    if m is None:
+        raise ScenarioError("<command line>", "--planner", f"{text!r}: give NAME or NAME[key=value,...], e.g. nsos[alpha=0.9]")
+    params = {}
+    for item in filter(None, (p.strip() for p in (m["params"] or "").split(","))):
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise ScenarioError("<command line>", "--planner", f"{text!r}: {item!r} is not key=value")
+        params[key.strip()] = yaml.safe_load(value)
+    if module is not None:
+        mod = Path(module)
+        if not mod.is_file():
+            raise ScenarioError(str(mod), "", "no such planner file (--planner-file)")
+        params["module"] = str(mod.resolve())
+    return PlannerSpec(name=m["name"], **params)
+
+
+def bench_run(suite: str, planners: list[str], out: str | Path, split: str = "val", numbering: str = "true",
+              options: BatchOptions = BatchOptions(), limit: int | None = None, salt_file: str | Path | None = None,
+              planner_file: str | Path | None = None, progress=None) -> bench.BenchOutput:
+    """Run planners (``NAME`` or ``NAME[key=value,...]``, :func:`planner_spec`) on a suite's
+    split into ``out`` (:func:`~semsearch_cli.bench.run_bench`)."""
+    if not planners:
+        raise ScenarioError("<command line>", "--planner", "give the planner to run (NAME or NAME[key=value,...])")
+    specs = [planner_spec(p, planner_file) for p in planners]
+    return bench.run_bench(suite, specs, out, split, numbering, options, limit, salt_file, progress)
+
+
+def bench_list() -> list[dict]:
+    """Every suite's splits: kind, floors, goals, episodes, repeats, hash (shipped splits) and the
+    published hash."""
+    rows = []
+    for s in bench.SUITES.values():
+        for split in s.splits:
+            row = {"suite": s.name, "split": split, "kind": s.kind, "repeats": s.repeats, "summary": s.summary,
+                   "published": bench.PUBLISHED.get((s.name, split))}
+            if split in s.hidden:
+                row.update(floors=None, goals=None, episodes=None, hash=None, hidden=True)
+            else:
+                sp = bench.open_split(s.name, split)
+                eps = [pd.read_csv(f.scenario.parent / "episodes.csv", dtype=str, keep_default_na=False) for f in sp.floors]
+                row.update(floors=len(sp.floors), goals=sum(e["goal"].nunique() for e in eps), episodes=sum(len(e) for e in eps),
+                           hash=sp.hash, hidden=False)
+            rows.append(row)
+    return rows
+
+
+def bench_hash(suite: str, split: str = "val", salt_file: str | Path | None = None) -> bench.Split:
+    """A split, built (a hidden one from ``salt_file``) and hashed: its ``hash`` and whether it is
+    the published one (``official``)."""
+    return bench.open_split(suite, split, salt_file)

@@ -358,13 +358,15 @@ def verify(
                                             "meta.json names)."),
     workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Replaying processes (default: the CPU count, at "
                                           "most 4; at most the CPU count). The verdict does not depend on it."),
+    salt_file: Optional[Path] = typer.Option(None, "--salt-file", help="A bench folder of a hidden split: the file holding "
+                                             "its salt (maintainers)."),
 ):
     """Replay every run of a results folder that has its decisions (`semsearch run --decisions`),
     without its planner, and check its outcome, distance, steps and decisions exactly: each run
     that does not replay is named, and the status is 1."""
 
     try:
-        res = api.verify(folder, scenario, workers=workers)
+        res = api.verify(folder, scenario, workers=workers, salt_file=salt_file)
     except ScenarioError as exc:
         _fail(exc)
     v = res.verdict
@@ -373,7 +375,7 @@ def verify(
     skipped = f"; {v.unrecorded} without decisions (not recorded with --decisions, or an error or timeout) not checked" \
         if v.unrecorded else ""
     out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance, steps and "
-              f"decisions recorded{skipped} (scenario {res.scenario})")
+              f"decisions recorded{skipped} ({'suite' if isinstance(res.scenario, str) else 'scenario'} {res.scenario})")
     if v.failed:
         out.print(f"{len(v.failed)} run(s) do not replay")
         raise typer.Exit(1)
@@ -449,6 +451,81 @@ def show(
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {path}")
+
+
+bench_app = typer.Typer(no_args_is_help=True, help="semsearch-bench: frozen suites, runs that verify by replay (docs/bench.md).")
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("list")
+def bench_list():
+    """Every suite and split: its kind, floors (or rooms), goals, episodes, repeats and hash."""
+    try:
+        rows = api.bench_list()
+    except ScenarioError as exc:
+        _fail(exc)
+    t = Table(title="semsearch-bench suites (semsearch bench run SUITE --planner NAME --out DIR)")
+    for col in ("suite", "split", "kind", "floors", "goals", "episodes", "repeats", "hash", "published"):
+        t.add_column(col, overflow="fold", justify="right" if col in ("floors", "goals", "episodes", "repeats") else "left")
+    for r in rows:
+        if r["hidden"]:
+            pub = r["published"][:16] if r["published"] else "none yet (a maintainer's)"
+            t.add_row(r["suite"], r["split"], r["kind"], "hidden", "", "", str(r["repeats"]), "(salt held by the maintainers)", pub)
+        else:
+            mark = "= published" if r["hash"] == r["published"] else "DIFFERS from " + str(r["published"])[:16]
+            t.add_row(r["suite"], r["split"], r["kind"], str(r["floors"]), str(r["goals"]), str(r["episodes"]), str(r["repeats"]),
+                      r["hash"][:16], mark)
+    out.print(t)
+
+
+@bench_app.command("run")
+def bench_run(
+    suite: str = typer.Argument(..., help="A suite's name (semsearch bench list)."),
+    planner: List[str] = typer.Option(..., "--planner", help="NAME or NAME[key=value,...], e.g. nsos[alpha=0.9] (repeatable)."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="The results folder (bench.json, one folder per floor)."),
+    split: str = typer.Option("val", "--split", help="val (shipped) or test (hidden: --salt-file)."),
+    numbering: str = typer.Option("true", "--numbering", help="true, shuffled, parity-flipped or reversed: the floors' labels permuted."),
+    limit: Optional[int] = typer.Option(None, "--limit", min=1, help="Only the first N episodes of the split (a first look)."),
+    planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner(s)."),
+    salt_file: Optional[Path] = typer.Option(None, "--salt-file", help="The salt of a hidden split (maintainers)."),
+    workers: Optional[int] = WORKERS,
+    oversubscribe: bool = OVERSUBSCRIBE,
+    executor: str = EXECUTOR,
+    scheduler: Optional[str] = SCHEDULER,
+):
+    """Run planners on a suite's split: every run recorded with its decisions (semsearch verify
+    DIR replays them), every row with the suite's hash; resumable."""
+    opts = BatchOptions(workers=workers, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler)
+    res = _with_progress(lambda tick: api.bench_run(suite, planner, out_dir, split, numbering, opts, limit, salt_file,
+                                                    planner_file, progress=tick))
+    runs = res.runs[res.runs["stage"] == ""]
+    t = Table(title=f"{res.split.suite.name} {res.split.name}, numbering {res.numbering} ({len(res.floors)} floors; "
+                    f"hash {res.split.hash[:16]}{', official' if res.split.official else ''})")
+    for col in ("planner", "runs", "success", "SPL", "mean distance m"):
+        t.add_column(col, justify="left" if col == "planner" else "right")
+    for label, g in runs.groupby("planner", sort=False):
+        t.add_row(str(label), str(len(g)), f"{g['success'].mean():.3f}", f"{g['spl'].mean():.3f}", f"{g['distance_m'].mean():.1f}")
+    out.print(t)
+    _warn_errors(runs)
+    out.print(f"results: {res.out} (verify: semsearch verify {res.out})")
+
+
+@bench_app.command("hash")
+def bench_hash(
+    suite: str = typer.Argument(..., help="A suite's name (semsearch bench list)."),
+    split: str = typer.Option("val", "--split", help="The split."),
+    salt_file: Optional[Path] = typer.Option(None, "--salt-file", help="The salt of a hidden split (maintainers)."),
+):
+    """Print a split's hash (a hidden split built from its salt) and whether it is the published one."""
+    try:
+        sp = api.bench_hash(suite, split, salt_file)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(sp.hash)
+    pub = sp.published
+    err.print(f"{suite} {split}: {len(sp.floors)} floors; " + ("the published hash" if sp.official else
+              "no published hash yet (docs/bench.md: a maintainer fills it in)" if pub is None else
+              f"NOT the published hash {pub[:16]}: not official"), highlight=False, soft_wrap=True)
 
 
 generate_app = typer.Typer(no_args_is_help=True, help="Generate numbered buildings, and rooms for indirect search, of your own.")

@@ -171,10 +171,15 @@ class Batch:
         with Batch(loaded, specs, out, options) as batch:
             write_meta(out, loaded)
             rows = batch.run(progress)
+
+    ``stamp``: columns written with the same value on every row (a bench run's suite, split,
+    hash, numbering and floor: :data:`~semsearch_cli.metrics.BENCH_COLUMNS`).
     """
 
-    def __init__(self, loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions()):
+    def __init__(self, loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
+                 stamp: dict | None = None):
         self.loaded, self.specs, self.out, self.options = loaded, specs, Path(out), options
+        self.stamp = dict(stamp or {})
         self.variants = specs.variants if hasattr(specs, "variants") else list(dict.fromkeys(s.variant for s in specs))
         self.codes = {v.label: code_of(v)["hash"] for v in self.variants}
         self.done: pd.DataFrame | None = None
@@ -216,13 +221,14 @@ class Batch:
             serial = total == 0 or (executor == "processes" and total == 1)
             runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), options.start_method, executor,
                                                                    options.scheduler)
-        writer = RowWriter(runs_csv, columns_for(loaded.task.columns))
+        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *self.stamp]))
         n = 0
         try:
             for rows in runner.rows(loaded, todo, out, watch):
                 for r in rows:
                     r["fingerprint"] = fp
                     r["code"] = codes.get(r["planner"], "")
+                    r.update(self.stamp)
                 writer.write(rows)
                 n += 1
                 if progress:

@@ -120,7 +120,7 @@ class Loaded:
                 d.pop(key, None)
             for key in ("seeds", "out", "run_time_limit"):
                 d["experiment"].pop(key, None)
-            d = _files_by_content(d, self.path.parent)
+            d = files_by_content(d, self.path.parent)
             h = hashlib.sha256(json.dumps(d, sort_keys=True).encode())
             self._fingerprint = h.hexdigest()[:16]
         return self._fingerprint
@@ -133,13 +133,13 @@ class Loaded:
         return Loaded(self.path, sc, self.task)
 
 
-def _files_by_content(d, base: Path):
+def files_by_content(d, base: Path):
     """The scenario document ``d`` with each string that names an existing file (relative to
     ``base``) replaced by a hash of the file's bytes."""
     if isinstance(d, dict):
-        return {k: _files_by_content(v, base) for k, v in d.items()}
+        return {k: files_by_content(v, base) for k, v in d.items()}
     if isinstance(d, list):
-        return [_files_by_content(v, base) for v in d]
+        return [files_by_content(v, base) for v in d]
     if isinstance(d, str) and ("." in d or "/" in d) and len(d) < 4096:
         try:
             p = base / d

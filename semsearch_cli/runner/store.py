@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError, did_you_mean
-from ..metrics import CAUSES, COLUMNS, columns_for
+from ..metrics import BENCH_COLUMNS, CAUSES, COLUMNS, columns_for
 from ..planners.base import MAX_INFO_DEPTH
 from ..plugins import load_kinds
 from ..tasks import TASKS
@@ -47,6 +47,7 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     try:
         df = pd.read_csv(io.BytesIO(data), dtype={"stage": str, "map": str, "message": str, "kind": str, "scenario": str,
                                                   "fingerprint": str, "code": str, "room": str, "cause": str,
+                                                  **dict.fromkeys(BENCH_COLUMNS, str),
                                                   **dict.fromkeys(KEY_TEXT, str)},
                          encoding="utf-8", keep_default_na=False,
                          na_values={c: MISSING for c in [*COLUMNS, *LATER] if c not in KEY_TEXT})  # a scenario may be named 50045233
@@ -67,7 +68,7 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
             if c in df.columns:
                 df[c] = _lossless(df[c])
     load_kinds()
-    known = columns_for(c for t in TASKS.values() for c in t.columns)  # every registered kind's
+    known = columns_for([*(c for t in TASKS.values() for c in t.columns), *BENCH_COLUMNS])  # every registered kind's, a bench's
     extra = [c for c in df.columns if c not in known]
     if extra:
         raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), known)} "

@@ -1,0 +1,116 @@
+"""Building a suite's split: its floors' folders, their episodes and the manifest.
+
+``doors-v1`` draws floors from the building generator (a layout, a numbering convention and a
+seed per floor, from the split's salt), each with four goals spread by distance and five drawn
+starts per goal; ``doors-classic-v1`` freezes the shipped thesis scenarios with the thesis' own
+starts. ``scripts/make_bench.py`` writes the shipped ``val`` splits with these; a maintainer's
+``--salt-file`` builds a hidden ``test`` split the same way (:func:`~.suites.open_split`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from ..runner.specs import Loaded
+from ..shipped import CONFIGS
+from ..tasks.episodes import EPISODE_COLUMNS
+from ..world.buildings.numbered import generate_building
+from .suites import Suite, write_manifest
+
+DEFAULT_PLANNER = [{"name": "nsos", "alpha": 0.9}]  # what `semsearch run FLOOR/scenario.yaml` runs; a bench run sets its own
+
+
+def floor_rng(salt: str, suite: str, split: str, i: int) -> np.random.Generator:
+    """The generator of floor ``i`` of a split: seeded by the split's salt, never by the order
+    of other floors."""
+    words = np.frombuffer(hashlib.sha256(f"{suite}/{split}/{salt}/{i}".encode()).digest()[:16], np.uint32)
+    return np.random.default_rng([int(w) for w in words])
+
+
+def freeze_episodes(scenario: Path, repeats: int) -> int:
+    """Draw (or take) the scenario's episodes, write them to ``episodes.csv`` beside it and make
+    the scenario read that file (``repeats`` runs of each): the floor's episodes frozen. Returns
+    their number."""
+    loaded = Loaded.load(scenario)
+    eps = loaded.task.episodes
+    rows = pd.DataFrame([loaded.task.episode_row(e) for e in eps], columns=EPISODE_COLUMNS)
+    rows.to_csv(scenario.parent / "episodes.csv", index=False, lineterminator="\n")
+    doc = yaml.safe_load(scenario.read_text())
+    doc["episodes"] = {"file": "episodes.csv"}
+    doc["planners"] = DEFAULT_PLANNER
+    doc.setdefault("experiment", {})["seeds"] = repeats
+    header = "".join(line + "\n" for line in scenario.read_text().splitlines() if line.startswith("#"))
+    scenario.write_text(header + yaml.safe_dump(doc, sort_keys=False))
+    return len(eps)
+
+
+# doors-v1's floors: (layout, numbering convention, weight); `random` is the control on which no
+# planner can use the numbers
+DOORS_V1_MIX = [(lay, scheme, 1.0) for lay in ("grid", "wings", "angled", "single")
+                for scheme in ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks")]
+DOORS_V1_MIX += [(lay, "random", 1.0) for lay in ("grid", "wings", "angled", "single")]
+DOORS_V1_FLOORS = {"val": 40, "test": 40}
+DOORS_V1_STARTS = 5  # drawn per goal
+DOORS_V1_MIN_DISTANCE = 10.0  # m, geodesic from a start to its goal
+
+
+def make_doors_v1(split: str, salt: str, out: Path) -> None:
+    """``doors-v1``: :data:`DOORS_V1_FLOORS` floors drawn from :data:`DOORS_V1_MIX`, each with
+    its generator's four goals and :data:`DOORS_V1_STARTS` starts per goal."""
+    out.mkdir(parents=True, exist_ok=True)
+    weights = np.array([w for *_, w in DOORS_V1_MIX], float)
+    floors = []
+    for i in range(DOORS_V1_FLOORS[split]):
+        rng = floor_rng(salt, "doors-v1", split, i)
+        lay, scheme, _ = DOORS_V1_MIX[int(rng.choice(len(DOORS_V1_MIX), p=weights / weights.sum()))]
+        seed = int(rng.integers(2**31))
+        fid = f"f{i:03d}"
+        path = generate_building(lay, scheme, seed, out / fid, spacing=3.0, name=f"doors-v1-{split}-{fid}",
+                                 planners=DEFAULT_PLANNER)
+        doc = yaml.safe_load(path.read_text())
+        doc["episodes"] = {"starts": DOORS_V1_STARTS, "seed": int(rng.integers(2**31)),
+                           "min_distance": DOORS_V1_MIN_DISTANCE}
+        path.write_text(yaml.safe_dump(doc, sort_keys=False))
+        freeze_episodes(path, 1)
+        floors.append((fid, {"generator": "building", "layout": lay, "numbering": scheme, "seed": seed, "spacing": 3.0}))
+    write_manifest(SUITE_DOORS, split, out, floors)
+
+
+CLASSIC = ("normal", "inverse", "hotel_thesis", "kth")  # the shipped thesis door scenarios, in the thesis' order
+
+
+def make_doors_classic(split: str, salt: str, out: Path) -> None:
+    """``doors-classic-v1``: the shipped thesis scenarios (:data:`CLASSIC`) with their own
+    starts (one per goal, the heading drawn at each repeat), their files copied beside them."""
+    out.mkdir(parents=True, exist_ok=True)
+    floors = []
+    for name in CLASSIC:
+        src = CONFIGS / f"{name}.yaml"
+        doc = yaml.safe_load(src.read_text())
+        dest = out / name
+        dest.mkdir()
+        for key in ("image",):
+            f = src.parent / doc["map"][key]
+            shutil.copyfile(f, dest / f.name)
+            doc["map"][key] = f.name
+        f = src.parent / doc["doors"]
+        shutil.copyfile(f, dest / f.name)
+        doc["doors"] = f.name
+        doc["experiment"].pop("out", None)
+        (dest / "scenario.yaml").write_text(f"# the shipped scenario {name} (configs/{name}.yaml), frozen for doors-classic-v1\n"
+                                            + yaml.safe_dump(doc, sort_keys=False))
+        freeze_episodes(dest / "scenario.yaml", 10)
+        floors.append((name, {"scenario": f"configs/{name}.yaml"}))
+    write_manifest(SUITE_CLASSIC, split, out, floors)
+
+
+SUITE_DOORS = Suite("doors-v1", "doors", "generated floors: corridor layouts x numbering conventions, 4 goals x 5 drawn "
+                    "starts each", repeats=1, splits=("val", "test"), shipped=("val",), make=make_doors_v1, hidden=("test",))
+SUITE_CLASSIC = Suite("doors-classic-v1", "doors", "the thesis' Hotel, Normal, Inverse and KTH floors with its own starts, "
+                      "10 repeats (Tables 4.2-4.10)", repeats=10, splits=("val",), shipped=("val",), make=make_doors_classic)

@@ -1,0 +1,215 @@
+"""``semsearch bench run`` and the bench's side of ``semsearch verify``.
+
+A bench results folder holds ``bench.json`` (the suite, split, its hash, the numbering, the
+planners run into it) and one sub-folder per floor, each an ordinary results folder (runs.csv,
+meta.json, decisions/) beside ``scenario/``: the floor as it was run (its labels permuted under a
+numbering other than ``true``). Every run is recorded with its decisions, and every row carries
+the suite, split, hash, numbering and floor (:data:`~semsearch_cli.metrics.BENCH_COLUMNS`).
+Floors run one after the other, each a resumable batch: an interrupted bench run resumes where it
+stopped, whatever the workers or the executor.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+import yaml
+
+from ..config import PlannerSpec
+from ..errors import ScenarioError
+from ..files import atomic_text, output_folder
+from ..report.build import write_meta
+from ..runner import Batch, BatchOptions, Loaded, folder_lock, read_runs
+from ..runner.specs import RunList
+from ..runner.verify import Verdict, verify_folder
+from ..tasks.episodes import Episode
+from .numbering import NUMBERINGS, relabel
+from .suites import Floor, Split, open_split, suite_named
+
+BENCH_FILE = "bench.json"
+
+
+def _label_value(text: str):
+    """A label as a scenario writes it: a whole number as an int, anything else as text."""
+    return int(text) if text.isdigit() and (text == "0" or not text.startswith("0")) else text
+
+
+def materialise(split: Split, floor: Floor, numbering: str, dest: Path) -> Path:
+    """Write ``floor`` into ``dest`` as it runs under ``numbering``: its scenario and every file
+    it names, the signs' labels (and the goals and episodes with them) permuted by
+    :func:`~.numbering.relabel`. Returns the scenario's path."""
+    if numbering not in NUMBERINGS:
+        raise ScenarioError("<command line>", "--numbering", f"unknown numbering {numbering!r}; valid: {', '.join(NUMBERINGS)}")
+    src = floor.scenario
+    doc = yaml.safe_load(src.read_text())
+    dest.mkdir(parents=True, exist_ok=True)
+    names = {"image": doc["map"]["image"], "episodes": doc["episodes"]["file"]}
+    if "doors" in doc:
+        names["doors"] = doc["doors"]
+    for f in names.values():
+        shutil.copyfile(src.parent / f, dest / Path(f).name)
+    doc["map"]["image"] = Path(names["image"]).name
+    doc["episodes"]["file"] = Path(names["episodes"]).name
+    if "doors" in doc:
+        doc["doors"] = Path(names["doors"]).name
+    if numbering != "true":
+        if "doors" not in doc:
+            raise ScenarioError("<command line>", "--numbering", f"{split.suite.name} has no door signs to renumber")
+        door_file = dest / doc["doors"]
+        with door_file.open(newline="") as fh:
+            rows = list(csv.reader(fh))
+        head, body = rows[0], rows[1:]
+        k = head.index("number")
+        new = relabel([r[k].strip() for r in body], numbering, f"{split.suite.name}/{split.name}/{floor.id}")
+        for r in body:
+            r[k] = new[r[k].strip()]
+        with door_file.open("w", newline="") as fh:
+            csv.writer(fh, lineterminator="\n").writerows([head, *body])
+        doc["goals"] = [_label_value(new[str(g)]) for g in doc["goals"]]
+        eps = pd.read_csv(dest / doc["episodes"]["file"], dtype=str, keep_default_na=False)
+        eps["goal"] = [new[g] for g in eps["goal"]]
+        eps["hash"] = [Episode(0, g, float(x), float(y), float(h) if h else None, int(r) if r else None).hash
+                       for g, x, y, h, r in zip(eps["goal"], eps["start_x"], eps["start_y"], eps["start_heading"], eps["room"])]
+        eps.to_csv(dest / doc["episodes"]["file"], index=False, lineterminator="\n")
+    doc["experiment"]["seeds"] = split.suite.repeats
+    path = dest / "scenario.yaml"
+    atomic_text(path, f"# {split.suite.name} {split.name} floor {floor.id}, numbering {numbering} (semsearch bench)\n"
+                + yaml.safe_dump(doc, sort_keys=False))
+    return path
+
+
+@dataclass
+class BenchOutput:
+    out: Path
+    split: Split
+    numbering: str
+    runs: pd.DataFrame
+    floors: list = field(default_factory=list)  # the floors run (their ids)
+
+
+def _check_bench_file(out: Path, split: Split, numbering: str, planners: list[str]) -> dict:
+    """bench.json of ``out`` for this run: a folder of another suite, split, hash or numbering is
+    refused; the planners accumulate."""
+    f = out / BENCH_FILE
+    want = {"suite": split.suite.name, "split": split.name, "hash": split.hash, "numbering": numbering}
+    if f.is_file():
+        try:
+            have = json.loads(f.read_text())
+        except ValueError as exc:
+            raise ScenarioError(str(f), "", f"not a bench.json semsearch wrote ({exc})") from None
+        for key, value in want.items():
+            if have.get(key) != value:
+                raise ScenarioError(str(f), key, f"this folder holds {have.get(key)!r}, this run is {value!r}: a bench folder "
+                                    "holds one suite, split and numbering; write into another folder with --out")
+    else:
+        have = dict(want)
+    have["official"] = split.official
+    have["repeats"] = split.suite.repeats
+    have["kind"] = split.suite.kind
+    have["planners"] = list(dict.fromkeys([*have.get("planners", []), *planners]))
+    return have
+
+
+def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: str = "val", numbering: str = "true",
+              options: BatchOptions = BatchOptions(), limit: int | None = None, salt_file: str | Path | None = None,
+              progress=None) -> BenchOutput:
+    """Run ``planners`` on a suite's split into ``out`` (see the module docstring): every floor,
+    or the first ``limit`` episodes in the split's order. ``options`` as a batch's (workers,
+    executor); decisions are always recorded. ``progress(row, done, total)`` after each run."""
+    sp = open_split(suite, split, salt_file)
+    if numbering not in NUMBERINGS:
+        raise ScenarioError("<command line>", "--numbering", f"unknown numbering {numbering!r}; valid: {', '.join(NUMBERINGS)}")
+    if limit is not None and limit < 1:
+        raise ScenarioError("<command line>", "--limit", f"{limit}: give at least 1 episode")
+    options = options.checked().replace(decisions=True, seeds=None, goals=None, planners=None)
+    out = output_folder(out)
+    counts = [len(pd.read_csv(f.scenario.parent / "episodes.csv", usecols=["goal"])) for f in sp.floors]
+    todo, left = [], limit
+    for f, n in zip(sp.floors, counts):
+        if left is not None and left <= 0:
+            break
+        take = n if left is None else min(n, left)
+        todo.append((f, take))
+        left = None if left is None else left - take
+    with folder_lock(out):
+        first = Loaded.load(materialise(sp, todo[0][0], numbering, out / todo[0][0].id / "scenario")).with_planners(planners)
+        labels = [v.label for v in first.task.variants()]
+        meta = _check_bench_file(out, sp, numbering, labels)
+        atomic_text(out / BENCH_FILE, json.dumps(meta, indent=1) + "\n")
+    total = sum(n for _, n in todo) * len(labels) * sp.suite.repeats
+    done = sum(_done_rows(out / f.id, labels) for f, _ in todo)
+    stamp = {"suite": sp.suite.name, "split": sp.name, "suite_hash": sp.hash, "numbering": numbering}
+    frames = []
+    for f, take in todo:
+        dest = out / f.id
+        loaded = first if f is todo[0][0] else Loaded.load(materialise(sp, f, numbering, dest / "scenario")).with_planners(planners)
+        specs = RunList(loaded.task.episodes[:take], loaded.task.variants(), sp.suite.repeats)
+
+        def tick(row, n, _total, base=done):
+            if progress:
+                progress(row, base + n, total)
+
+        with Batch(loaded, specs, dest, options, stamp={**stamp, "floor": f.id}) as batch:
+            write_meta(dest, loaded)
+            before = len(batch.done)
+            rows = batch.run(tick)
+        done += len(rows) - before
+        frames.append(rows)
+    runs = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+    return BenchOutput(out, sp, numbering, runs, [f.id for f, _ in todo])
+
+
+def _done_rows(folder: Path, labels: list[str]) -> int:
+    """The runs of ``labels`` already in a floor's runs.csv."""
+    rows = read_runs(folder / "runs.csv", as_written=True)
+    return int(((rows["stage"] == "") & rows["planner"].astype(str).isin(labels)).sum()) if len(rows) else 0
+
+
+def read_bench(folder: Path) -> dict:
+    """A bench folder's bench.json, or a :class:`ScenarioError`."""
+    f = Path(folder) / BENCH_FILE
+    try:
+        meta = json.loads(f.read_text())
+        suite_named(meta["suite"])
+        return meta
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ScenarioError(str(f), "", f"not a bench.json semsearch wrote ({type(exc).__name__}: {exc})") from None
+
+
+def is_bench(folder: Path) -> bool:
+    return (Path(folder) / BENCH_FILE).is_file()
+
+
+def verify_bench(folder: str | Path, salt_file: str | Path | None = None, workers: int = 1,
+                 progress=None) -> tuple[Split, dict[str, Verdict]]:
+    """Replay every recorded run of a bench folder from its decisions (no planner built), floor by
+    floor, each on its floor rebuilt from the suite (never from the folder's copy): a row made on
+    a split of another hash, or that does not replay to its outcome, distance and steps, is
+    named. Returns the split and each floor's :class:`~semsearch_cli.runner.verify.Verdict`."""
+    folder = Path(folder)
+    meta = read_bench(folder)
+    sp = open_split(meta["suite"], meta["split"], salt_file)
+    if sp.hash != meta.get("hash"):
+        raise ScenarioError(str(folder / BENCH_FILE), "hash", f"the results were made on {meta['suite']} {meta['split']} of hash "
+                            f"{str(meta.get('hash'))[:16]}, this semsearch's is {sp.hash[:16]}: verify them with the suite they "
+                            "were made on")
+    verdicts: dict[str, Verdict] = {}
+    with tempfile.TemporaryDirectory(prefix="semsearch-verify-") as tmp:
+        for f in sp.floors:
+            if not (folder / f.id / "runs.csv").is_file():
+                continue
+            rows = read_runs(folder / f.id / "runs.csv", as_written=True)
+            own = rows[rows["stage"] == ""]
+            bad = own["suite_hash"].astype(str) != sp.hash if "suite_hash" in own.columns else pd.Series(True, index=own.index)
+            loaded = Loaded.load(materialise(sp, f, meta["numbering"], Path(tmp) / f.id), planners=False)
+            v = verify_folder(folder / f.id, loaded, progress, workers)
+            if bad.any():
+                v.failed.append((f"{int(bad.sum())} row(s)", f"carry another suite hash than {sp.hash[:16]}"))
+            verdicts[f.id] = v
+    return sp, verdicts

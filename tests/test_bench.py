@@ -1,0 +1,214 @@
+"""semsearch-bench: suites, their hashes, the numbering ablation, bench runs and their verification."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from semsearch_cli import api, bench
+from semsearch_cli.bench.suites import build, read_split
+from semsearch_cli.cli import app
+from semsearch_cli.runner import BatchOptions
+
+runner = CliRunner()
+
+
+# -- the numbering ablation ------------------------------------------------------------------------
+
+def test_parity_flip_swaps_each_odd_number_with_the_next_even_one():
+    assert bench.relabel([1, 2, 3, 4, 5], "parity-flipped", "x") == {1: 2, 2: 1, 3: 4, 4: 3, 5: 5}
+
+
+def test_reversed_trades_the_kth_smallest_with_the_kth_largest_within_each_prefix():
+    got = bench.relabel(["K101", "K103", "K105", "B7", "B8", "Lab"], "reversed", "x")
+    assert got == {"K101": "K105", "K103": "K103", "K105": "K101", "B7": "B8", "B8": "B7", "Lab": "Lab"}
+
+
+def test_lettered_labels_trade_with_the_same_letter_only():
+    got = bench.relabel(["24A", "24B", "25A", "23"], "parity-flipped", "x")
+    # 23 <-> 24 needs a 24 without a letter: none, so 23 stays; 24A, 25A... 25 is odd: 25A <-> 26A (absent)
+    assert got == {"24A": "24A", "24B": "24B", "25A": "25A", "23": "23"}
+    got = bench.relabel(["23A", "24A", "24B"], "parity-flipped", "x")
+    assert got == {"23A": "24A", "24A": "23A", "24B": "24B"}
+
+
+@pytest.mark.parametrize("how", bench.NUMBERINGS)
+def test_every_numbering_is_a_bijection_of_the_floors_labels(how):
+    labels = [*range(101, 141), "K201", "K202", "2.14", "2.15", "Lab"]
+    m = bench.relabel(labels, how, "floor-7")
+    assert sorted(map(str, m)) == sorted(map(str, labels)) and sorted(map(str, m.values())) == sorted(map(str, labels))
+    assert (m == {a: a for a in labels}) == (how == "true")
+
+
+def test_shuffled_is_seeded_by_the_floor():
+    labels = list(range(1, 30))
+    assert bench.relabel(labels, "shuffled", "a") == bench.relabel(labels, "shuffled", "a")
+    assert bench.relabel(labels, "shuffled", "a") != bench.relabel(labels, "shuffled", "b")
+
+
+@pytest.mark.parametrize("how", ["shuffled", "parity-flipped", "reversed"])
+def test_a_renumbered_floor_keeps_every_sign_and_each_goal_door_in_its_place(tmp_path, how):
+    sp = bench.open_split("doors-v1")
+    # the first floor this numbering changes (one numbered with a single parity has no parity to flip)
+    floor = next(f for f in sp.floors if len(set(pd.read_csv(f.scenario.parent / "doors.csv")["number"] % 2)) == 2)
+    true = bench.materialise(sp, floor, "true", tmp_path / "true")
+    other = bench.materialise(sp, floor, how, tmp_path / how)
+    a = pd.read_csv(true.parent / "doors.csv", dtype=str)
+    b = pd.read_csv(other.parent / "doors.csv", dtype=str)
+    assert (a[["x", "y", "facing"]].to_numpy() == b[["x", "y", "facing"]].to_numpy()).all()  # positions kept
+    assert sorted(a["number"]) == sorted(b["number"]) and (a["number"] != b["number"]).any()  # labels permuted
+    where = {n: (x, y) for n, x, y in zip(b["number"], b["x"], b["y"])}
+    old = {n: (x, y) for n, x, y in zip(a["number"], a["x"], a["y"])}
+    ea = pd.read_csv(true.parent / "episodes.csv", dtype=str, keep_default_na=False)
+    eb = pd.read_csv(other.parent / "episodes.csv", dtype=str, keep_default_na=False)
+    assert (ea[["start_x", "start_y", "start_heading", "shortest_m"]] == eb[["start_x", "start_y", "start_heading", "shortest_m"]]).all().all()
+    assert all(old[g] == where[h] for g, h in zip(ea["goal"], eb["goal"]))  # each episode's goal is the same door
+    assert api.validate(other)["signs"] == len(a)  # and the renumbered floor loads (the episodes' hashes are its own)
+
+
+# -- suites and their hashes -----------------------------------------------------------------------
+
+def test_every_shipped_split_has_its_published_hash():
+    for s in bench.SUITES.values():
+        for split in s.shipped:
+            sp = bench.open_split(s.name, split)
+            assert sp.hash == bench.PUBLISHED[(s.name, split)] and sp.official
+
+
+@pytest.mark.parametrize("suite", ["doors-v1", "doors-classic-v1"])
+def test_a_shipped_split_is_rebuilt_byte_for_byte_from_its_builder(tmp_path, suite):
+    s = bench.SUITES[suite]
+    build(s, "val", f"{suite}/val", tmp_path / "val")
+    again = read_split(s, "val", tmp_path / "val")
+    assert again.hash == bench.open_split(suite).hash
+
+
+def test_doors_v1_val_has_40_floors_of_4_goals_and_5_starts_each():
+    sp = bench.open_split("doors-v1")
+    assert len(sp.floors) == 40
+    for f in sp.floors:
+        eps = pd.read_csv(f.scenario.parent / "episodes.csv")
+        assert eps.groupby("goal").size().tolist() == [5] * 4, f.id
+        assert (eps["shortest_m"] >= 10.0).all()
+
+
+def test_a_hidden_split_needs_its_salt_and_is_official_only_with_the_published_hash(tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
+    with pytest.raises(api.ScenarioError, match="--salt-file"):
+        bench.open_split("doors-v1", "test")
+    salt = tmp_path / "salt.txt"
+    salt.write_text("a test salt, not the project's: 0123456789abcdef\n")
+    sp = bench.open_split("doors-v1", "test", salt)
+    assert len(sp.floors) == 40 and sp.hash != bench.open_split("doors-v1").hash
+    assert not sp.official  # no published test hash in this repository: a placeholder
+    monkeypatch.setitem(bench.PUBLISHED, ("doors-v1", "test"), sp.hash)
+    assert bench.open_split("doors-v1", "test", salt).official  # the maintainer's hash, filled in
+    other = tmp_path / "other.txt"
+    other.write_text("another salt entirely, 16+ chars")
+    assert not bench.open_split("doors-v1", "test", other).official
+    res = runner.invoke(app, ["bench", "hash", "doors-v1", "--split", "test", "--salt-file", str(other)])
+    assert res.exit_code == 0 and res.stdout.strip() == bench.open_split("doors-v1", "test", other).hash
+
+
+def test_a_short_salt_and_an_unknown_suite_are_refused_in_words(tmp_path):
+    salt = tmp_path / "salt.txt"
+    salt.write_text("short")
+    res = runner.invoke(app, ["bench", "hash", "doors-v1", "--split", "test", "--salt-file", str(salt)])
+    assert res.exit_code == 2 and "at least 16" in res.stderr
+    res = runner.invoke(app, ["bench", "run", "doors-v2", "--planner", "greedy", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "did you mean 'doors-v1'" in res.stderr
+
+
+# -- bench runs and verify ------------------------------------------------------------------------
+
+def _run(tmp_path, planner, limit=3, numbering="true", suite="doors-v1", **kw):
+    return api.bench_run(suite, [planner], tmp_path / f"{planner}-{numbering}", numbering=numbering,
+                         options=BatchOptions(workers=1), limit=limit, **kw)
+
+
+@pytest.mark.parametrize("planner", ["greedy", "nsos[alpha=0.9]", "bvp", "draft"])
+def test_every_built_in_door_planner_verifies_exactly_on_a_slice(tmp_path, planner):
+    res = _run(tmp_path, planner, limit=7)  # floor f000's 20 episodes are more than 7: one floor
+    runs = res.runs
+    assert len(runs) == 7 and set(runs["suite_hash"]) == {res.split.hash} and set(runs["floor"]) == {"f000"}
+    assert len(list((res.out / "f000" / "decisions").glob("*.json"))) == 7
+    v = api.verify(res.out, workers=1).verdict
+    assert (v.runs, v.verified, v.failed) == (7, 7, [])
+
+
+def test_a_slice_spans_floors_and_resumes(tmp_path):
+    res = _run(tmp_path, "greedy", limit=22)
+    assert res.floors == ["f000", "f001"] and len(res.runs) == 22
+    again = _run(tmp_path, "greedy", limit=22)
+    assert len(again.runs) == 22  # nothing ran twice
+
+
+def test_verify_names_a_tampered_distance_and_a_truncated_decision_sequence(tmp_path):
+    res = _run(tmp_path, "nsos[alpha=0.9]", limit=3)
+    f = res.out / "f000" / "runs.csv"
+    rows = pd.read_csv(f, dtype=str, keep_default_na=False)
+    rows.loc[0, "distance_m"] = str(float(rows.loc[0, "distance_m"]) - 1.0)
+    rows.to_csv(f, index=False)
+    dec = sorted((res.out / "f000" / "decisions").glob("*ep1__seed0.json"))[0]
+    rec = json.loads(dec.read_text())
+    rec["decisions"] = rec["decisions"][: len(rec["decisions"]) // 2]
+    dec.write_text(json.dumps(rec))
+    out = runner.invoke(app, ["verify", str(res.out), "--workers", "1"])
+    assert out.exit_code == 1
+    assert "floor f000: nsos[alpha=0.9] goal" in out.stdout and "episode 0 seed 0: distance_m" in out.stdout
+    assert "episode 1 seed 0: the replay stopped" in out.stdout
+    assert "1 of 3 runs replayed" in out.stdout
+
+
+def test_a_folder_of_another_numbering_is_refused(tmp_path):
+    _run(tmp_path, "greedy", limit=1)
+    with pytest.raises(api.ScenarioError, match="numbering"):
+        api.bench_run("doors-v1", ["greedy"], tmp_path / "greedy-true", numbering="shuffled", options=BatchOptions(workers=1), limit=1)
+
+
+def test_a_renumbered_run_pairs_with_the_true_one_episode_by_episode(tmp_path):
+    a = _run(tmp_path, "nsos[alpha=0.9]", limit=4).runs
+    b = _run(tmp_path, "nsos[alpha=0.9]", limit=4, numbering="shuffled").runs
+    assert (a[["floor", "episode", "start_x", "start_y", "shortest_m"]].to_numpy() == b[["floor", "episode", "start_x", "start_y", "shortest_m"]].to_numpy()).all()
+    assert set(b["numbering"]) == {"shuffled"} and (a["goal"].astype(str) != b["goal"].astype(str)).any()
+    assert api.verify(tmp_path / "nsos[alpha=0.9]-shuffled", workers=1).verdict.verified == 4
+
+
+USER_PLANNER = '''
+from semsearch_cli.planners import Decision, Planner, register_planner
+
+
+@register_planner("first-candidate")
+class FirstCandidate(Planner):
+    """Always the first frontier candidate."""
+
+    task = "doors"
+
+    def choose(self, ctx, cands):
+        return Decision(int(cands.rows[0]), int(cands.cols[0])) if len(cands) else None
+'''
+
+
+def test_a_users_planner_file_runs_on_the_bench_and_verifies_without_it(tmp_path):
+    f = tmp_path / "mine.py"
+    f.write_text(USER_PLANNER)
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner", "first-candidate", "--planner-file", str(f),
+                              "--limit", "3", "--workers", "1", "--out", str(tmp_path / "mine")])
+    assert res.exit_code == 0, res.stderr
+    assert "first-candidate" in res.stdout
+    f.unlink()  # the planner is gone: its runs still verify from their decisions
+    res = runner.invoke(app, ["verify", str(tmp_path / "mine"), "--workers", "1"])
+    assert res.exit_code == 0 and "3 of 3 runs replayed" in res.stdout
+
+
+def test_the_classic_suite_runs_the_thesis_scenario_as_semsearch_run_does(tmp_path):
+    res = api.bench_run("doors-classic-v1", ["greedy"], tmp_path / "b", options=BatchOptions(workers=1), limit=1)
+    direct = api.run("normal", BatchOptions(seeds=10, goals=[54], planners=["greedy"], out=tmp_path / "r", workers=1), plots=False)
+    cols = ["goal", "episode", "seed", "start_x", "start_y", "start_heading", "outcome", "distance_m", "steps", "shortest_m"]
+    assert set(res.runs["floor"]) == {"normal"} and len(res.runs) == 10  # the first floor's first episode, 10 repeats
+    assert (res.runs[cols].reset_index(drop=True) == direct.runs[cols].reset_index(drop=True)).all().all()
