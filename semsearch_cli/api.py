@@ -131,7 +131,7 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
         if scenario is not None:
             raise ScenarioError("<command line>", "--scenario", f"{folder} is a bench folder: its floors are the suite's "
                                 "(bench.json); give --salt-file for a hidden split, never a scenario")
-        return verify_bench(folder, salt_file, progress, workers)
+        return _verify_bench(folder, salt_file, progress, workers)
     if salt_file is not None:
         raise ScenarioError("<command line>", "--salt-file", f"{folder} is not a bench folder (no bench.json)")
     if not (folder / "runs.csv").is_file():
@@ -466,13 +466,17 @@ def presence(counts: str | Path, hours, out: str | Path | None = None) -> pd.Dat
 
 
 def generate_building(layout: str, numbering: str, seed: int, out: str | Path, spacing: float = 2.5, signs: int | None = None,
-                      goals: list | None = None, name: str | None = None, scale: float = 1.0) -> Path:
+                      goals: list | None = None, name: str | None = None, scale: float = 1.0, skip: float = 0.0,
+                      letters: float = 0.0, extension: bool = False, style: str = "plain") -> Path:
     """Write a generated building into ``out`` (map.png, doors.csv and a scenario that runs as it
-    is); returns the scenario's path. ``goals``: door numbers (default: four spread by distance)."""
+    is); returns the scenario's path. ``goals``: door numbers (default: four spread by distance).
+    ``skip``, ``letters``, ``extension`` and ``style``: what real floors add (numbers skipped,
+    lettered doors, an extension renumbered, wing prefixes or floor-dot-room labels; see
+    :func:`~semsearch_cli.world.buildings.numbered.generate_building`)."""
     if goals and any(not isinstance(g, int) or isinstance(g, bool) for g in goals):
         raise ScenarioError("<command line>", "--goals", f"expected door numbers, got {','.join(map(str, goals))!r}")
     return numbered.generate_building(layout, numbering, seed, output_folder(out), spacing=spacing, signs=signs, goals=goals,
-                                      name=name, scale=scale)
+                                      name=name, scale=scale, skip=skip, letters=letters, extension=extension, style=style)
 
 
 def _among(items, valid: tuple, flag: str) -> tuple:
@@ -529,7 +533,7 @@ def import_kth(xml_file: str | Path, out: str | Path, **options) -> tuple[Path, 
     return imported(kth.import_kth, out, Path(xml_file), **options)
 
 
-def verify_bench(folder: Path, salt_file=None, progress=None, workers: int | None = None) -> VerifyOutput:
+def _verify_bench(folder: Path, salt_file=None, progress=None, workers: int | None = None) -> VerifyOutput:
     """:func:`verify` of a bench folder: the floors' verdicts as one, each run named with its floor."""
     split, verdicts = bench.verify_bench(folder, salt_file, workers_for(workers), progress)
     v = Verdict()
@@ -540,6 +544,7 @@ def verify_bench(folder: Path, salt_file=None, progress=None, workers: int | Non
         v.failed += [(f"floor {fid}: {name}", why) for name, why in fv.failed]
     if not v.runs:
         raise ScenarioError(str(folder), "", "holds no floor with rows to verify")
+    bench.board.write_verdict(folder, split.hash, v.runs, v.verified, len(v.failed))
     return VerifyOutput(folder, f"{split.suite.name} {split.name}, hash {split.hash[:16]}", v)
 
 
@@ -594,6 +599,14 @@ def bench_list() -> list[dict]:
                            hash=sp.hash, hidden=False)
             rows.append(row)
     return rows
+
+
+def bench_board(folders, out: str | Path) -> list[Path]:
+    """The results page of bench folders into ``out`` (index.html, board.md, the figure and the
+    per-floor table): :mod:`semsearch_cli.bench.board`."""
+    if not folders:
+        raise ScenarioError("<command line>", "FOLDERS", "give one or more bench results folders")
+    return bench.board.board([Path(f) for f in folders], out)
 
 
 def bench_hash(suite: str, split: str = "val", salt_file: str | Path | None = None) -> bench.Split:

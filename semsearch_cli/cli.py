@@ -510,6 +510,22 @@ def bench_run(
     out.print(f"results: {res.out} (verify: semsearch verify {res.out})")
 
 
+@bench_app.command("board")
+def bench_board(
+    folders: List[Path] = typer.Argument(..., help="Bench results folders (semsearch bench run --out)."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for index.html, board.md and the figure."),
+):
+    """The results page of bench folders: per suite and split, each planner's success, SPL, SoftSPL
+    and distance with 95% intervals over episodes, the paired difference to nsos[alpha=0.9], the
+    semantic gain (true minus shuffled numbering), verified or not, official or not."""
+    try:
+        files = api.bench_board(folders, out_dir)
+    except ScenarioError as exc:
+        _fail(exc)
+    for f in files:
+        out.print(f"wrote {f}")
+
+
 @bench_app.command("hash")
 def bench_hash(
     suite: str = typer.Argument(..., help="A suite's name (semsearch bench list)."),
@@ -534,7 +550,7 @@ app.add_typer(generate_app, name="generate")
 
 @generate_app.command("building")
 def generate_building(
-    layout: str = typer.Option(..., "--layout", help="grid, wings, angled or single."),
+    layout: str = typer.Option(..., "--layout", help="grid, wings, angled, single or hall."),
     numbering: str = typer.Option(..., "--numbering", help=", ".join(api.SCHEMES) + "."),
     seed: int = typer.Option(0, "--seed", min=0, max=2**32 - 1, help="Seed of the layout's variations (and of random numbering)."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for map.png, doors.csv and scenario.yaml."),
@@ -544,12 +560,18 @@ def generate_building(
     name: Optional[str] = typer.Option(None, "--name", help="Scenario name (default LAYOUT-NUMBERING-SEED)."),
     scale: float = typer.Option(1.0, "--scale", callback=_finite, min=0.5, max=4.0,
                                 help="Stretch the layout this many times in x and y (scale^2 the area), corridors as wide."),
+    skip: float = typer.Option(0.0, "--skip", callback=_finite, min=0.0, max=0.95,
+                               help="Share of numbered door slots left without a door (numbers skipped, as real floors do)."),
+    letters: float = typer.Option(0.0, "--letters", callback=_finite, min=0.0, max=0.9,
+                                  help="Share of doors that share a room's number with a letter suffix (24a, 24b)."),
+    extension: bool = typer.Option(False, "--extension", help="Renumber the last corridor in a hundred-block of its own."),
+    style: str = typer.Option("plain", "--style", help="plain (214), wing (K214: a wing letter per corridor) or dot (2.14)."),
 ):
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
         wanted = _split([goals], "--goals") if goals is not None else None
         path = api.generate_building(layout, numbering, seed, out_dir, spacing=spacing, signs=signs, goals=wanted, name=name,
-                                     scale=scale)
+                                     scale=scale, skip=skip, letters=letters, extension=extension, style=style)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")

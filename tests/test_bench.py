@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
+import html as html_lib
 import json
+import os
+import re
 import shutil
-from pathlib import Path
+import subprocess
 
 import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
 from semsearch_cli import api, bench
+from semsearch_cli.bench.predictability import predictability
 from semsearch_cli.bench.suites import build, read_split
 from semsearch_cli.cli import app
 from semsearch_cli.runner import BatchOptions
@@ -212,3 +216,68 @@ def test_the_classic_suite_runs_the_thesis_scenario_as_semsearch_run_does(tmp_pa
     cols = ["goal", "episode", "seed", "start_x", "start_y", "start_heading", "outcome", "distance_m", "steps", "shortest_m"]
     assert set(res.runs["floor"]) == {"normal"} and len(res.runs) == 10  # the first floor's first episode, 10 repeats
     assert (res.runs[cols].reset_index(drop=True) == direct.runs[cols].reset_index(drop=True)).all().all()
+
+
+# -- predictability and the board ------------------------------------------------------------------
+
+def test_predictability_of_walls_numbered_steadily_with_one_parity_each_is_one():
+    xs = [0.0, 3.0, 6.0, 9.0, 12.0] * 2
+    ys = [0.0] * 5 + [4.0] * 5
+    facing = [90.0] * 5 + [-90.0] * 5
+    labels = [1, 3, 5, 7, 9, 2, 4, 6, 8, 10]
+    p = predictability(labels, xs, ys, facing, "t")
+    assert (p.order, p.parity, p.walls, p.signs) == (1.0, 1.0, 2, 10)
+
+
+def test_a_loop_numbered_wall_is_ordered_without_parity():
+    xs = [0.0, 3.0, 6.0, 9.0, 12.0, 15.0] * 2
+    ys = [0.0] * 6 + [4.0] * 6
+    facing = [90.0] * 6 + [-90.0] * 6
+    labels = [201, 202, 203, 204, 205, 206, 212, 211, 210, 209, 208, 207]
+    p = predictability(labels, xs, ys, facing, "t")
+    assert p.order == 1.0 and p.parity < 0.0  # half of each wall odd: less parity than a shuffle gives
+
+
+def test_a_shuffled_floors_predictability_is_near_zero():
+    sp = bench.open_split("doors-v1")
+    values = [f.recipe["predictability"]["value"] for f in sp.floors if f.recipe["numbering"] == "random"]
+    assert values and all(abs(v) < 0.2 for v in values)
+
+
+CHROMIUM = next((p for p in map(shutil.which, ("chromium", "chromium-browser", "google-chrome")) if p), None)
+PROBE = """<script>
+window.addEventListener("load", () => {
+  const t = document.querySelector("table");
+  const k = [...t.rows[0].cells].findIndex(h => h.innerText.trim() === "SPL");
+  const col = () => [...t.rows].slice(1).map(r => parseFloat(r.cells[k].innerText));
+  const before = col();
+  t.rows[0].cells[k].click();
+  const up = col();
+  t.rows[0].cells[k].click();
+  const down = col();
+  document.body.setAttribute("data-probe", JSON.stringify({before, up, down,
+    headings: [...document.querySelectorAll("h2")].map(h => h.innerText),
+    images: document.images.length, broken: [...document.images].filter(i => !i.naturalWidth).length}));
+});</script>"""
+
+
+@pytest.mark.skipif(CHROMIUM is None and not os.environ.get("CI"),
+                    reason="no chromium on PATH (.ci/run installs it from Debian's packages, and there it must run)")
+def test_the_board_opens_in_a_browser_and_sorts_by_a_column(tmp_path):
+    folders = [_run(tmp_path, p, limit=6, numbering=n).out for p, n in
+               (("nsos[alpha=0.9]", "true"), ("nsos[alpha=0.9]", "shuffled"), ("greedy", "true"))]
+    api.verify(folders[0], workers=1)
+    files = api.bench_board(folders, tmp_path / "site")
+    md = (tmp_path / "site" / "board.md").read_text()
+    assert "| nsos[alpha=0.9] | 6 | 6 |" in md and "verified" in md and "not verified" in md
+    assert "semantic gain" in md and "(n=6)" in md
+    page = tmp_path / "probe.html"
+    page.write_text((tmp_path / "site" / "index.html").read_text().replace("</body>", PROBE + "</body>"))
+    res = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--window-size=1100,1200",
+                          "--virtual-time-budget=10000", "--dump-dom", page.as_uri()], capture_output=True, text=True, timeout=120)
+    found = re.search(r'data-probe="([^"]*)"', res.stdout)
+    assert found, res.stderr[-2000:]
+    probe = json.loads(html_lib.unescape(found.group(1)))
+    assert probe["headings"] == ["doors-v1 val"] and probe["images"] >= 1 and probe["broken"] == 0
+    assert probe["up"] == sorted(probe["before"]) and probe["down"] == sorted(probe["before"], reverse=True)
+    assert len(files) >= 2

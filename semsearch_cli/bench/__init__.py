@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+from . import board
 from .make import SUITE_CLASSIC, SUITE_DOORS
 from .numbering import NUMBERINGS, relabel
 from .run import BENCH_FILE, BenchOutput, is_bench, materialise, read_bench, run_bench, verify_bench
@@ -16,6 +17,6 @@ _HASHES = json.loads((DATA / "published.json").read_text()) if (DATA / "publishe
 for _suite in (SUITE_DOORS, SUITE_CLASSIC):
     register(_suite, _HASHES.get(_suite.name, {}))
 
-__all__ = ["BENCH_FILE", "BenchOutput", "DATA", "Floor", "NUMBERINGS", "PUBLISHED", "SUITES", "Split", "Suite", "is_bench",
+__all__ = ["board", "BENCH_FILE", "BenchOutput", "DATA", "Floor", "NUMBERINGS", "PUBLISHED", "SUITES", "Split", "Suite", "is_bench",
            "materialise", "open_split", "read_bench", "register", "relabel", "run_bench", "split_hash", "suite_named",
            "verify_bench"]

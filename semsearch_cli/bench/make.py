@@ -21,6 +21,7 @@ from ..runner.specs import Loaded
 from ..shipped import CONFIGS
 from ..tasks.episodes import EPISODE_COLUMNS
 from ..world.buildings.numbered import generate_building
+from .predictability import predictability
 from .suites import Suite, write_manifest
 
 DEFAULT_PLANNER = [{"name": "nsos", "alpha": 0.9}]  # what `semsearch run FLOOR/scenario.yaml` runs; a bench run sets its own
@@ -50,35 +51,66 @@ def freeze_episodes(scenario: Path, repeats: int) -> int:
     return len(eps)
 
 
-# doors-v1's floors: (layout, numbering convention, weight); `random` is the control on which no
-# planner can use the numbers
-DOORS_V1_MIX = [(lay, scheme, 1.0) for lay in ("grid", "wings", "angled", "single")
-                for scheme in ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks")]
-DOORS_V1_MIX += [(lay, "random", 1.0) for lay in ("grid", "wings", "angled", "single")]
+# doors-v1's mix. Calibrated on the label statistics of 142 public KTH floor plans
+# (benchmarks/kth_labels.py; docs/bench.md quotes the table):
+P_PARITY = 0.23  # floors whose walls each carry one parity (KTH: parity statistic >= 0.5 on 23% of floors)
+P_LETTERS = 0.63  # floors with lettered doors (KTH: 63% of floors)
+LETTERS = (0.08, 0.41)  # a lettered floor's share of lettered doors, uniform (KTH: the interquartile range)
+SKIP = (0.43, 0.83)  # share of numbers skipped, uniform (KTH: the interquartile range)
+# Stated choices, not calibrated (the KTH floors have no prefixes, no dotted labels, and no record
+# of extensions or layouts):
+P_RANDOM = 0.10  # the random-numbering control
+P_EXTENSION = 0.15  # the last corridor renumbered in a block of its own
+STYLES = (("plain", 0.8), ("wing", 0.1), ("dot", 0.1))
+LAYOUTS = ("grid", "wings", "angled", "single", "hall")  # uniform
+PARITY_SCHEMES = ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks")  # uniform
+SEQUENTIAL_SCHEMES = ("loop",)
+SPACING = 2.5  # m between door slots
 DOORS_V1_FLOORS = {"val": 40, "test": 40}
 DOORS_V1_STARTS = 5  # drawn per goal
 DOORS_V1_MIN_DISTANCE = 10.0  # m, geodesic from a start to its goal
 
 
+def draw_floor(rng: np.random.Generator) -> dict:
+    """One floor's recipe from doors-v1's mix (the constants above)."""
+    if rng.random() < P_RANDOM:
+        scheme = "random"
+    elif rng.random() < P_PARITY:
+        scheme = PARITY_SCHEMES[int(rng.integers(len(PARITY_SCHEMES)))]
+    else:
+        scheme = SEQUENTIAL_SCHEMES[int(rng.integers(len(SEQUENTIAL_SCHEMES)))]
+    names, w = zip(*STYLES)
+    return {"layout": LAYOUTS[int(rng.integers(len(LAYOUTS)))], "numbering": scheme, "seed": int(rng.integers(2**31)),
+            "spacing": SPACING, "skip": round(float(rng.uniform(*SKIP)), 3),
+            "letters": round(float(rng.uniform(*LETTERS)), 3) if rng.random() < P_LETTERS else 0.0,
+            "extension": bool(rng.random() < P_EXTENSION), "style": str(rng.choice(names, p=np.array(w) / sum(w))),
+            "letter_case": "lower" if rng.random() < 0.5 else "upper"}
+
+
 def make_doors_v1(split: str, salt: str, out: Path) -> None:
-    """``doors-v1``: :data:`DOORS_V1_FLOORS` floors drawn from :data:`DOORS_V1_MIX`, each with
-    its generator's four goals and :data:`DOORS_V1_STARTS` starts per goal."""
+    """``doors-v1``: :data:`DOORS_V1_FLOORS` floors drawn by :func:`draw_floor`, each with its
+    generator's four goals and :data:`DOORS_V1_STARTS` starts per goal; each floor's recipe
+    records its predictability (:mod:`.predictability`)."""
     out.mkdir(parents=True, exist_ok=True)
-    weights = np.array([w for *_, w in DOORS_V1_MIX], float)
     floors = []
     for i in range(DOORS_V1_FLOORS[split]):
         rng = floor_rng(salt, "doors-v1", split, i)
-        lay, scheme, _ = DOORS_V1_MIX[int(rng.choice(len(DOORS_V1_MIX), p=weights / weights.sum()))]
-        seed = int(rng.integers(2**31))
+        r = draw_floor(rng)
         fid = f"f{i:03d}"
-        path = generate_building(lay, scheme, seed, out / fid, spacing=3.0, name=f"doors-v1-{split}-{fid}",
-                                 planners=DEFAULT_PLANNER)
+        path = generate_building(r["layout"], r["numbering"], r["seed"], out / fid, spacing=r["spacing"],
+                                 name=f"doors-v1-{split}-{fid}", planners=DEFAULT_PLANNER, skip=r["skip"],
+                                 letters=r["letters"], extension=r["extension"], style=r["style"],
+                                 letter_case=r["letter_case"])
         doc = yaml.safe_load(path.read_text())
         doc["episodes"] = {"starts": DOORS_V1_STARTS, "seed": int(rng.integers(2**31)),
                            "min_distance": DOORS_V1_MIN_DISTANCE}
-        path.write_text(yaml.safe_dump(doc, sort_keys=False))
+        path.write_text(path.read_text().split("\n", 1)[0] + "\n" + yaml.safe_dump(doc, sort_keys=False))
         freeze_episodes(path, 1)
-        floors.append((fid, {"generator": "building", "layout": lay, "numbering": scheme, "seed": seed, "spacing": 3.0}))
+        d = pd.read_csv(path.parent / "doors.csv", dtype={"number": str}, keep_default_na=False)
+        p = predictability(d["number"].tolist(), d["x"], d["y"], d["facing"], fid)
+        floors.append((fid, {"generator": "building", **r, "signs": len(d),
+                             "predictability": {"order": round(p.order, 4), "parity": round(p.parity, 4),
+                                                "value": round(p.value, 4)}}))
     write_manifest(SUITE_DOORS, split, out, floors)
 
 

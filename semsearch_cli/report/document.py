@@ -84,7 +84,9 @@ class Document:
         return "\n".join(lines)
 
     # ---- HTML -------------------------------------------------------------------------
-    def html(self, title: str) -> str:
+    def html(self, title: str, sortable: bool = False) -> str:
+        """The page; with ``sortable`` a click on a table's header sorts its rows by that column
+        (by the number a cell starts with, else its text; a second click reverses)."""
         e = html.escape
         body: list[str] = []
         for b in self.blocks:
@@ -120,8 +122,20 @@ class Document:
                  "figcaption{color:#555;font-size:13px}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap;"
                  "overflow-wrap:anywhere;font-size:12px}code{background:#f3f3f3;overflow-wrap:anywhere}"
                  "blockquote{color:#555;border-left:3px solid #ccc;margin:1em 0;padding-left:1em}")
+        script = f"<script>{SORT_JS}</script>\n" if sortable else ""
         return (f"<!doctype html><html><head><meta charset=utf-8><title>{e(title)}</title><style>{style}</style></head><body>\n"
-                + "\n".join(body) + "\n</body></html>\n")
+                + "\n".join(body) + "\n" + script + "</body></html>\n")
+
+
+# a table sorted by a click on its header: by the number a cell starts with, else by its text
+SORT_JS = ("document.querySelectorAll('table').forEach(function(t){var hs=t.rows[0].cells;"
+           "Array.prototype.forEach.call(hs,function(h,k){h.style.cursor='pointer';h.title='sort';"
+           "h.addEventListener('click',function(){var rs=Array.prototype.slice.call(t.rows,1);"
+           "var up=h.dataset.dir!=='up';h.dataset.dir=up?'up':'down';"
+           "function v(r){var s=r.cells[k].textContent.trim();var n=parseFloat(s);return isNaN(n)?s:n;}"
+           "rs.sort(function(a,b){var x=v(a),y=v(b);var c=(typeof x==='number'&&typeof y==='number')?x-y:"
+           "String(x).localeCompare(String(y));return up?c:-c;});"
+           "rs.forEach(function(r){r.parentNode.appendChild(r);});});});});")
 
 
 def markdown_table(df: pd.DataFrame, mark_rows: bool = False, fmt: str = "{:.2f}") -> str:

@@ -11,7 +11,9 @@ Layouts (``LAYOUTS``):
   grid    corridors around room blocks, like the thesis' Normal map;
   wings   a long main corridor with perpendicular wings and a loop, like its Hotel;
   angled  corridors at 30 and 120 degrees off a main one, like its KTH floor;
-  single  one long corridor.
+  single  one long corridor;
+  hall    an open hall (a lobby: doors around its walls, open ends) with corridors leaving it east,
+          west and north.
 
 Numbering schemes (``SCHEMES``):
   odd-even-out  odd numbers on one wall, even on the other, rising with the distance from the
@@ -24,7 +26,16 @@ Numbering schemes (``SCHEMES``):
   corridor-parity-in  the same, rising from the corridor's ends toward its middle: their Inverse;
   floor         rising along each corridor, both walls in turn, floor digit first (201, 202, ...);
   blocks        one hundred-block per corridor (101.., 201.., ...), rising along it, with gaps;
+  loop          rising along one wall of each corridor to its end and back along the other, floor
+                digit first (201, 202, ... along the left wall, then the right): consecutive
+                numbers share a wall, so a wall has no parity (as on most KTH floors, docs/bench.md);
   random        a random permutation: the control case where no planner can use the signs.
+
+What real floors add on top of a scheme (:func:`generate_building`'s ``skip``, ``letters``,
+``extension`` and ``style``): numbers skipped (a slot numbered but without a door: rooms wider than
+one door spacing), a room's doors sharing its number with letter suffixes (``24a``, ``24b``), a
+later extension renumbered in a hundred-block of its own, and labels written with a wing prefix
+(``K201``) or as floor-dot-room (``2.14``).
 """
 
 from __future__ import annotations
@@ -42,8 +53,10 @@ from ...kernels.grid import dijkstra
 from ..scenario_folder import map_image, scenario_dict, write_building
 from ..importers.mobilesim import spread_goals
 
-LAYOUTS = ("grid", "wings", "angled", "single")
-SCHEMES = ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks", "random")
+LAYOUTS = ("grid", "wings", "angled", "single", "hall")
+SCHEMES = ("odd-even-out", "odd-even-in", "corridor-parity", "corridor-parity-in", "floor", "blocks", "loop", "random")
+STYLES = ("plain", "wing", "dot")  # how a number is written: 201, K201 (a wing prefix per corridor), 2.01
+WING_LETTERS = "ABCDEFGHJKLMNPRSTUVWXYZ"  # no I, O, Q: read as digits
 
 
 @dataclass(frozen=True)
@@ -108,6 +121,17 @@ def layout(name: str, rng: np.random.Generator) -> Plan:
         shift = (3.0 - min(xs), 3.0 - min(ys))
         cs = [Corridor((c.a[0] + shift[0], c.a[1] + shift[1]), (c.b[0] + shift[0], c.b[1] + shift[1]), c.width) for c in cs]
         return Plan(tuple(cs), (max(xs) + shift[0] + 3.0, max(ys) + shift[1] + 3.0), (cs[0].a[0] + 1.5, cs[0].a[1]))
+    if name == "hall":
+        # the hall is a wide corridor: rasterise() extends it by half its depth at both ends,
+        # open floor without doors; the corridors start at its walls
+        W, D = 16.0 + j(3), 10.0 + j(2)
+        east, west, north = 26.0 + j(4), 22.0 + j(4), 18.0 + j(3)
+        x0, y = 3.0 + west + D / 2, 3.0 + D / 2 + 1.0
+        cs = [Corridor((x0, y), (x0 + W, y), D),
+              Corridor((x0 + W + D / 2, y), (x0 + W + D / 2 + east, y)),
+              Corridor((x0 - D / 2 - west, y), (x0 - D / 2, y)),
+              Corridor((x0 + W / 2, y + D / 2), (x0 + W / 2, y + D / 2 + north))]
+        return Plan(tuple(cs), (x0 + W + D / 2 + east + 3.0, y + D / 2 + north + 3.0), (x0 + W / 2, y))
     raise ScenarioError("<command line>", "--layout", f"unknown layout {name!r}; valid: {', '.join(LAYOUTS)}")
 
 
@@ -221,6 +245,13 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
             count[cor] = count.get(cor, 0) + 1
             nums[k] = 100 * (cor + 1) + count[cor]
         return nums
+    if scheme == "loop":
+        # up the left wall (side +1) from a to b, back along the right wall from b to a
+        order = sorted(range(len(slots)), key=lambda k: (slots[k].corridor, -slots[k].side, slots[k].t * slots[k].side))
+        nums = [0] * len(slots)
+        for i, k in enumerate(order, start=1):
+            nums[k] = int(f"{floor}{i:02d}")
+        return nums
     if scheme == "random":
         return [int(x) for x in rng.permutation(len(slots)) + 1]
     raise ScenarioError("<command line>", "--numbering", f"unknown numbering scheme {scheme!r}; valid: {', '.join(SCHEMES)}")
@@ -267,36 +298,112 @@ def corridor_parity(slots: list[Slot], plan: Plan, outward: bool) -> list[int]:
 def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: float = 0.1,
                       spacing: float = 2.5, signs: int | None = None, goals: list | None = None,
                       name: str | None = None, density_delta: float = 2.5, planners: list | None = None,
-                      floor: int = 2, scale: float = 1.0) -> Path:
+                      floor: int = 2, scale: float = 1.0, skip: float = 0.0, letters: float = 0.0,
+                      extension: bool = False, style: str = "plain", letter_case: str = "lower") -> Path:
     """Write ``out/map.png``, ``out/doors.csv`` and ``out/scenario.yaml``; returns the YAML path.
 
     ``signs`` trims the doors (not the numbers) at random to that count, keeping ``goals``;
-    ``scale`` stretches the layout (see :func:`scaled`), corridors keeping their width.
+    ``scale`` stretches the layout (see :func:`scaled`), corridors keeping their width. What real
+    floors add (:func:`real_labels`): ``skip`` (0-0.95) the share of numbered slots left without a
+    door, ``letters`` (0-0.9) the share of doors that share a room's number with a letter suffix,
+    ``extension`` the last corridor renumbered in a hundred-block of its own, ``style`` how labels
+    are written (:data:`STYLES`). Goals given by number must survive these (the default goals are
+    drawn after them).
     """
+    if style not in STYLES:
+        raise ScenarioError("<command line>", "--style", f"unknown label style {style!r}; valid: {', '.join(STYLES)}")
+    if not (0.0 <= skip <= 0.95 and 0.0 <= letters <= 0.9):
+        raise ScenarioError("<command line>", "--skip" if not 0.0 <= skip <= 0.95 else "--letters",
+                            "a share: --skip between 0 and 0.95, --letters between 0 and 0.9")
     rng = np.random.default_rng(seed)
     plan = scaled(layout(layout_name, rng), scale)
     img, frame = rasterise(plan, res)
     slots = door_slots(plan, img, frame, spacing)
     nums = number_slots(slots, plan, scheme, img, frame, rng, floor)
     keep = [i for i, s in enumerate(slots) if s.ok and nums[i] > 0]  # 0: a slot the scheme leaves unsigned
-    goal_set = {int(g) for g in goals or []}
-    missing = goal_set - {nums[i] for i in keep}
+    goal_set = {int(g) if isinstance(g, int) else g for g in goals or []}
+    if skip > 0.0:  # drawn from their own generator: a floor with skip=0 is the one without
+        sub = np.random.default_rng([seed, 1])
+        keep = [i for i in keep if nums[i] in goal_set or sub.random() >= skip]
+    labels = {i: nums[i] for i in keep}
+    if letters > 0.0 or extension or style != "plain":
+        labels = real_labels(slots, keep, nums, np.random.default_rng([seed, 2]), letters, extension, style, floor,
+                             letter_case)
+        keep = [i for i in keep if i in labels]
+    missing = goal_set - set(labels.values())
     if missing:
-        raise ScenarioError("<command line>", "--goals", f"no door of this building carries {sorted(missing)} "
+        raise ScenarioError("<command line>", "--goals", f"no door of this building carries {sorted(missing, key=str)} "
                             f"(numbers run {min(n for n in nums if n > 0)}..{max(nums)} with gaps at junctions)")
     if signs is not None:
         if signs > len(keep):
             raise ScenarioError("<command line>", "--signs", f"the building has room for {len(keep)} signs at {spacing} m spacing, fewer than {signs}")
-        spare = [i for i in keep if nums[i] not in goal_set]
+        spare = [i for i in keep if labels[i] not in goal_set]
         drop = set(rng.choice(spare, size=len(keep) - signs, replace=False).tolist()) if len(keep) > signs else set()
         keep = [i for i in keep if i not in drop]
     free = img == 255
-    snapped = [(nums[i], slots[i].x, slots[i].y, slots[i].facing) for i in keep]
+    snapped = [(labels[i], slots[i].x, slots[i].y, slots[i].facing) for i in keep]
     if not goals:
         goals = spread_goals(free, frame, snapped, plan.start)
     scen = scenario_dict(name or f"{layout_name}-{scheme}-{seed}", res, plan.start, goals, planners, density_delta)
-    return write_building(out, img, sorted(snapped), scen,
-                          f"generated by `semsearch generate building --layout {layout_name} --numbering {scheme} --seed {seed}`")
+    extra = "".join(f" --{k} {v}" for k, v in (("skip", skip), ("letters", letters), ("style", style)) if v not in (0.0, "plain"))
+    extra += " --extension" if extension else ""
+    return write_building(out, img, sorted(snapped, key=lambda s: (str(type(s[0])), s[0], s[1], s[2])), scen,
+                          f"generated by `semsearch generate building --layout {layout_name} --numbering {scheme} --seed {seed}{extra}`")
+
+
+def real_labels(slots: list[Slot], keep: list[int], nums: list[int], rng: np.random.Generator, letters: float,
+                extension: bool, style: str, floor: int, letter_case: str = "lower") -> dict:
+    """The label of each kept slot (``{slot: label}``), as real floors write them:
+
+    - ``letters``: walking each wall's doors in order, a door starts a room of 2 doors (3 in one
+      case of 4) with probability ``letters / 2.25``; the room's doors carry its first door's
+      number with the suffixes a, b, c (``letter_case``), the others' numbers are skipped;
+    - ``extension``: the last corridor with doors is renumbered by a whole number of hundreds,
+      into a hundred-block above every other number (parity kept);
+    - ``style``: ``plain`` numbers; ``wing``: a wing letter per corridor before the number
+      (``K201``); ``dot``: floor-dot-room (``2.14``) when every number lies in the floor's
+      hundred-block (else plain: a number outside it has no room part)."""
+    num = {i: nums[i] for i in keep}
+    if extension:
+        cors = sorted({slots[i].corridor for i in keep})
+        if len(cors) >= 2:
+            last = [i for i in keep if slots[i].corridor == cors[-1]]
+            rest = [num[i] for i in keep if slots[i].corridor != cors[-1]]
+            offset = (max(rest) // 100 + 2) * 100 - (min(num[i] for i in last) // 100) * 100
+            for i in last:
+                num[i] += offset
+    suffix = {i: "" for i in keep}
+    if letters > 0.0:
+        abc = "abc" if letter_case == "lower" else "ABC"
+        walls: dict = {}
+        for i in keep:
+            walls.setdefault((slots[i].corridor, slots[i].side), []).append(i)
+        for doors in walls.values():
+            doors.sort(key=lambda i: slots[i].t)
+            k = 0
+            while k < len(doors):
+                if rng.random() < letters / 2.25 and k + 1 < len(doors):
+                    size = 3 if rng.random() < 0.25 and k + 2 < len(doors) else 2
+                    room = doors[k : k + size]
+                    for j, i in enumerate(room):
+                        suffix[i] = abc[j]
+                        num[i] = num[room[0]]
+                    k += size
+                else:
+                    k += 1
+    if style == "dot" and not all(floor * 100 <= num[i] < floor * 100 + 100 for i in keep):
+        style = "plain"
+    start = int(rng.integers(len(WING_LETTERS)))
+    out = {}
+    for i in keep:
+        n, sfx = num[i], suffix[i]
+        if style == "wing":
+            out[i] = f"{WING_LETTERS[(start + slots[i].corridor) % len(WING_LETTERS)]}{n}{sfx}"
+        elif style == "dot":
+            out[i] = f"{floor}.{n - floor * 100:02d}{sfx}"
+        else:
+            out[i] = f"{n}{sfx}" if sfx else n
+    return out
 
 
 def generate_batch(out: Path, seeds: int = 3, layouts=LAYOUTS, schemes=SCHEMES, spacing: float = 3.0,

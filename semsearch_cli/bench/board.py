@@ -1,0 +1,206 @@
+"""``semsearch bench board``: the results page of one or more bench folders (HTML and Markdown).
+
+Per suite and split, every planner's success, SPL, SoftSPL and mean distance over the episodes,
+each with a 95% interval over episodes (the unit: a floor's episode, its repeats averaged); the
+paired difference in SPL to ``nsos[alpha=0.9]`` on the same episodes; the semantic gain (SPL under
+the true numbering minus SPL under shuffled labels, paired episode by episode) overall and per
+numbering convention, and the other numberings' differences; cost columns when the rows carry
+them; whether the folder was verified (``semsearch verify`` wrote its verdict beside the rows
+and the rows have not changed since); and whether the results are official (a test split's hash
+is the published one). Intervals: success, Wilson's interval widened for clustered runs
+(:func:`~semsearch_cli.report.stats.rate_ci`); means and differences, the BCa bootstrap over
+episodes (:func:`~semsearch_cli.report.stats.mean_ci`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import ScenarioError
+from ..files import atomic_text, output_folder
+from ..report.document import Document
+from ..report.figures.bench import plot_gain_vs_predictability
+from ..report.stats import mean_ci, rate_ci
+from ..runner import read_runs
+from .run import BENCH_FILE, is_bench, read_bench
+from .suites import SUITES, open_split
+
+BASELINE = "nsos[alpha=0.9]"
+VERIFY_FILE = "verify.json"
+COST_COLUMNS = ("calls", "tokens")  # a planner that reports its cost (language models) adds these to its rows
+
+
+def rows_digest(folder: Path) -> str:
+    """A digest of a bench folder's rows (every floor's runs.csv, in floor order): what a verdict
+    was reached on."""
+    h = hashlib.sha256()
+    for f in sorted(Path(folder).glob("*/runs.csv")):
+        h.update(f.parent.name.encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def write_verdict(folder: Path, split_hash: str, runs: int, verified: int, failed: int) -> None:
+    """Record a verification of a bench folder beside its rows (``verify.json``)."""
+    atomic_text(Path(folder) / VERIFY_FILE, json.dumps({"hash": split_hash, "runs": runs, "verified": verified,
+                                                        "failed": failed, "rows": rows_digest(folder)}, indent=1) + "\n")
+
+
+def verdict_of(folder: Path, split_hash: str) -> str:
+    """How a folder stands: ``verified`` (every run replayed, on these rows), ``failed``,
+    ``changed`` (rows written since the verification), or ``not verified``."""
+    f = Path(folder) / VERIFY_FILE
+    if not f.is_file():
+        return "not verified"
+    try:
+        v = json.loads(f.read_text())
+    except ValueError:
+        return "not verified"
+    if v.get("hash") != split_hash or v.get("rows") != rows_digest(folder):
+        return "changed since verified"
+    return "verified" if v.get("failed") == 0 and v.get("verified") == v.get("runs") else f"{v.get('failed')} failed"
+
+
+def load(folders) -> pd.DataFrame:
+    """Every row of the bench folders, with ``unit`` (floor/episode), ``verdict``, ``official``
+    and each floor's convention and predictability (from its split's recipe)."""
+    frames = []
+    for folder in folders:
+        folder = Path(folder)
+        if not is_bench(folder):
+            raise ScenarioError(str(folder), "", f"no {BENCH_FILE} here: give folders written by `semsearch bench run`")
+        meta = read_bench(folder)
+        sp = open_split(meta["suite"], meta["split"]) if meta["split"] not in SUITES[meta["suite"]].hidden else None
+        recipe = {f.id: f.recipe for f in sp.floors} if sp is not None else {}
+        for f in sorted(folder.glob("*/runs.csv")):
+            r = read_runs(f)
+            r = r[r["stage"] == ""]
+            if not len(r):
+                continue
+            r = r.assign(verdict=verdict_of(folder, meta["hash"]), official=bool(meta.get("official")),
+                         folder=str(folder), unit=r["floor"].astype(str) + "/" + r["episode"].astype(str))
+            rec = recipe.get(f.parent.name, {})
+            r["convention"] = rec.get("numbering", rec.get("scenario", f.parent.name))
+            r["predictability"] = (rec.get("predictability") or {}).get("value", np.nan)
+            frames.append(r)
+    if not frames:
+        raise ScenarioError(str(folders[0]), "", "the bench folders hold no rows")
+    return pd.concat(frames, ignore_index=True)
+
+
+def _ci(m, lo, hi, fmt="{:.3f}") -> str:
+    if not np.isfinite(m):
+        return ""
+    return fmt.format(m) + ("" if not (np.isfinite(lo) and np.isfinite(hi)) else f" [{fmt.format(lo)}, {fmt.format(hi)}]")
+
+
+def paired_diff(a: pd.DataFrame, b: pd.DataFrame, value: str = "spl") -> tuple[float, float, float, int]:
+    """Mean over shared episodes of (a - b) in ``value`` (each side's repeats averaged per
+    episode), its 95% BCa interval over episodes, and the number of episodes paired."""
+    ma = a.groupby("unit")[value].mean()
+    mb = b.groupby("unit")[value].mean()
+    common = ma.index.intersection(mb.index)
+    d = (ma[common] - mb[common]).to_numpy(float)
+    if not len(d):
+        return np.nan, np.nan, np.nan, 0
+    m, lo, hi = mean_ci(d, np.arange(len(d)))
+    return m, lo, hi, len(d)
+
+
+def tables(rows: pd.DataFrame) -> dict:
+    """The board's tables of one suite and split (keys: planners, conventions, numberings,
+    floors)."""
+    true = rows[rows["numbering"] == "true"]
+    planners = list(dict.fromkeys(true["planner"]))
+    out = []
+    for lab in planners:
+        d = true[true["planner"] == lab]
+        s, slo, shi = rate_ci(d["success"].to_numpy(float), d["unit"].to_numpy())
+        row = {"planner": lab, "episodes": d["unit"].nunique(), "runs": len(d),
+               "success": _ci(s, slo, shi), "SPL": _ci(*mean_ci(d["spl"].to_numpy(float), d["unit"].to_numpy())),
+               "SoftSPL": _ci(*mean_ci(d["soft_spl"].to_numpy(float), d["unit"].to_numpy())),
+               "distance m": _ci(*mean_ci(d["distance_m"].to_numpy(float), d["unit"].to_numpy()), fmt="{:.1f}")}
+        base = true[true["planner"] == BASELINE]
+        if lab != BASELINE and len(base):
+            m, lo, hi, n = paired_diff(d, base)
+            row[f"SPL - {BASELINE}"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
+        else:
+            row[f"SPL - {BASELINE}"] = ""
+        sh = rows[(rows["numbering"] == "shuffled") & (rows["planner"] == lab)]
+        m, lo, hi, n = paired_diff(d, sh) if len(sh) else (np.nan, np.nan, np.nan, 0)
+        row["semantic gain"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
+        for c in COST_COLUMNS:
+            if c in d.columns and pd.to_numeric(d[c], errors="coerce").notna().any():
+                row[f"{c} per run"] = f"{pd.to_numeric(d[c], errors='coerce').mean():.1f}"
+        row["verified"] = ", ".join(sorted(set(d["verdict"])))
+        row["official"] = "yes" if d["official"].all() else "no"
+        out.append(row)
+    planners_df = pd.DataFrame(out)
+    conv, numb, floors = [], [], []
+    for lab in planners:
+        d = true[true["planner"] == lab]
+        sh = rows[(rows["numbering"] == "shuffled") & (rows["planner"] == lab)]
+        if len(sh):
+            row = {"planner": lab}
+            for c in sorted(set(d["convention"])):
+                m, lo, hi, n = paired_diff(d[d["convention"] == c], sh)
+                row[c] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
+            conv.append(row)
+            for fid, g in d.groupby("floor"):
+                m, _, _, n = paired_diff(g, sh)
+                if n:
+                    floors.append({"planner": lab, "floor": fid, "convention": g["convention"].iloc[0],
+                                   "predictability": float(g["predictability"].iloc[0]), "gain": m, "episodes": n})
+        row = {"planner": lab}
+        for how in ("shuffled", "parity-flipped", "reversed"):
+            other = rows[(rows["numbering"] == how) & (rows["planner"] == lab)]
+            m, lo, hi, n = paired_diff(d, other) if len(other) else (np.nan, np.nan, np.nan, 0)
+            row[f"true - {how}"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
+        if any(row[k] for k in row if k != "planner"):
+            numb.append(row)
+    return {"planners": planners_df, "conventions": pd.DataFrame(conv), "numberings": pd.DataFrame(numb),
+            "floors": pd.DataFrame(floors)}
+
+
+def board(folders, out: str | Path) -> list[Path]:
+    """Write ``out/index.html`` and ``out/board.md`` (and the figure) for the bench folders."""
+    out = output_folder(out)
+    rows = load(folders)
+    doc = Document()
+    doc.heading(1, "semsearch-bench results")
+    doc.para("Per suite and split: each planner over the episodes of its true numbering; intervals are 95% over episodes "
+             "(a floor's start/goal problem; its repeats averaged). Success: Wilson's interval widened for clustered runs; "
+             "SPL, SoftSPL, distance and every difference: the BCa bootstrap over episodes. Differences are paired: the two "
+             "sides ran the same episodes. Semantic gain: SPL under the floor's true numbering minus SPL under its labels "
+             "shuffled among its signs. Click a column's header to sort.")
+    written = []
+    for (suite, split), g in rows.groupby(["suite", "split"], sort=False):
+        t = tables(g)
+        hashes = sorted(set(g["suite_hash"].astype(str)))
+        doc.heading(2, f"{suite} {split}")
+        doc.para(f"suite hash {', '.join(h[:16] for h in hashes)}; {g['unit'].nunique()} episodes; numberings run: "
+                 f"{', '.join(sorted(set(g['numbering'])))}; "
+                 + ("official (the published hash)" if g["official"].all() else "not official (no published hash matches)"))
+        doc.table(t["planners"].set_index("planner"), fmt="{}")
+        if len(t["conventions"]):
+            doc.heading(3, "Semantic gain per numbering convention (SPL, true minus shuffled)")
+            doc.table(t["conventions"].set_index("planner"), fmt="{}")
+        if len(t["numberings"]):
+            doc.heading(3, "SPL under the true numbering minus under each permutation")
+            doc.table(t["numberings"].set_index("planner"), fmt="{}")
+        if len(t["floors"]) and t["floors"]["predictability"].notna().any():
+            fig = out / f"gain_vs_predictability_{suite}_{split}.png"
+            written += plot_gain_vs_predictability(t["floors"], fig)
+            doc.figure(fig, f"{suite} {split}: each floor's semantic gain (mean SPL over its episodes, true minus shuffled) "
+                       "against its predictability (docs/bench.md), marked by numbering convention, with the least-squares "
+                       "line over the floors.")
+            t["floors"].to_csv(out / f"floors_{suite}_{split}.csv", index=False)
+            written.append(out / f"floors_{suite}_{split}.csv")
+    atomic_text(out / "board.md", doc.markdown(out))
+    atomic_text(out / "index.html", doc.html("semsearch-bench results", sortable=True))
+    return [out / "index.html", out / "board.md", *written]
