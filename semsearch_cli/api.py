@@ -592,6 +592,9 @@ def bench_list() -> list[dict]:
                    "published": bench.PUBLISHED.get((s.name, split))}
             if split in s.hidden:
                 row.update(floors=None, goals=None, episodes=None, hash=None, hidden=True)
+            elif s.fetched and not bench.real.is_fetched(s):
+                row.update(floors=None, goals=None, episodes=None, hash=None, hidden=False, fetch=True,
+                           sources=len(bench.real.read_sources(s.name)["floors"]))
             else:
                 sp = bench.open_split(s.name, split)
                 eps = [pd.read_csv(f.scenario.parent / "episodes.csv", dtype=str, keep_default_na=False) for f in sp.floors]
@@ -607,6 +610,19 @@ def bench_board(folders, out: str | Path) -> list[Path]:
     if not folders:
         raise ScenarioError("<command line>", "FOLDERS", "give one or more bench results folders")
     return bench.board.board([Path(f) for f in folders], out)
+
+
+def bench_fetch(suite: str, from_dirs=(), mirror: str | None = None, partial: bool = False, progress=None):
+    """Fetch a track of floors that may not be shipped (:mod:`semsearch_cli.bench.real`) and
+    build its split in the cache; returns (the split, the floors left out with why)."""
+    s = bench.suite_named(suite)
+    if not s.fetched:
+        raise ScenarioError("<command line>", "SUITE", f"{suite} is shipped with semsearch: nothing to fetch (the tracks to "
+                            f"fetch: {', '.join(n for n, x in bench.SUITES.items() if x.fetched)})")
+    for d in from_dirs:
+        if not Path(d).is_dir():
+            raise ScenarioError(str(d), "--from", "no such folder")
+    return bench.real.fetch(s, [Path(d) for d in from_dirs], mirror, partial, progress)
 
 
 def bench_hash(suite: str, split: str = "val", salt_file: str | Path | None = None) -> bench.Split:

@@ -468,7 +468,10 @@ def bench_list():
     for col in ("suite", "split", "kind", "floors", "goals", "episodes", "repeats", "hash", "published"):
         t.add_column(col, overflow="fold", justify="right" if col in ("floors", "goals", "episodes", "repeats") else "left")
     for r in rows:
-        if r["hidden"]:
+        if r.get("fetch"):
+            t.add_row(r["suite"], r["split"], r["kind"], f"{r['sources']} to fetch", "", "", str(r["repeats"]),
+                      f"(semsearch bench fetch {r['suite']})", str(r["published"] or "")[:16])
+        elif r["hidden"]:
             pub = r["published"][:16] if r["published"] else "none yet (a maintainer's)"
             t.add_row(r["suite"], r["split"], r["kind"], "hidden", "", "", str(r["repeats"]), "(salt held by the maintainers)", pub)
         else:
@@ -524,6 +527,26 @@ def bench_board(
         _fail(exc)
     for f in files:
         out.print(f"wrote {f}")
+
+
+@bench_app.command("fetch")
+def bench_fetch(
+    suite: str = typer.Argument(..., help="A track of floors that may not be shipped (semsearch bench list)."),
+    from_dir: Optional[List[Path]] = typer.Option(None, "--from", help="A folder holding copies of the source files "
+                                                  "(found by name and SHA-256; repeatable)."),
+    mirror: Optional[str] = typer.Option(None, "--mirror", help="A URL standing for the sources' host (http://HOST:PORT)."),
+    partial: bool = typer.Option(False, "--partial", help="Build the split from the floors whose files were found (not official)."),
+):
+    """Fetch a track's source files (each checked by its SHA-256), import its floors and draw their
+    episodes, into the cache: then semsearch bench run SUITE runs it."""
+    try:
+        sp, missing = api.bench_fetch(suite, from_dir or [], mirror, partial)
+    except ScenarioError as exc:
+        _fail(exc)
+    for m in missing:
+        err.print(f"left out: {m}", highlight=False, soft_wrap=True)
+    out.print(f"{suite}: {len(sp.floors)} floors in {sp.folder}; hash {sp.hash[:16]} "
+              + ("(the published hash: official)" if sp.official else "(not the published hash: not official)"))
 
 
 @bench_app.command("hash")

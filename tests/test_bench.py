@@ -2,22 +2,32 @@
 
 from __future__ import annotations
 
+import functools
 import html as html_lib
+import http.server
 import json
 import os
 import re
 import shutil
 import subprocess
+import threading
+import urllib.parse
 
+import numpy as np
 import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
 from semsearch_cli import api, bench
+from semsearch_cli.bench.board import at_budget, uis_budgets
 from semsearch_cli.bench.predictability import predictability
 from semsearch_cli.bench.suites import build, read_split
 from semsearch_cli.cli import app
-from semsearch_cli.runner import BatchOptions
+from semsearch_cli.planners import PLANNERS, Variant
+from semsearch_cli.runner import BatchOptions, Loaded
+from semsearch_cli.shipped import scenario_file
+
+from .conftest import REF
 
 runner = CliRunner()
 
@@ -59,7 +69,8 @@ def test_shuffled_is_seeded_by_the_floor():
 def test_a_renumbered_floor_keeps_every_sign_and_each_goal_door_in_its_place(tmp_path, how):
     sp = bench.open_split("doors-v1")
     # the first floor this numbering changes (one numbered with a single parity has no parity to flip)
-    floor = next(f for f in sp.floors if len(set(pd.read_csv(f.scenario.parent / "doors.csv")["number"] % 2)) == 2)
+    labels = {f.id: pd.read_csv(f.scenario.parent / "doors.csv", dtype=str)["number"].tolist() for f in sp.floors}
+    floor = next(f for f in sp.floors if any(a != b for a, b in bench.relabel(labels[f.id], how, f.id).items()))
     true = bench.materialise(sp, floor, "true", tmp_path / "true")
     other = bench.materialise(sp, floor, how, tmp_path / how)
     a = pd.read_csv(true.parent / "doors.csv", dtype=str)
@@ -187,7 +198,7 @@ USER_PLANNER = '''
 from semsearch_cli.planners import Decision, Planner, register_planner
 
 
-@register_planner("first-candidate")
+@register_planner("u_first_candidate")
 class FirstCandidate(Planner):
     """Always the first frontier candidate."""
 
@@ -201,10 +212,10 @@ class FirstCandidate(Planner):
 def test_a_users_planner_file_runs_on_the_bench_and_verifies_without_it(tmp_path):
     f = tmp_path / "mine.py"
     f.write_text(USER_PLANNER)
-    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner", "first-candidate", "--planner-file", str(f),
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner", "u_first_candidate", "--planner-file", str(f),
                               "--limit", "3", "--workers", "1", "--out", str(tmp_path / "mine")])
     assert res.exit_code == 0, res.stderr
-    assert "first-candidate" in res.stdout
+    assert "u_first_candidate" in res.stdout
     f.unlink()  # the planner is gone: its runs still verify from their decisions
     res = runner.invoke(app, ["verify", str(tmp_path / "mine"), "--workers", "1"])
     assert res.exit_code == 0 and "3 of 3 runs replayed" in res.stdout
@@ -281,3 +292,89 @@ def test_the_board_opens_in_a_browser_and_sorts_by_a_column(tmp_path):
     assert probe["headings"] == ["doors-v1 val"] and probe["images"] >= 1 and probe["broken"] == 0
     assert probe["up"] == sorted(probe["before"]) and probe["down"] == sorted(probe["before"], reverse=True)
     assert len(files) >= 2
+
+
+# -- indirect-v1 ------------------------------------------------------------------------------------
+
+def test_indirect_v1_val_holds_table_3s_rooms_and_starts():
+    sp = bench.open_split("indirect-v1")
+    eps = pd.read_csv(sp.floors[0].scenario.parent / "episodes.csv")
+    assert len(eps) == 1400 and eps.groupby(["goal", "room"]).size().eq(10).all() and eps["room"].nunique() == 20
+    frozen = Loaded.load(sp.floors[0].scenario).task
+    config = Loaded.load(scenario_file("indirect")).task
+    for a, b in zip(frozen.episodes[::350], config.episodes[::350]):  # the same starts, and the same searches from them
+        assert a.content == b.content
+        ra, rb = frozen.run(Variant("ISCG-PN-SM", ()), a, 0), config.run(Variant("ISCG-PN-SM", ()), b, 0)
+        assert (ra.outcome, ra.distance_m, ra.steps, ra.time_s) == (rb.outcome, rb.distance_m, rb.steps, rb.time_s)
+
+
+@pytest.mark.parametrize("planner", sorted(n for n, c in PLANNERS.items() if c.task == "indirect"))
+def test_every_indirect_method_verifies_exactly_on_a_slice(tmp_path, planner):
+    res = _run(tmp_path, planner, limit=2, suite="indirect-v1")
+    v = api.verify(res.out, workers=1).verdict
+    assert (v.runs, v.verified, v.failed) == (2, 2, [])
+
+
+def test_the_uis_budget_is_the_least_time_at_which_uis_reaches_the_papers_rate():
+    # 100 searches at 1 m that find the target at 1, 2, ..., 90 s and 10 that never do
+    t = pd.DataFrame({"method": "UIS", "scale": 1.0, "success": [1] * 90 + [0] * 10,
+                      "time_s": [float(k) for k in range(1, 91)] + [300.0] * 10})
+    b = uis_budgets(t)
+    assert b[1.0] == 28.0  # the paper's UIS at 1 m: 28%, reached at the 28th search's time
+    assert np.isnan(b[2.5]) or b[2.5] == 65.0  # no searches at 2.5 m here: nan
+    assert at_budget(t, b)["success"].sum() == 28
+    assert at_budget(t, 60.0)["success"].sum() == 60
+
+
+# -- real floors, fetched by their SHA-256 -------------------------------------------------------------
+
+@pytest.fixture
+def mirror(tmp_path):
+    """An HTTP server on loopback laid out as the track's sources' URLs, holding the files of
+    ../shared (the authors' three maps and one KTH floor): what `bench fetch --mirror` downloads."""
+    www = tmp_path / "www"
+    for fl in bench.real.read_sources("doors-real-v1")["floors"]:
+        for e in fl["files"].values():
+            local = next(iter(sorted(REF.rglob(e["name"]))), None)
+            if local is not None:
+                dest = www / urllib.parse.urlparse(e["url"]).path.lstrip("/")
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(local, dest)
+    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(www))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    yield f"http://127.0.0.1:{server.server_address[1]}", www
+    server.shutdown()
+
+
+@pytest.mark.skipif(not REF.is_dir(), reason=f"the authors' reference maps are not at {REF} (../shared absent)")
+def test_the_real_track_is_fetched_over_http_checked_and_runs(tmp_path, monkeypatch, mirror):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
+    url, _ = mirror
+    with pytest.raises(api.ScenarioError, match="--partial"):  # the KTH floors that ../shared lacks
+        api.bench_fetch("doors-real-v1", mirror=url)
+    sp, missing = api.bench_fetch("doors-real-v1", mirror=url, partial=True)
+    ids = [f.id for f in sp.floors]
+    assert ids[:3] == ["normal", "inverse", "hotel"] and "kth-A0043016-0510035517_A_40_1_105" in ids and len(ids) == 4
+    assert missing and not sp.official  # a part of the track: never official
+    sources = {fl["id"]: fl for fl in bench.real.read_sources("doors-real-v1")["floors"]}
+    assert all(f.recipe["hash"] == sources[f.id]["hash"] for f in sp.floors)  # each floor is the one the track names
+    res = api.bench_run("doors-real-v1", ["nsos[alpha=0.9]"], tmp_path / "out", options=BatchOptions(workers=1), limit=2)
+    assert set(res.runs["floor"]) == {"normal"}
+    assert api.verify(res.out, workers=1).verdict.verified == 2
+
+
+@pytest.mark.skipif(not REF.is_dir(), reason=f"the authors' reference maps are not at {REF} (../shared absent)")
+def test_a_source_file_of_another_version_is_refused_by_its_sha(tmp_path, monkeypatch, mirror):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
+    url, www = mirror
+    doors = next(www.rglob("hotel2.doors"))
+    doors.write_text(doors.read_text().replace("148", "149", 1))
+    _, missing = api.bench_fetch("doors-real-v1", mirror=url, partial=True)
+    assert any(m.startswith("hotel: hotel2.doors: its SHA-256 is") for m in missing)
+
+
+def test_a_track_not_fetched_says_how_to_fetch_it(tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "empty"))
+    res = runner.invoke(app, ["bench", "run", "doors-real-v1", "--planner", "greedy", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "semsearch bench fetch doors-real-v1" in res.stderr

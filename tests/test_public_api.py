@@ -41,6 +41,7 @@ API = {
     "bench_run": ["suite", "planners", "out", "split", "numbering", "options", "limit", "salt_file", "planner_file", "progress"],
     "bench_list": [],
     "bench_hash": ["suite", "split", "salt_file"],
+    "bench_fetch": ["suite", "from_dirs", "mirror", "partial", "progress"],
     "bench_board": ["folders", "out"],
     "planner_spec": ["text", "module"],
     "presence": ["counts", "hours", "out"],

@@ -17,10 +17,12 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from ..config import load_scenario
 from ..runner.specs import Loaded
 from ..shipped import CONFIGS
 from ..tasks.episodes import EPISODE_COLUMNS
 from ..world.buildings.numbered import generate_building
+from ..world.rooms import generate_rooms, write_rooms
 from .predictability import predictability
 from .suites import Suite, write_manifest
 
@@ -44,7 +46,7 @@ def freeze_episodes(scenario: Path, repeats: int) -> int:
     rows.to_csv(scenario.parent / "episodes.csv", index=False, lineterminator="\n")
     doc = yaml.safe_load(scenario.read_text())
     doc["episodes"] = {"file": "episodes.csv"}
-    doc["planners"] = DEFAULT_PLANNER
+    doc.setdefault("planners", DEFAULT_PLANNER)
     doc.setdefault("experiment", {})["seeds"] = repeats
     header = "".join(line + "\n" for line in scenario.read_text().splitlines() if line.startswith("#"))
     scenario.write_text(header + yaml.safe_dump(doc, sort_keys=False))
@@ -142,7 +144,43 @@ def make_doors_classic(split: str, salt: str, out: Path) -> None:
     write_manifest(SUITE_CLASSIC, split, out, floors)
 
 
+INDIRECT_ROOMS = 20  # per split, as Table 3's
+INDIRECT_STARTS = 10  # drawn per room and view scale
+
+
+def make_indirect(split: str, salt: str, out: Path) -> None:
+    """``indirect-v1``: the paper's protocol as ``configs/indirect.yaml`` runs it (11 methods' rooms
+    of 6 m x 6 m, view scales 1.0-2.5 m, 5 minutes per search, :data:`INDIRECT_STARTS` starts per
+    room and scale), on :data:`INDIRECT_ROOMS` rooms written to ``rooms.yaml``: for ``val`` the
+    rooms of Table 3's experiment (the config's seed 0), for ``test`` rooms generated from the
+    split's salt."""
+    src = CONFIGS / "indirect.yaml"
+    doc = yaml.safe_load(src.read_text())
+    sc = load_scenario(src)
+    spec, gen = sc.indirect, sc.indirect.rooms
+    seed = gen.seed if split == "val" else int(floor_rng(salt, "indirect-v1", split, 0).integers(2**31))
+    dest = out / "rooms"
+    dest.mkdir(parents=True)
+    rooms = generate_rooms(INDIRECT_ROOMS, seed, spec.relations, spec.masks, spec.target, gen.size, gen.obstacles)
+    write_rooms(dest / "rooms.yaml", rooms)
+    doc["indirect"]["rooms"] = "rooms.yaml"
+    doc["episodes"] = {"starts": INDIRECT_STARTS, "seed": 0 if split == "val" else int(floor_rng(salt, "indirect-v1", split, 1).integers(2**31))}
+    doc["experiment"].pop("out", None)
+    (dest / "scenario.yaml").write_text(f"# configs/indirect.yaml on {INDIRECT_ROOMS} rooms frozen for indirect-v1 {split}\n"
+                                        + yaml.safe_dump(doc, sort_keys=False))
+    freeze_episodes(dest / "scenario.yaml", 1)
+    write_manifest(SUITE_INDIRECT, split, out, [("rooms", {"rooms": INDIRECT_ROOMS, "seed": seed if split == "val" else "salted"})])
+
+
 SUITE_DOORS = Suite("doors-v1", "doors", "generated floors: corridor layouts x numbering conventions, 4 goals x 5 drawn "
-                    "starts each", repeats=1, splits=("val", "test"), shipped=("val",), make=make_doors_v1, hidden=("test",))
+                    "starts each", repeats=1, splits=("val", "test"), shipped=("val",), make=make_doors_v1, hidden=("test",),
+                    labels="doors")
 SUITE_CLASSIC = Suite("doors-classic-v1", "doors", "the thesis' Hotel, Normal, Inverse and KTH floors with its own starts, "
-                      "10 repeats (Tables 4.2-4.10)", repeats=10, splits=("val",), shipped=("val",), make=make_doors_classic)
+                      "10 repeats (Tables 4.2-4.10)", repeats=10, splits=("val",), shipped=("val",), make=make_doors_classic,
+                      labels="doors")
+SUITE_INDIRECT = Suite("indirect-v1", "indirect", "Loncomilla et al.'s protocol: 20 rooms x 7 view scales x 10 starts, "
+                        "success within 60 s and 5 min, and at a budget calibrated on UIS", repeats=1, splits=("val", "test"),
+                        shipped=("val",), make=make_indirect, hidden=("test",))
+SUITE_REAL = Suite("doors-real-v1", "doors", "real floors fetched by their SHA-256 (semsearch bench fetch): the authors' "
+                    "Normal, Inverse and Hotel maps and KTH campus floors; 4 goals x 5 drawn starts each", repeats=1,
+                    splits=("val",), shipped=(), fetched=True, labels="doors")

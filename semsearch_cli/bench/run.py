@@ -40,6 +40,19 @@ def _label_value(text: str):
     return int(text) if text.isdigit() and (text == "0" or not text.startswith("0")) else text
 
 
+def _copy_named(doc, base: Path, dest: Path):
+    """``doc`` with every string that names a file beside the floor's scenario (its map, signs,
+    rooms, episodes, logs) copied into ``dest`` and renamed to the copy (its file name)."""
+    if isinstance(doc, dict):
+        return {k: _copy_named(v, base, dest) for k, v in doc.items()}
+    if isinstance(doc, list):
+        return [_copy_named(v, base, dest) for v in doc]
+    if isinstance(doc, str) and doc and "/" not in doc and (base / doc).is_file():
+        dest.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(base / doc, dest / doc)
+    return doc
+
+
 def materialise(split: Split, floor: Floor, numbering: str, dest: Path) -> Path:
     """Write ``floor`` into ``dest`` as it runs under ``numbering``: its scenario and every file
     it names, the signs' labels (and the goals and episodes with them) permuted by
@@ -47,21 +60,13 @@ def materialise(split: Split, floor: Floor, numbering: str, dest: Path) -> Path:
     if numbering not in NUMBERINGS:
         raise ScenarioError("<command line>", "--numbering", f"unknown numbering {numbering!r}; valid: {', '.join(NUMBERINGS)}")
     src = floor.scenario
-    doc = yaml.safe_load(src.read_text())
     dest.mkdir(parents=True, exist_ok=True)
-    names = {"image": doc["map"]["image"], "episodes": doc["episodes"]["file"]}
-    if "doors" in doc:
-        names["doors"] = doc["doors"]
-    for f in names.values():
-        shutil.copyfile(src.parent / f, dest / Path(f).name)
-    doc["map"]["image"] = Path(names["image"]).name
-    doc["episodes"]["file"] = Path(names["episodes"]).name
-    if "doors" in doc:
-        doc["doors"] = Path(names["doors"]).name
+    doc = _copy_named(yaml.safe_load(src.read_text()), src.parent, dest)
     if numbering != "true":
-        if "doors" not in doc:
-            raise ScenarioError("<command line>", "--numbering", f"{split.suite.name} has no door signs to renumber")
-        door_file = dest / doc["doors"]
+        key = split.suite.labels
+        if key is None or key not in doc:
+            raise ScenarioError("<command line>", "--numbering", f"{split.suite.name} has no labels to renumber")
+        door_file = dest / doc[key]
         with door_file.open(newline="") as fh:
             rows = list(csv.reader(fh))
         head, body = rows[0], rows[1:]

@@ -47,6 +47,8 @@ class Suite:
     shipped: tuple[str, ...]
     make: Callable[[str, str, Path], None] | None = field(default=None, compare=False, repr=False)
     hidden: tuple[str, ...] = ()  # splits drawn from a secret salt
+    fetched: bool = False  # made of floors that may not be shipped: built by `semsearch bench fetch` (bench/real.py)
+    labels: str | None = None  # the scenario key of the file whose labels --numbering permutes (None: no labels)
 
 
 SUITES: dict[str, Suite] = {}
@@ -175,6 +177,8 @@ def open_split(name: str, split: str = "val", salt_file: str | Path | None = Non
     suite = suite_named(name)
     if split not in suite.splits:
         raise ScenarioError("<command line>", "--split", f"{name} has no split {split!r}; its splits: {', '.join(suite.splits)}")
+    if suite.fetched:
+        return read_split(suite, split, fetched_folder(suite))
     if split in suite.hidden:
         if salt_file is None:
             raise ScenarioError("<command line>", "--salt-file", f"{name} {split} is drawn from a secret salt that the "
@@ -189,6 +193,17 @@ def open_split(name: str, split: str = "val", salt_file: str | Path | None = Non
         raise ScenarioError("<command line>", "--salt-file", f"{name} {split} is public; a salt goes with a hidden split "
                             f"({', '.join(suite.hidden) or 'this suite has none'})")
     return read_split(suite, split, DATA / name / split)
+
+
+def fetched_folder(suite: Suite) -> Path:
+    """The split folder the last ``semsearch bench fetch`` of ``suite`` built, or a
+    :class:`ScenarioError` saying to fetch it."""
+    cur = cache_dir() / "bench" / suite.name / "current"
+    folder = cur.parent / cur.read_text().strip() if cur.is_file() else None
+    if folder is None or not (folder / "suite.json").is_file():
+        raise ScenarioError("<command line>", "SUITE", f"{suite.name} is made of floors that semsearch may not ship: "
+                            f"fetch them first, semsearch bench fetch {suite.name} [--from DIR]")
+    return folder
 
 
 def build(suite: Suite, split: str, salt: str, folder: Path) -> None:
