@@ -1,12 +1,14 @@
-"""The val board of every built-in planner: each door planner on every door suite's val split
-(doors-v1 under its true and shuffled numberings, nsos[alpha=0.9] and greedy also under
-parity-flipped and reversed; doors-classic-v1 true), every folder verified by replay, and the
-board written (docs/bench-board.md and its figure). Prints the wall time of each run and each
-verification, their ratio, and the predictability per numbering convention.
+"""The val board of every built-in planner: each planner of a suite's kind on its val split
+(doors-v1 under its true and shuffled numberings, and with --ablation all nsos[alpha=0.9] and
+greedy under parity-flipped and reversed too; doors-classic-v1, indirect-v1 and objects-v1 true), every
+folder verified by replay, and the board written (docs/bench-board.md and its figure). Prints the
+wall time of each run and each verification, their ratio, and the predictability per numbering
+convention. Folders already complete are resumed (their runs not run again: the time then counts
+only what ran).
 
 Usage:
   python benchmarks/bench_board.py [--out results/bench] [--workers 2] [--site docs/bench-board]
-                                   [--suites doors-v1,doors-classic-v1] [--md FILE]
+                                   [--suites doors-v1,doors-classic-v1,indirect-v1,objects-v1] [--ablation shuffled|all] [--md FILE]
 """
 
 from __future__ import annotations
@@ -21,12 +23,24 @@ import pandas as pd
 from output import emit
 
 from semsearch_cli import api
-from semsearch_cli.bench import open_split
+from semsearch_cli.bench import SUITES, open_split
+from semsearch_cli.planners import PLANNERS
 from semsearch_cli.runner import BatchOptions
 
-DOOR_PLANNERS = ["nsos[alpha=0.9]", "greedy", "bvp", "draft", "geometric"]
-ABLATION = {"doors-v1": {"nsos[alpha=0.9]": ("shuffled", "parity-flipped", "reversed"), "greedy": ("shuffled", "parity-flipped", "reversed"),
-                         "bvp": ("shuffled",), "draft": ("shuffled",), "geometric": ("shuffled",)}}
+FIRST = {"doors": ["nsos[alpha=0.9]", "greedy"], "objects": ["lsos"]}  # listed first on the board; then the kind's other built-in planners
+
+
+def planners_of(kind: str) -> list[str]:
+    rest = sorted(n for n, c in PLANNERS.items() if c.task == kind and n not in {p.split("[")[0] for p in FIRST.get(kind, [])})
+    return FIRST.get(kind, []) + rest
+
+
+def numberings(suite: str, planner: str, ablation: str) -> tuple:
+    if suite != "doors-v1":
+        return ("true",)
+    if ablation == "all" and planner in ("nsos[alpha=0.9]", "greedy"):
+        return ("true", "shuffled", "parity-flipped", "reversed")
+    return ("true", "shuffled")
 
 
 def safe(label: str) -> str:
@@ -38,14 +52,14 @@ def main() -> int:
     ap.add_argument("--out", type=Path, default=Path("results/bench"))
     ap.add_argument("--site", type=Path, default=Path("docs/bench-board"))
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--suites", default="doors-v1,doors-classic-v1")
-    ap.add_argument("--planners", default=",".join(DOOR_PLANNERS))
+    ap.add_argument("--suites", default="doors-v1,doors-classic-v1,indirect-v1,objects-v1")
+    ap.add_argument("--ablation", default="all", choices=("shuffled", "all"))
     ap.add_argument("--md", type=Path)
     a = ap.parse_args()
     timings, folders = [], []
     for suite in a.suites.split(","):
-        for planner in a.planners.split(","):
-            for numbering in ("true", *ABLATION.get(suite, {}).get(planner, ())):
+        for planner in planners_of(SUITES[suite].kind):
+            for numbering in numberings(suite, planner, a.ablation):
                 out = a.out / suite / f"{safe(planner)}-{numbering}"
                 t0 = time.perf_counter()
                 res = api.bench_run(suite, [planner], out, numbering=numbering, options=BatchOptions(workers=a.workers))

@@ -598,8 +598,9 @@ def bench_list() -> list[dict]:
             else:
                 sp = bench.open_split(s.name, split)
                 eps = [pd.read_csv(f.scenario.parent / "episodes.csv", dtype=str, keep_default_na=False) for f in sp.floors]
-                row.update(floors=len(sp.floors), goals=sum(e["goal"].nunique() for e in eps), episodes=sum(len(e) for e in eps),
-                           hash=sp.hash, hidden=False)
+                rooms = sum(e["room"].nunique() for e in eps if (e["room"] != "").all())  # indirect search: rooms, not floors
+                row.update(floors=f"{rooms} rooms" if rooms else len(sp.floors), goals=sum(e["goal"].nunique() for e in eps),
+                           episodes=sum(len(e) for e in eps), hash=sp.hash, hidden=False)
             rows.append(row)
     return rows
 

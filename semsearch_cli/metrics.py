@@ -15,8 +15,9 @@ COLUMNS = ["kind", "scenario", "planner", "params", "goal", "episode", "seed", "
 BUILT_IN_KIND_COLUMNS = ("room", "stage", "map", "time_s")
 SHARED = [c for c in COLUMNS if c not in BUILT_IN_KIND_COLUMNS]  # what every kind's run row holds (run_row)
 # what a semsearch-bench run adds to each row (semsearch bench run): the suite, its split and that
-# split's hash, the numbering its labels were run under, and the floor (a folder of the split)
-BENCH_COLUMNS = ("suite", "split", "suite_hash", "numbering", "floor")
+# split's hash, the numbering its labels were run under, the floor (a folder of the split), and the
+# SHA-256 of the run's decisions file (decisions/<run>.json: the record that replays it)
+BENCH_COLUMNS = ("suite", "split", "suite_hash", "numbering", "floor", "decisions_sha256")
 
 
 def columns_for(kind_columns) -> list[str]:

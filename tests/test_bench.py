@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import hashlib
 import html as html_lib
 import http.server
 import json
@@ -95,7 +96,7 @@ def test_every_shipped_split_has_its_published_hash():
             assert sp.hash == bench.PUBLISHED[(s.name, split)] and sp.official
 
 
-@pytest.mark.parametrize("suite", ["doors-v1", "doors-classic-v1"])
+@pytest.mark.parametrize("suite", ["doors-v1", "doors-classic-v1", "indirect-v1", "objects-v1"])
 def test_a_shipped_split_is_rebuilt_byte_for_byte_from_its_builder(tmp_path, suite):
     s = bench.SUITES[suite]
     build(s, "val", f"{suite}/val", tmp_path / "val")
@@ -130,6 +131,16 @@ def test_a_hidden_split_needs_its_salt_and_is_official_only_with_the_published_h
     assert res.exit_code == 0 and res.stdout.strip() == bench.open_split("doors-v1", "test", other).hash
 
 
+def test_bench_list_shows_every_split_with_its_size_and_hash(tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
+    rows = {(r["suite"], r["split"]): r for r in api.bench_list()}
+    assert (rows[("doors-v1", "val")]["floors"], rows[("doors-v1", "val")]["goals"], rows[("doors-v1", "val")]["episodes"]) == (40, 160, 800)
+    assert (rows[("indirect-v1", "val")]["floors"], rows[("indirect-v1", "val")]["episodes"]) == ("20 rooms", 1400)
+    assert rows[("doors-v1", "test")]["hidden"] and rows[("doors-real-v1", "val")].get("fetch")
+    res = runner.invoke(app, ["bench", "list"])
+    assert res.exit_code == 0 and "doors-classic-v1" in res.stdout and "= published" in res.stdout
+
+
 def test_a_short_salt_and_an_unknown_suite_are_refused_in_words(tmp_path):
     salt = tmp_path / "salt.txt"
     salt.write_text("short")
@@ -151,7 +162,9 @@ def test_every_built_in_door_planner_verifies_exactly_on_a_slice(tmp_path, plann
     res = _run(tmp_path, planner, limit=7)  # floor f000's 20 episodes are more than 7: one floor
     runs = res.runs
     assert len(runs) == 7 and set(runs["suite_hash"]) == {res.split.hash} and set(runs["floor"]) == {"f000"}
-    assert len(list((res.out / "f000" / "decisions").glob("*.json"))) == 7
+    files = sorted((res.out / "f000" / "decisions").glob("*.json"))
+    assert len(files) == 7  # and each row names its record by the SHA-256 of its bytes
+    assert sorted(runs["decisions_sha256"]) == sorted(hashlib.sha256(f.read_bytes()).hexdigest() for f in files)
     v = api.verify(res.out, workers=1).verdict
     assert (v.runs, v.verified, v.failed) == (7, 7, [])
 
@@ -166,18 +179,23 @@ def test_a_slice_spans_floors_and_resumes(tmp_path):
 def test_verify_names_a_tampered_distance_and_a_truncated_decision_sequence(tmp_path):
     res = _run(tmp_path, "nsos[alpha=0.9]", limit=3)
     f = res.out / "f000" / "runs.csv"
+    decisions = res.out / "f000" / "decisions"
     rows = pd.read_csv(f, dtype=str, keep_default_na=False)
-    rows.loc[0, "distance_m"] = str(float(rows.loc[0, "distance_m"]) - 1.0)
+    rows.loc[0, "distance_m"] = str(float(rows.loc[0, "distance_m"]) - 1.0)  # episode 0: a shorter distance
+    for ep in (1, 2):  # episode 1: a truncated record; episode 2: the same, and the row's digest changed to match
+        dec = sorted(decisions.glob(f"*ep{ep}__seed0.json"))[0]
+        rec = json.loads(dec.read_text())
+        rec["decisions"] = rec["decisions"][: len(rec["decisions"]) // 2]
+        dec.write_text(json.dumps(rec))
+        if ep == 2:
+            rows.loc[rows["episode"] == "2", "decisions_sha256"] = hashlib.sha256(dec.read_bytes()).hexdigest()
     rows.to_csv(f, index=False)
-    dec = sorted((res.out / "f000" / "decisions").glob("*ep1__seed0.json"))[0]
-    rec = json.loads(dec.read_text())
-    rec["decisions"] = rec["decisions"][: len(rec["decisions"]) // 2]
-    dec.write_text(json.dumps(rec))
     out = runner.invoke(app, ["verify", str(res.out), "--workers", "1"])
     assert out.exit_code == 1
     assert "floor f000: nsos[alpha=0.9] goal" in out.stdout and "episode 0 seed 0: distance_m" in out.stdout
-    assert "episode 1 seed 0: the replay stopped" in out.stdout
-    assert "1 of 3 runs replayed" in out.stdout
+    assert "is not the record the row names" in out.stdout  # episode 1
+    assert "episode 2 seed 0: the replay stopped" in out.stdout
+    assert "0 of 3 runs replayed" in out.stdout
 
 
 def test_a_folder_of_another_numbering_is_refused(tmp_path):
@@ -378,3 +396,30 @@ def test_a_track_not_fetched_says_how_to_fetch_it(tmp_path, monkeypatch):
     monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "empty"))
     res = runner.invoke(app, ["bench", "run", "doors-real-v1", "--planner", "greedy", "--out", str(tmp_path / "o")])
     assert res.exit_code == 2 and "semsearch bench fetch doors-real-v1" in res.stderr
+
+
+# -- objects-v1 ---------------------------------------------------------------------------------------
+
+def test_objects_v1_val_is_the_thesis_office_and_runs_as_semsearch_run_does(tmp_path):
+    res = api.bench_run("objects-v1", ["lsos"], tmp_path / "b", options=BatchOptions(workers=1), limit=1)
+    direct = api.run("office", BatchOptions(goals=["Static.mug@12"], planners=["lsos"], out=tmp_path / "r", workers=1), plots=False)
+    cols = ["goal", "episode", "seed", "start_x", "start_y", "start_heading", "outcome", "distance_m", "steps", "shortest_m"]
+    assert len(res.runs) == 10 and set(res.runs["goal"]) == {"Static.mug@12"}
+    assert (res.runs[cols].reset_index(drop=True) == direct.runs[cols].reset_index(drop=True)).all().all()
+
+
+@pytest.mark.parametrize("planner", sorted(n for n, c in PLANNERS.items() if c.task == "objects"))
+def test_every_object_planner_verifies_exactly_on_a_slice(tmp_path, planner):
+    res = _run(tmp_path, planner, limit=2, suite="objects-v1")  # 2 episodes x 10 repeats
+    v = api.verify(res.out, workers=1).verdict
+    assert (v.runs, v.verified, v.failed) == (20, 20, [])
+
+
+def test_the_objects_test_split_is_drawn_offices(tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
+    salt = tmp_path / "salt.txt"
+    salt.write_text("a test salt for the offices, not the project's")
+    sp = bench.open_split("objects-v1", "test", salt)
+    assert [f.id for f in sp.floors] == [f"o{i:03d}" for i in range(8)] and not sp.official
+    shortest = pd.concat([pd.read_csv(f.scenario.parent / "episodes.csv") for f in sp.floors])["shortest_m"]
+    assert len(shortest) == 8 * 13 and (shortest > 3.0).all()  # the mug never beside the start

@@ -32,7 +32,7 @@ from ..runner import read_runs
 from .run import BENCH_FILE, is_bench, read_bench
 from .suites import SUITES, open_split
 
-BASELINE = "nsos[alpha=0.9]"
+BASELINES = {"doors": "nsos[alpha=0.9]", "objects": "lsos"}  # each kind's planner of the thesis, the board's reference
 VERIFY_FILE = "verify.json"
 COST_COLUMNS = ("calls", "tokens")  # a planner that reports its cost (language models) adds these to its rows
 
@@ -119,6 +119,7 @@ def tables(rows: pd.DataFrame) -> dict:
     floors)."""
     true = rows[rows["numbering"] == "true"]
     planners = list(dict.fromkeys(true["planner"]))
+    baseline = BASELINES.get(str(rows["kind"].iloc[0]), "")
     out = []
     for lab in planners:
         d = true[true["planner"] == lab]
@@ -127,12 +128,12 @@ def tables(rows: pd.DataFrame) -> dict:
                "success": _ci(s, slo, shi), "SPL": _ci(*mean_ci(d["spl"].to_numpy(float), d["unit"].to_numpy())),
                "SoftSPL": _ci(*mean_ci(d["soft_spl"].to_numpy(float), d["unit"].to_numpy())),
                "distance m": _ci(*mean_ci(d["distance_m"].to_numpy(float), d["unit"].to_numpy()), fmt="{:.1f}")}
-        base = true[true["planner"] == BASELINE]
-        if lab != BASELINE and len(base):
+        base = true[true["planner"] == baseline]
+        if lab != baseline and len(base):
             m, lo, hi, n = paired_diff(d, base)
-            row[f"SPL - {BASELINE}"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
+            row[f"SPL - {baseline}"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
         else:
-            row[f"SPL - {BASELINE}"] = ""
+            row[f"SPL - {baseline}"] = ""
         sh = rows[(rows["numbering"] == "shuffled") & (rows["planner"] == lab)]
         m, lo, hi, n = paired_diff(d, sh) if len(sh) else (np.nan, np.nan, np.nan, 0)
         row["semantic gain"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
@@ -143,6 +144,7 @@ def tables(rows: pd.DataFrame) -> dict:
         row["official"] = "yes" if d["official"].all() else "no"
         out.append(row)
     planners_df = pd.DataFrame(out)
+    planners_df = planners_df.loc[:, [c for c in planners_df.columns if (planners_df[c].astype(str) != "").any()]]
     conv, numb, floors = [], [], []
     for lab in planners:
         d = true[true["planner"] == lab]

@@ -13,6 +13,7 @@ import hashlib
 import shutil
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import yaml
@@ -22,6 +23,7 @@ from ..runner.specs import Loaded
 from ..shipped import CONFIGS
 from ..tasks.episodes import EPISODE_COLUMNS
 from ..world.buildings.numbered import generate_building
+from ..world.buildings.office import random_office
 from ..world.rooms import generate_rooms, write_rooms
 from .predictability import predictability
 from .suites import Suite, write_manifest
@@ -172,6 +174,43 @@ def make_indirect(split: str, salt: str, out: Path) -> None:
     write_manifest(SUITE_INDIRECT, split, out, [("rooms", {"rooms": INDIRECT_ROOMS, "seed": seed if split == "val" else "salted"})])
 
 
+OFFICES = 8  # generated offices in a test split
+
+
+def make_objects(split: str, salt: str, out: Path) -> None:
+    """``objects-v1``: for ``val`` the thesis' office (``configs/office.yaml``: the five mug patterns
+    of Table 5.1, the combined and the moved-mug cases, requests at 12:00 and 00:00, its start);
+    for ``test`` :data:`OFFICES` offices drawn by
+    :func:`~semsearch_cli.world.buildings.office.random_office` from the split's salt. Ten
+    repeats of each episode (the start's heading drawn at each)."""
+    out.mkdir(parents=True, exist_ok=True)
+    floors = []
+    if split == "val":
+        src = CONFIGS / "office.yaml"
+        doc = yaml.safe_load(src.read_text())
+        dest = out / "office"
+        dest.mkdir()
+        f = src.parent / doc["map"]["image"]
+        shutil.copyfile(f, dest / f.name)
+        doc["map"]["image"] = f.name
+        (dest / "scenario.yaml").write_text("# the shipped scenario office (configs/office.yaml), frozen for objects-v1\n"
+                                            + yaml.safe_dump(doc, sort_keys=False))
+        freeze_episodes(dest / "scenario.yaml", 10)
+        floors.append(("office", {"scenario": "configs/office.yaml"}))
+    else:
+        for i in range(OFFICES):
+            rng = floor_rng(salt, "objects-v1", split, i)
+            fid = f"o{i:03d}"
+            img, doc = random_office(rng, name=f"objects-v1-{split}-{fid}")
+            dest = out / fid
+            dest.mkdir()
+            cv2.imwrite(str(dest / "map.png"), img)
+            (dest / "scenario.yaml").write_text(yaml.safe_dump(doc, sort_keys=False))
+            freeze_episodes(dest / "scenario.yaml", 10)
+            floors.append((fid, {"generator": "office"}))
+    write_manifest(SUITE_OBJECTS, split, out, floors)
+
+
 SUITE_DOORS = Suite("doors-v1", "doors", "generated floors: corridor layouts x numbering conventions, 4 goals x 5 drawn "
                     "starts each", repeats=1, splits=("val", "test"), shipped=("val",), make=make_doors_v1, hidden=("test",),
                     labels="doors")
@@ -184,3 +223,6 @@ SUITE_INDIRECT = Suite("indirect-v1", "indirect", "Loncomilla et al.'s protocol:
 SUITE_REAL = Suite("doors-real-v1", "doors", "real floors fetched by their SHA-256 (semsearch bench fetch): the authors' "
                     "Normal, Inverse and Hotel maps and KTH campus floors; 4 goals x 5 drawn starts each", repeats=1,
                     splits=("val",), shipped=(), fetched=True, labels="doors")
+SUITE_OBJECTS = Suite("objects-v1", "objects", "the thesis' office patterns (val: Table 5.1's five, combined, moved mug; 13 "
+                       "episodes) and generated offices (test), 10 repeats", repeats=10, splits=("val", "test"),
+                       shipped=("val",), make=make_objects, hidden=("test",))

@@ -160,7 +160,7 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
             if progress:
                 progress(row, base + n, total)
 
-        with Batch(loaded, specs, dest, options, stamp={**stamp, "floor": f.id}) as batch:
+        with Batch(loaded, specs, dest, options, stamp={**stamp, "floor": f.id}, own=("decisions_sha256",)) as batch:
             write_meta(dest, loaded)
             before = len(batch.done)
             rows = batch.run(tick)

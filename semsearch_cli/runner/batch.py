@@ -173,13 +173,14 @@ class Batch:
             rows = batch.run(progress)
 
     ``stamp``: columns written with the same value on every row (a bench run's suite, split,
-    hash, numbering and floor: :data:`~semsearch_cli.metrics.BENCH_COLUMNS`).
+    hash, numbering and floor: :data:`~semsearch_cli.metrics.BENCH_COLUMNS`); ``own``: columns
+    each run's rows bring themselves, written in this folder (a bench run's ``decisions_sha256``).
     """
 
     def __init__(self, loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
-                 stamp: dict | None = None):
+                 stamp: dict | None = None, own: tuple = ()):
         self.loaded, self.specs, self.out, self.options = loaded, specs, Path(out), options
-        self.stamp = dict(stamp or {})
+        self.stamp, self.own = dict(stamp or {}), tuple(own)
         self.variants = specs.variants if hasattr(specs, "variants") else list(dict.fromkeys(s.variant for s in specs))
         self.codes = {v.label: code_of(v)["hash"] for v in self.variants}
         self.done: pd.DataFrame | None = None
@@ -221,7 +222,7 @@ class Batch:
             serial = total == 0 or (executor == "processes" and total == 1)
             runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), options.start_method, executor,
                                                                    options.scheduler)
-        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *self.stamp]))
+        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *self.stamp, *self.own]))
         n = 0
         try:
             for rows in runner.rows(loaded, todo, out, watch):

@@ -20,7 +20,7 @@ from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
 from ..tasks.decisions import Recording
 from ..tasks.loop import running
 from .specs import Loaded, RunSpec
-from .store import save_run_files
+from .store import decisions_digest, save_run_files
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,12 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
         res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=msg)
     finally:
         running(None)
-    return task.rows(spec.variant, spec.episode, spec.seed, res), res
+    rows = task.rows(spec.variant, spec.episode, spec.seed, res)
+    if res.decisions_record is not None:  # a bench row names its record (metrics.BENCH_COLUMNS); other folders drop it
+        digest = decisions_digest(res.decisions_record)
+        for r in rows:
+            r["decisions_sha256"] = digest
+    return rows, res
 
 
 def identity(loaded: Loaded, spec: RunSpec) -> dict:

@@ -4,6 +4,7 @@ reports; and each run's path (and trace) beside it."""
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import math
@@ -243,12 +244,22 @@ def save_run_files(out: Path, stem: str, res) -> None:
         write_decisions(out / "decisions" / f"{stem}.json", res.decisions_record)
 
 
+def decisions_text(record: dict) -> str:
+    """A run's decisions record as the file holds it (compact JSON, one line)."""
+    return json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n"
+
+
+def decisions_digest(record: dict) -> str:
+    """The SHA-256 (hex) of a decisions file's bytes: what a bench row names its record by."""
+    return hashlib.sha256(decisions_text(record).encode("utf-8")).hexdigest()
+
+
 def write_decisions(path: Path, record: dict) -> None:
     """A run's decisions record (:mod:`semsearch_cli.tasks.decisions`) as compact JSON, atomically."""
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = temp_path(path)
     with open(tmp, "w", encoding="utf-8") as fh:
-        fh.write(json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n")
+        fh.write(decisions_text(record))
     os.replace(tmp, path)
 
 

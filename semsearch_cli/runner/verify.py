@@ -10,6 +10,7 @@ names the run."""
 
 from __future__ import annotations
 
+import hashlib
 import math
 import multiprocessing as mp
 import numbers
@@ -121,6 +122,9 @@ def _job(job) -> str:
 
 def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, want: list[dict], episodes: dict) -> str:
     """Why the run's replay does not give its rows, or "" when it does."""
+    named = str(want[0].get("decisions_sha256") or "")
+    if named and hashlib.sha256(f.read_bytes()).hexdigest() != named:
+        return f"{f.name} is not the record the row names (its SHA-256 differs from the row's decisions_sha256)"
     try:
         record = read_decisions(f)
     except ScenarioError as exc:
