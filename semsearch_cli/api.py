@@ -467,16 +467,18 @@ def presence(counts: str | Path, hours, out: str | Path | None = None) -> pd.Dat
 
 def generate_building(layout: str, numbering: str, seed: int, out: str | Path, spacing: float = 2.5, signs: int | None = None,
                       goals: list | None = None, name: str | None = None, scale: float = 1.0, skip: float = 0.0,
-                      letters: float = 0.0, extension: bool = False, style: str = "plain") -> Path:
+                      letters: float = 0.0, extension: bool = False, style: str = "plain", letter_case: str = "lower") -> Path:
     """Write a generated building into ``out`` (map.png, doors.csv and a scenario that runs as it
     is); returns the scenario's path. ``goals``: door numbers (default: four spread by distance).
     ``skip``, ``letters``, ``extension`` and ``style``: what real floors add (numbers skipped,
-    lettered doors, an extension renumbered, wing prefixes or floor-dot-room labels; see
+    lettered doors (``letter_case`` lower or upper), an extension renumbered, wing prefixes or
+    floor-dot-room labels; see
     :func:`~semsearch_cli.world.buildings.numbered.generate_building`)."""
     if goals and any(not isinstance(g, int) or isinstance(g, bool) for g in goals):
         raise ScenarioError("<command line>", "--goals", f"expected door numbers, got {','.join(map(str, goals))!r}")
     return numbered.generate_building(layout, numbering, seed, output_folder(out), spacing=spacing, signs=signs, goals=goals,
-                                      name=name, scale=scale, skip=skip, letters=letters, extension=extension, style=style)
+                                      name=name, scale=scale, skip=skip, letters=letters, extension=extension, style=style,
+                                      letter_case=letter_case)
 
 
 def _among(items, valid: tuple, flag: str) -> tuple:

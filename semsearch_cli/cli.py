@@ -584,17 +584,19 @@ def generate_building(
     scale: float = typer.Option(1.0, "--scale", callback=_finite, min=0.5, max=4.0,
                                 help="Stretch the layout this many times in x and y (scale^2 the area), corridors as wide."),
     skip: float = typer.Option(0.0, "--skip", callback=_finite, min=0.0, max=0.95,
-                               help="Share of numbered door slots left without a door (numbers skipped, as real floors do)."),
+                               help="Share of each prefix's number range left without a door (numbers skipped, as real floors do)."),
     letters: float = typer.Option(0.0, "--letters", callback=_finite, min=0.0, max=0.9,
                                   help="Share of doors that share a room's number with a letter suffix (24a, 24b)."),
     extension: bool = typer.Option(False, "--extension", help="Renumber the last corridor in a hundred-block of its own."),
     style: str = typer.Option("plain", "--style", help="plain (214), wing (K214: a wing letter per corridor) or dot (2.14)."),
+    letter_case: str = typer.Option("lower", "--letter-case", help="lower (24a) or upper (24A): the lettered doors' suffixes."),
 ):
     """Write a generated building: map PNG, doors CSV and a scenario YAML that runs as it is."""
     try:
         wanted = _split([goals], "--goals") if goals is not None else None
         path = api.generate_building(layout, numbering, seed, out_dir, spacing=spacing, signs=signs, goals=wanted, name=name,
-                                     scale=scale, skip=skip, letters=letters, extension=extension, style=style)
+                                     scale=scale, skip=skip, letters=letters, extension=extension, style=style,
+                                     letter_case=letter_case)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"wrote {out_dir / 'map.png'}, {out_dir / 'doors.csv'}, {path}")

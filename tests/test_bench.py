@@ -27,6 +27,7 @@ from semsearch_cli.cli import app
 from semsearch_cli.planners import PLANNERS, Variant
 from semsearch_cli.runner import BatchOptions, Loaded
 from semsearch_cli.shipped import scenario_file
+from semsearch_cli.world.buildings.numbered import generate_building
 
 from .conftest import REF
 
@@ -42,6 +43,11 @@ def test_parity_flip_swaps_each_odd_number_with_the_next_even_one():
 def test_reversed_trades_the_kth_smallest_with_the_kth_largest_within_each_prefix():
     got = bench.relabel(["K101", "K103", "K105", "B7", "B8", "Lab"], "reversed", "x")
     assert got == {"K101": "K105", "K103": "K103", "K105": "K101", "B7": "B8", "B8": "B7", "Lab": "Lab"}
+
+
+def test_parity_flip_pairs_across_skipped_numbers_and_reversed_carries_suffixes():
+    assert bench.relabel([23, 24, 26, 27, 28], "parity-flipped", "x") == {23: 24, 24: 23, 26: 27, 27: 26, 28: 28}
+    assert bench.relabel(["23", "24a", "24b", "25"], "reversed", "x") == {"23": "25", "24a": "24b", "24b": "24a", "25": "23"}
 
 
 def test_lettered_labels_trade_with_the_same_letter_only():
@@ -198,6 +204,19 @@ def test_verify_names_a_tampered_distance_and_a_truncated_decision_sequence(tmp_
     assert "0 of 3 runs replayed" in out.stdout
 
 
+def test_verify_fails_a_folder_that_is_no_floor_and_a_run_whose_record_was_taken_away(tmp_path):
+    res = _run(tmp_path, "greedy", limit=3)
+    shutil.copytree(res.out / "f000", res.out / "zzz")  # rows that name no floor of the split
+    next((res.out / "f000" / "decisions").glob("*ep2__seed0.json")).unlink()
+    out = runner.invoke(app, ["verify", str(res.out), "--workers", "1"])
+    assert out.exit_code == 1
+    assert "floor zzz: its rows: folder zzz is not a floor of doors-v1 val" in out.stdout
+    assert "floor f000: 1 run(s): have no decisions record" in out.stdout
+    board = api.bench_board([res.out], tmp_path / "site")  # the board reads the split's floors alone, and says it failed
+    md = (tmp_path / "site" / "board.md").read_text()
+    assert "| greedy | 3 | 3 |" in md and "failed" in md and board
+
+
 def test_a_folder_of_another_numbering_is_refused(tmp_path):
     _run(tmp_path, "greedy", limit=1)
     with pytest.raises(api.ScenarioError, match="numbering"):
@@ -331,6 +350,16 @@ def test_every_indirect_method_verifies_exactly_on_a_slice(tmp_path, planner):
     res = _run(tmp_path, planner, limit=2, suite="indirect-v1")
     v = api.verify(res.out, workers=1).verdict
     assert (v.runs, v.verified, v.failed) == (2, 2, [])
+
+
+def test_loop_numbers_run_on_past_99_doors_and_skip_leaves_that_share_of_the_range(tmp_path):
+    p = generate_building("grid", "loop", 3, tmp_path / "g", spacing=2.5)
+    nums = sorted(pd.read_csv(p.parent / "doors.csv")["number"])
+    assert nums[0] == 201 and len(nums) <= max(nums) - 200 < len(nums) + 20 and len(set(nums)) == len(nums)  # 299, 300, ... (no 2100)
+    q = generate_building("grid", "loop", 3, tmp_path / "s", spacing=2.5, skip=0.6)
+    kept = sorted(pd.read_csv(q.parent / "doors.csv")["number"])
+    gap = 1 - len(kept) / (kept[-1] - kept[0] + 1)
+    assert abs(gap - 0.6) < 0.01 and kept[0] == nums[0] and kept[-1] == nums[-1]
 
 
 def test_the_uis_budget_is_the_least_time_at_which_uis_reaches_the_papers_rate():

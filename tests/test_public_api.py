@@ -46,7 +46,7 @@ API = {
     "planner_spec": ["text", "module"],
     "presence": ["counts", "hours", "out"],
     "generate_building": ["layout", "numbering", "seed", "out", "spacing", "signs", "goals", "name", "scale", "skip", "letters",
-                          "extension", "style"],
+                          "extension", "style", "letter_case"],
     "generate_batch": ["out", "seeds", "runs", "layouts", "schemes"],
     "generate_rooms": ["n", "seed", "out", "size", "obstacles"],
     "import_mobilesim": ["map_file", "doors_file", "out", "options"],

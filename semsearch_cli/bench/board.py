@@ -30,7 +30,7 @@ from ..report.indirect import PAPER_SCALES, PAPER_TABLE3, claims_table
 from ..report.stats import mean_ci, rate_ci
 from ..runner import read_runs
 from .run import BENCH_FILE, is_bench, read_bench
-from .suites import SUITES, open_split
+from .suites import PUBLISHED
 
 BASELINES = {"doors": "nsos[alpha=0.9]", "objects": "lsos"}  # each kind's planner of the thesis, the board's reference
 VERIFY_FILE = "verify.json"
@@ -69,26 +69,34 @@ def verdict_of(folder: Path, split_hash: str) -> str:
 
 
 def load(folders) -> pd.DataFrame:
-    """Every row of the bench folders, with ``unit`` (floor/episode), ``verdict``, ``official``
-    and each floor's convention and predictability (from its split's recipe)."""
+    """Every row of the bench folders' floors (the floors bench.json lists; a row must name its
+    folder's floor and the folder's numbering), with ``unit`` (floor/episode), ``verdict``,
+    ``official`` (its suite hash is the published one) and each floor's convention and
+    predictability (bench.json, written at run time: the board needs no split at hand)."""
     frames = []
     for folder in folders:
         folder = Path(folder)
         if not is_bench(folder):
             raise ScenarioError(str(folder), "", f"no {BENCH_FILE} here: give folders written by `semsearch bench run`")
         meta = read_bench(folder)
-        sp = open_split(meta["suite"], meta["split"]) if meta["split"] not in SUITES[meta["suite"]].hidden else None
-        recipe = {f.id: f.recipe for f in sp.floors} if sp is not None else {}
-        for f in sorted(folder.glob("*/runs.csv")):
+        floors = meta.get("floors")
+        if not isinstance(floors, dict):
+            raise ScenarioError(str(folder / BENCH_FILE), "floors", "lists no floors: written by an older semsearch; run the "
+                                "bench into a fresh folder")
+        verdict = verdict_of(folder, meta["hash"])
+        for fid, info in floors.items():
+            f = folder / fid / "runs.csv"
+            if not f.is_file():
+                continue
             r = read_runs(f)
-            r = r[r["stage"] == ""]
+            r = r[(r["stage"] == "") & (r["floor"].astype(str) == fid) & (r["numbering"].astype(str) == meta["numbering"])]
             if not len(r):
                 continue
-            r = r.assign(verdict=verdict_of(folder, meta["hash"]), official=bool(meta.get("official")),
-                         folder=str(folder), unit=r["floor"].astype(str) + "/" + r["episode"].astype(str))
-            rec = recipe.get(f.parent.name, {})
-            r["convention"] = rec.get("numbering", rec.get("scenario", f.parent.name))
-            r["predictability"] = (rec.get("predictability") or {}).get("value", np.nan)
+            official = PUBLISHED.get((str(meta["suite"]), str(meta["split"])))
+            r = r.assign(verdict=verdict, official=r["suite_hash"].astype(str) == str(official), folder=str(folder),
+                         unit=r["floor"].astype(str) + "/" + r["episode"].astype(str),
+                         convention=str((info or {}).get("convention", fid)),
+                         predictability=float((info or {}).get("predictability") or np.nan))
             frames.append(r)
     if not frames:
         raise ScenarioError(str(folders[0]), "", "the bench folders hold no rows")
@@ -212,9 +220,10 @@ def indirect_tables(rows: pd.DataFrame) -> dict:
         row = {"planner": lab, "searches": len(d), "rooms": d["room"].nunique()}
         for b in INDIRECT_BUDGETS:
             row[f"success within {b:g} s"] = _ci(*rate_ci(at_budget(d, b)["success"].to_numpy(float), d["room"].to_numpy()))
-        if budgets:
-            row["success within the UIS budget"] = _ci(*rate_ci(at_budget(d, budgets)["success"].to_numpy(float),
-                                                                 d["room"].to_numpy()))
+        if budgets:  # over the view scales where UIS reaches the paper's rate at all
+            dc = d[d["scale"].map(lambda x: np.isfinite(budgets.get(x, np.nan)))]
+            row["success within the UIS budget"] = _ci(*rate_ci(at_budget(dc, budgets)["success"].to_numpy(float),
+                                                                 dc["room"].to_numpy())) if len(dc) else ""
         row["SPL"] = _ci(*mean_ci(d["spl"].to_numpy(float), d["room"].to_numpy()))
         row["verified"] = ", ".join(sorted(set(d["verdict"])))
         row["official"] = "yes" if d["official"].all() else "no"
@@ -240,9 +249,13 @@ def indirect_tables(rows: pd.DataFrame) -> dict:
         agreement["Spearman rho over the cells"] = round(float(spearmanr(cells["ours"], cells["paper"]).statistic), 3)
         taus = [kendalltau(g["ours"], g["paper"]).statistic for _, g in cells.groupby("scale") if len(g) >= 3]
         agreement["Kendall tau of the methods per view scale (mean)"] = round(float(np.nanmean(taus)), 3) if taus else np.nan
+    calibrated = true[true["scale"].map(lambda x: np.isfinite(budgets.get(x, np.nan)))] if budgets else true.iloc[:0]
     claims = []
-    for name, b in [*((f"within {x:g} s", x) for x in INDIRECT_BUDGETS), *((("within the UIS budget", budgets),) if budgets else ())]:
-        c = claims_table(at_budget(true, b))
+    for name, b, d in [*((f"within {x:g} s", x, true) for x in INDIRECT_BUDGETS),
+                       *((("within the UIS budget", budgets, calibrated),) if len(calibrated) else ())]:
+        c = claims_table(at_budget(d, b))
+        if isinstance(b, dict):  # a budget per view scale: growth with the scale is the calibration's, not a finding
+            c = c[~c["claim"].str.startswith("success grows")]
         claims.append(c.assign(budget=name))
     wide = cells.assign(cell=[f"{o:.0f} ({p})" for o, p in zip(cells["ours"], cells["paper"])]).pivot(
         index="method", columns="scale", values="cell") if len(cells) else pd.DataFrame()
@@ -289,10 +302,9 @@ def board(folders, out: str | Path) -> list[Path]:
              "sides ran the same episodes. Semantic gain: SPL under the floor's true numbering minus SPL under its labels "
              "shuffled among its signs. Click a column's header to sort.")
     written = []
-    for (suite, split), g in rows.groupby(["suite", "split"], sort=False):
-        hashes = sorted(set(g["suite_hash"].astype(str)))
-        doc.heading(2, f"{suite} {split}")
-        doc.para(f"suite hash {', '.join(h[:16] for h in hashes)}; {g['unit'].nunique()} episodes; numberings run: "
+    for (suite, split, hash_), g in rows.groupby(["suite", "split", "suite_hash"], sort=False):
+        doc.heading(2, f"{suite} {split}" + ("" if g["official"].all() else f" ({hash_[:16]})"))
+        doc.para(f"suite hash {hash_[:16]}; {g['unit'].nunique()} episodes; numberings run: "
                  f"{', '.join(sorted(set(g['numbering'])))}; "
                  + ("official (the published hash)" if g["official"].all() else "not official (no published hash matches)"))
         if (g["kind"] == "indirect").all():
@@ -307,13 +319,13 @@ def board(folders, out: str | Path) -> list[Path]:
             doc.heading(3, "SPL under the true numbering minus under each permutation")
             doc.table(t["numberings"].set_index("planner"), fmt="{}")
         if len(t["floors"]) and t["floors"]["predictability"].notna().any():
-            fig = out / f"gain_vs_predictability_{suite}_{split}.png"
+            fig = out / f"gain_vs_predictability_{suite}_{split}_{hash_[:8]}.png"
             written += plot_gain_vs_predictability(t["floors"], fig)
             doc.figure(fig, f"{suite} {split}: each floor's semantic gain (mean SPL over its episodes, true minus shuffled) "
                        "against its predictability (docs/bench.md), marked by numbering convention, with the least-squares "
                        "line over the floors.")
-            t["floors"].to_csv(out / f"floors_{suite}_{split}.csv", index=False)
-            written.append(out / f"floors_{suite}_{split}.csv")
+            t["floors"].to_csv(out / f"floors_{suite}_{split}_{hash_[:8]}.csv", index=False)
+            written.append(out / f"floors_{suite}_{split}_{hash_[:8]}.csv")
     atomic_text(out / "board.md", doc.markdown(out))
     atomic_text(out / "index.html", doc.html("semsearch-bench results", sortable=True))
     return [out / "index.html", out / "board.md", *written]

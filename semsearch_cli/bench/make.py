@@ -34,7 +34,7 @@ DEFAULT_PLANNER = [{"name": "nsos", "alpha": 0.9}]  # what `semsearch run FLOOR/
 def floor_rng(salt: str, suite: str, split: str, i: int) -> np.random.Generator:
     """The generator of floor ``i`` of a split: seeded by the split's salt, never by the order
     of other floors."""
-    words = np.frombuffer(hashlib.sha256(f"{suite}/{split}/{salt}/{i}".encode()).digest()[:16], np.uint32)
+    words = np.frombuffer(hashlib.sha256(f"{suite}/{split}/{salt}/{i}".encode()).digest()[:16], "<u4")  # any machine's byte order
     return np.random.default_rng([int(w) for w in words])
 
 
@@ -57,10 +57,17 @@ def freeze_episodes(scenario: Path, repeats: int) -> int:
 
 # doors-v1's mix. Calibrated on the label statistics of 142 public KTH floor plans
 # (benchmarks/kth_labels.py; docs/bench.md quotes the table):
-P_PARITY = 0.23  # floors whose walls each carry one parity (KTH: parity statistic >= 0.5 on 23% of floors)
+P_PARITY = 0.23  # of the floors that are not the control: one parity per wall (KTH: parity statistic >= 0.5 on 23% of floors)
 P_LETTERS = 0.63  # floors with lettered doors (KTH: 63% of floors)
-LETTERS = (0.08, 0.41)  # a lettered floor's share of lettered doors, uniform (KTH: the interquartile range)
-SKIP = (0.43, 0.83)  # share of numbers skipped, uniform (KTH: the interquartile range)
+LETTERS = (0.08, 0.41)  # a lettered floor's share of lettered doors: KTH's quartiles (of the floors with any)
+SKIP = (0.43, 0.83)  # share of each prefix's number range without a door: KTH's quartiles
+
+
+def with_quartiles(rng: np.random.Generator, q1: float, q3: float, lo: float, hi: float) -> float:
+    """A uniform draw whose quartiles are ``q1`` and ``q3`` (on ``[q1 - (q3 - q1) / 2, q3 + (q3 -
+    q1) / 2]``), clipped to ``[lo, hi]``, rounded to 3 decimals."""
+    h = (q3 - q1) / 2
+    return round(float(np.clip(rng.uniform(q1 - h, q3 + h), lo, hi)), 3)
 # Stated choices, not calibrated (the KTH floors have no prefixes, no dotted labels, and no record
 # of extensions or layouts):
 P_RANDOM = 0.10  # the random-numbering control
@@ -72,6 +79,7 @@ SEQUENTIAL_SCHEMES = ("loop",)
 SPACING = 2.5  # m between door slots
 DOORS_V1_FLOORS = {"val": 40, "test": 40}
 DOORS_V1_STARTS = 5  # drawn per goal
+MIN_SIGNS = 8  # a floor has at least this many signs (the real track keeps KTH floors of as many)
 DOORS_V1_MIN_DISTANCE = 10.0  # m, geodesic from a start to its goal
 
 
@@ -85,8 +93,8 @@ def draw_floor(rng: np.random.Generator) -> dict:
         scheme = SEQUENTIAL_SCHEMES[int(rng.integers(len(SEQUENTIAL_SCHEMES)))]
     names, w = zip(*STYLES)
     return {"layout": LAYOUTS[int(rng.integers(len(LAYOUTS)))], "numbering": scheme, "seed": int(rng.integers(2**31)),
-            "spacing": SPACING, "skip": round(float(rng.uniform(*SKIP)), 3),
-            "letters": round(float(rng.uniform(*LETTERS)), 3) if rng.random() < P_LETTERS else 0.0,
+            "spacing": SPACING, "skip": with_quartiles(rng, *SKIP, 0.0, 0.95),
+            "letters": with_quartiles(rng, *LETTERS, 0.02, 0.9) if rng.random() < P_LETTERS else 0.0,
             "extension": bool(rng.random() < P_EXTENSION), "style": str(rng.choice(names, p=np.array(w) / sum(w))),
             "letter_case": "lower" if rng.random() < 0.5 else "upper"}
 
@@ -99,15 +107,23 @@ def make_doors_v1(split: str, salt: str, out: Path) -> None:
     floors = []
     for i in range(DOORS_V1_FLOORS[split]):
         rng = floor_rng(salt, "doors-v1", split, i)
-        r = draw_floor(rng)
         fid = f"f{i:03d}"
-        path = generate_building(r["layout"], r["numbering"], r["seed"], out / fid, spacing=r["spacing"],
-                                 name=f"doors-v1-{split}-{fid}", planners=DEFAULT_PLANNER, skip=r["skip"],
-                                 letters=r["letters"], extension=r["extension"], style=r["style"],
-                                 letter_case=r["letter_case"])
+        for _ in range(20):  # a floor with fewer than MIN_SIGNS signs is drawn again (from the same stream)
+            r = draw_floor(rng)
+            shutil.rmtree(out / fid, ignore_errors=True)
+            path = generate_building(r["layout"], r["numbering"], r["seed"], out / fid, spacing=r["spacing"],
+                                     name=f"doors-v1-{split}-{fid}", planners=DEFAULT_PLANNER, skip=r["skip"],
+                                     letters=r["letters"], extension=r["extension"], style=r["style"],
+                                     letter_case=r["letter_case"])
+            if sum(1 for _ in open(path.parent / "doors.csv")) - 1 >= MIN_SIGNS:
+                break
         doc = yaml.safe_load(path.read_text())
         doc["episodes"] = {"starts": DOORS_V1_STARTS, "seed": int(rng.integers(2**31)),
                            "min_distance": DOORS_V1_MIN_DISTANCE}
+        if len(doc["goals"]) < 4:  # a floor of few signs: the spread quantiles met twice on one sign; draw the rest
+            labels = pd.read_csv(path.parent / "doors.csv", dtype=str, keep_default_na=False)["number"].tolist()
+            rest = [a for a in labels if str(a) not in {str(g) for g in doc["goals"]}]
+            doc["goals"] += [int(a) if a.isdigit() else a for a in rng.choice(rest, 4 - len(doc["goals"]), replace=False)]
         path.write_text(path.read_text().split("\n", 1)[0] + "\n" + yaml.safe_dump(doc, sort_keys=False))
         freeze_episodes(path, 1)
         d = pd.read_csv(path.parent / "doors.csv", dtype={"number": str}, keep_default_na=False)

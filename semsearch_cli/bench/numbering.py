@@ -6,14 +6,19 @@ does), and a goal is the same door under its new label: the episodes (start, goa
 path) do not move, and a planner's rows under two numberings pair episode by episode.
 
 - ``true``: the floor as built.
-- ``shuffled``: a random bijection (seeded by the floor): the numbers carry nothing a planner
-  could use; the difference true minus shuffled is a planner's *semantic gain*.
-- ``parity-flipped``: each odd number ``n`` swapped with ``n + 1`` (same prefix and suffix) where
-  the floor has both: the walls' parities trade places, the order along the corridors stays.
-- ``reversed``: within each prefix (a wing, a floor), the k-th smallest number's labels trade with
-  the k-th largest's: numbers fall where they rose, parity kept where the count allows.
+- ``shuffled``: a random bijection of all the floor's labels (seeded by the floor): the labels
+  carry nothing a planner could use; the difference true minus shuffled is a planner's *semantic
+  gain*.
+- ``parity-flipped``: within each prefix (a wing, a floor), the floor's numbers in order are paired
+  greedily, each with the next one when the two differ in parity (``23`` with ``24``; with ``26``
+  when 24 and 25 are skipped), and each pair's labels trade their numbers (a suffix kept: ``23a``
+  becomes ``24a`` where the floor has it). On a floor with one parity per wall, the walls trade
+  parities and the order along the corridors stays; on a floor whose walls carry both parities
+  (``loop``) it moves signs by one place along the wall.
+- ``reversed``: within each prefix, the labels in order of number (then suffix) are reversed: the
+  k-th smallest trades with the k-th largest, suffix and all: numbers fall where they rose.
 
-Labels without a number (``Lab``) keep their place in every numbering.
+Labels without a number (``Lab``) keep their place under ``parity-flipped`` and ``reversed``.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ def relabel(labels: list, how: str, seed: str) -> dict:
     if how == "true":
         return {a: a for a in distinct}
     if how == "shuffled":
-        words = np.frombuffer(hashlib.sha256(f"shuffled/{seed}".encode()).digest()[:16], np.uint32)
+        words = np.frombuffer(hashlib.sha256(f"shuffled/{seed}".encode()).digest()[:16], "<u4")
         order = np.random.default_rng([int(w) for w in words]).permutation(len(distinct))
         return {a: distinct[int(k)] for a, k in zip(distinct, order)}
     groups: dict[str, list] = {}  # prefix -> its numbered labels
@@ -45,17 +50,22 @@ def relabel(labels: list, how: str, seed: str) -> dict:
     out = {a: a for a in distinct}
     if how == "reversed":
         for items in groups.values():
-            numbers = sorted({n for n, *_ in items})
-            flip = dict(zip(numbers, reversed(numbers)))
-            _swap_numbers(items, flip, out)
+            order = sorted(items, key=lambda t: (t[0], t[1], str(t[2])))
+            for a, b in zip(order, reversed(order)):
+                out[a[2]] = b[2]
         return out
     if how == "parity-flipped":
         for items in groups.values():
-            have = {n for n, *_ in items}
-            flip = {}
-            for n in have:
-                partner = n + 1 if n % 2 else n - 1
-                flip[n] = partner if partner in have else n
+            numbers = sorted({n for n, *_ in items})
+            flip = {n: n for n in numbers}
+            k = 0
+            while k + 1 < len(numbers):
+                a, b = numbers[k], numbers[k + 1]
+                if (a - b) % 2:
+                    flip[a], flip[b] = b, a
+                    k += 2
+                else:
+                    k += 1
             _swap_numbers(items, flip, out)
         return out
     raise ValueError(f"unknown numbering {how!r}; valid: {', '.join(NUMBERINGS)}")

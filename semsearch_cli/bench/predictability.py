@@ -102,7 +102,7 @@ def predictability(labels, x, y, facing, seed: str = "") -> Predictability:
     prefixes = np.array([parsed[i].prefix for i in idx], object)
     lines = [w for w in walls(np.asarray(x, float)[idx], np.asarray(y, float)[idx], np.asarray(facing, float)[idx])]
     e_true, m_true, _ = _errors(numbers, prefixes, lines)
-    words = np.frombuffer(hashlib.sha256(f"predictability/{seed}".encode()).digest()[:16], np.uint32)
+    words = np.frombuffer(hashlib.sha256(f"predictability/{seed}".encode()).digest()[:16], "<u4")
     rng = np.random.default_rng([int(w) for w in words])
     es, ms = [], []
     for _ in range(SHUFFLES):

@@ -120,6 +120,17 @@ def floor_hash(scenario: Path) -> str:
     return hashlib.sha256(json.dumps(scenario_content(scenario), sort_keys=True).encode()).hexdigest()
 
 
+def _built(suite: Suite, fl: dict, files: dict, tmp: Path) -> tuple[str, dict]:
+    """Import one floor into ``tmp`` and check it against the content hash the track records."""
+    path = build_floor(fl, files, tmp / fl["id"])
+    h = floor_hash(path)
+    if fl.get("hash") and h != fl["hash"]:
+        raise ScenarioError(str(sources_file(suite.name)), f"floors[{fl['id']}].hash",
+                            f"the floor imports to content {h[:16]}, the track records {fl['hash'][:16]}: this "
+                            "semsearch's importer differs from the one the track was made with")
+    return fl["id"], {"importer": fl["importer"], "sources": {r: e["sha256"] for r, e in fl["files"].items()}, "hash": h}
+
+
 def fetch(suite: Suite, from_dirs=(), mirror: str | None = None, partial: bool = False, progress=None) -> tuple[Split, list[str]]:
     """Fetch a track's sources and build its split in the cache (see the module docstring).
     Returns the split and the floors left out (with why)."""
@@ -146,24 +157,18 @@ def fetch(suite: Suite, from_dirs=(), mirror: str | None = None, partial: bool =
                             "or build the split from the floors found (--partial: not official)")
     if not got:
         raise ScenarioError("<command line>", "--from", f"none of the {len(floors)} floors' files could be had, e.g. {missing[0]}")
-    key = hashlib.sha256(json.dumps(sorted(got)).encode()).hexdigest()[:16]
+    # the floors found and the sources they were named by: a cache built from another sources.json is not reused
+    key = hashlib.sha256(json.dumps(sorted(got)).encode() + sources_file(suite.name).read_bytes()).hexdigest()[:16]
     folder = cache_dir() / "bench" / suite.name / f"val-{key}"
     if not (folder / "suite.json").is_file():
         tmp = folder.with_name(f"{folder.name}.{os.getpid()}.tmp")
         shutil.rmtree(tmp, ignore_errors=True)
-        built = []
-        for fl in floors:
-            if fl["id"] not in got:
-                continue
-            path = build_floor(fl, got[fl["id"]], tmp / fl["id"])
-            h = floor_hash(path)
-            if fl.get("hash") and h != fl["hash"]:
-                raise ScenarioError(str(sources_file(suite.name)), f"floors[{fl['id']}].hash",
-                                    f"the floor imports to content {h[:16]}, the track records {fl['hash'][:16]}: this "
-                                    "semsearch's importer differs from the one the track was made with")
-            built.append((fl["id"], {"importer": fl["importer"], "sources": {r: e["sha256"] for r, e in fl["files"].items()},
-                                     "hash": h}))
-        write_manifest(suite, "val", tmp, built)
+        try:
+            built = [_built(suite, fl, got[fl["id"]], tmp) for fl in floors if fl["id"] in got]
+            write_manifest(suite, "val", tmp, built)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)  # a failed build leaves nothing behind
+            raise
         folder.parent.mkdir(parents=True, exist_ok=True)
         try:
             os.rename(tmp, folder)

@@ -18,6 +18,7 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import yaml
 
@@ -30,6 +31,7 @@ from ..runner.specs import RunList
 from ..runner.verify import Verdict, verify_folder
 from ..tasks.episodes import Episode
 from .numbering import NUMBERINGS, relabel
+from .predictability import predictability
 from .suites import Floor, Split, open_split, suite_named
 
 BENCH_FILE = "bench.json"
@@ -146,34 +148,56 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
         first = Loaded.load(materialise(sp, todo[0][0], numbering, out / todo[0][0].id / "scenario")).with_planners(planners)
         labels = [v.label for v in first.task.variants()]
         meta = _check_bench_file(out, sp, numbering, labels)
+        meta["floors"] = {f.id: floor_info(sp, f) for f in sp.floors}
         atomic_text(out / BENCH_FILE, json.dumps(meta, indent=1) + "\n")
     total = sum(n for _, n in todo) * len(labels) * sp.suite.repeats
-    done = sum(_done_rows(out / f.id, labels) for f, _ in todo)
     stamp = {"suite": sp.suite.name, "split": sp.name, "suite_hash": sp.hash, "numbering": numbering}
-    frames = []
+    frames, finished = [], 0  # the runs of this run's specs on the floors before this one
     for f, take in todo:
         dest = out / f.id
         loaded = first if f is todo[0][0] else Loaded.load(materialise(sp, f, numbering, dest / "scenario")).with_planners(planners)
         specs = RunList(loaded.task.episodes[:take], loaded.task.variants(), sp.suite.repeats)
-
-        def tick(row, n, _total, base=done):
-            if progress:
-                progress(row, base + n, total)
-
         with Batch(loaded, specs, dest, options, stamp={**stamp, "floor": f.id}, own=("decisions_sha256",)) as batch:
             write_meta(dest, loaded)
-            before = len(batch.done)
+            base = finished + sum(1 for k in _keys(batch.done) if specs.has_key(k))  # this floor's runs already there
+
+            def tick(row, n, _total, base=base):
+                if progress:
+                    progress(row, base + n, total)
+
             rows = batch.run(tick)
-        done += len(rows) - before
-        frames.append(rows)
+        own = rows[rows["stage"] == ""] if len(rows) else rows  # (a suite of chains would keep their stage rows too)
+        mine = np.array([specs.has_key(k) for k in _keys(own)], bool)  # not the runs a longer run left here
+        finished += int(mine.sum())
+        frames.append(own[mine] if len(own) else own)
     runs = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     return BenchOutput(out, sp, numbering, runs, [f.id for f, _ in todo])
 
 
-def _done_rows(folder: Path, labels: list[str]) -> int:
-    """The runs of ``labels`` already in a floor's runs.csv."""
-    rows = read_runs(folder / "runs.csv", as_written=True)
-    return int(((rows["stage"] == "") & rows["planner"].astype(str).isin(labels)).sum()) if len(rows) else 0
+def _keys(rows: pd.DataFrame) -> list[tuple]:
+    """The run keys (planner, goal, episode, seed) of a run's own rows (chains' stage rows aside)."""
+    if not len(rows):
+        return []
+    own = rows[rows["stage"] == ""] if "stage" in rows.columns else rows
+    return list(zip(own["planner"].astype(str), own["goal"].astype(str), own["episode"].astype(int), own["seed"].astype(int)))
+
+
+def floor_info(split: Split, floor: Floor) -> dict:
+    """What the board shows of a floor without its split at hand (a hidden split, a fetched
+    track): its numbering convention (or where it comes from) and its predictability (door
+    suites: :mod:`.predictability`, on its true labels)."""
+    r = floor.recipe
+    conv = r.get("numbering") or {"kth": "KTH floor plan", "mobilesim": "the authors' map"}.get(r.get("importer"), floor.id)
+    info = {"convention": conv, "predictability": None}
+    key = split.suite.labels
+    if key is not None:
+        pred = (r.get("predictability") or {}).get("value")
+        if pred is None:
+            doc = yaml.safe_load(floor.scenario.read_text())
+            d = pd.read_csv(floor.scenario.parent / doc[key], dtype={"number": str}, keep_default_na=False)
+            pred = predictability(d["number"].tolist(), d["x"], d["y"], d["facing"], floor.id).value
+        info["predictability"] = None if pred is None or not np.isfinite(pred) else round(float(pred), 4)
+    return info
 
 
 def read_bench(folder: Path) -> dict:
@@ -205,16 +229,24 @@ def verify_bench(folder: str | Path, salt_file: str | Path | None = None, worker
                             f"{str(meta.get('hash'))[:16]}, this semsearch's is {sp.hash[:16]}: verify them with the suite they "
                             "were made on")
     verdicts: dict[str, Verdict] = {}
+    ids = {f.id for f in sp.floors}
+    for extra in sorted(p.parent.name for p in folder.glob("*/runs.csv") if p.parent.name not in ids):
+        verdicts[extra] = Verdict(runs=1, failed=[("its rows", f"folder {extra} is not a floor of {sp.suite.name} {sp.name}")])
     with tempfile.TemporaryDirectory(prefix="semsearch-verify-") as tmp:
         for f in sp.floors:
             if not (folder / f.id / "runs.csv").is_file():
                 continue
             rows = read_runs(folder / f.id / "runs.csv", as_written=True)
             own = rows[rows["stage"] == ""]
-            bad = own["suite_hash"].astype(str) != sp.hash if "suite_hash" in own.columns else pd.Series(True, index=own.index)
             loaded = Loaded.load(materialise(sp, f, meta["numbering"], Path(tmp) / f.id), planners=False)
             v = verify_folder(folder / f.id, loaded, progress, workers)
-            if bad.any():
-                v.failed.append((f"{int(bad.sum())} row(s)", f"carry another suite hash than {sp.hash[:16]}"))
+            for col, want, what in (("suite_hash", sp.hash, "another suite hash"), ("floor", f.id, "another floor"),
+                                    ("numbering", meta["numbering"], "another numbering than bench.json's")):
+                bad = own[col].astype(str) != want if col in own.columns else pd.Series(True, index=own.index)
+                if bad.any():
+                    v.failed.append((f"{int(bad.sum())} row(s)", f"carry {what} ({col} is not {want[:16]})"))
+            if v.unrecorded:  # a bench run records every run: a row without its record cannot be checked
+                v.failed.append((f"{v.unrecorded} run(s)", "have no decisions record (an error or timeout row, or a "
+                                 "record taken away): not verifiable"))
             verdicts[f.id] = v
     return sp, verdicts

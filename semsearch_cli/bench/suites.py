@@ -4,7 +4,8 @@ A suite has splits. A split is a folder of floors, each a scenario folder (``sce
 map, its signs and ``episodes.csv``: the start/goal problems every planner meets), listed in the
 split's ``suite.json``. Its **hash** names its content: the SHA-256 of the suite's name, the split,
 the repeats per episode and each floor's scenario with every file it names standing for the
-SHA-256 of its bytes (its planners, which a bench run sets, left out). Two splits with one hash
+SHA-256 of its content (a map image's decoded pixels, any other file's bytes; its planners, which
+a bench run sets, left out). Two splits with one hash
 hold the same floors and episodes, wherever their files lie.
 
 ``val`` splits are shipped with semsearch (package data, ``semsearch_cli/data/bench``). A
@@ -23,6 +24,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+import cv2
+import numpy as np
 import yaml
 
 from ..errors import ScenarioError, did_you_mean
@@ -108,12 +111,30 @@ class Split:
         raise ScenarioError(str(self.folder / "suite.json"), "floors", f"no floor {floor_id!r} in {self.suite.name} {self.name}")
 
 
+IMAGES = (".png", ".pgm", ".bmp", ".jpg", ".jpeg")
+
+
+def _content(d, base: Path):
+    """``d`` with each string that names a file beside the scenario replaced by the hash of its
+    content: an image's by its pixels (its shape and values as decoded: two PNG encoders' bytes
+    for one map hash alike), any other file's by its bytes."""
+    if isinstance(d, dict):
+        return {k: _content(v, base) for k, v in d.items()}
+    if isinstance(d, list):
+        return [_content(v, base) for v in d]
+    if isinstance(d, str) and d.lower().endswith(IMAGES) and (base / d).is_file():
+        img = cv2.imread(str(base / d), cv2.IMREAD_UNCHANGED)
+        if img is not None:
+            return "pixels:" + hashlib.sha256(repr(img.shape).encode() + np.ascontiguousarray(img).tobytes()).hexdigest()
+    return files_by_content(d, base)
+
+
 def scenario_content(path: Path) -> dict:
     """A floor's scenario as the hash sees it: the YAML document without its planners, each file
-    it names replaced by the hash of its bytes."""
+    it names replaced by the hash of its content (:func:`_content`)."""
     doc = yaml.safe_load(path.read_text())
     doc.pop("planners", None)
-    return files_by_content(doc, path.parent)
+    return _content(doc, path.parent)
 
 
 def split_hash(suite: Suite, split: str, floors) -> str:
@@ -178,6 +199,9 @@ def open_split(name: str, split: str = "val", salt_file: str | Path | None = Non
     if split not in suite.splits:
         raise ScenarioError("<command line>", "--split", f"{name} has no split {split!r}; its splits: {', '.join(suite.splits)}")
     if suite.fetched:
+        if salt_file is not None:
+            raise ScenarioError("<command line>", "--salt-file", f"{name} is public (fetched by its sources); a salt goes "
+                                "with a hidden split")
         return read_split(suite, split, fetched_folder(suite))
     if split in suite.hidden:
         if salt_file is None:

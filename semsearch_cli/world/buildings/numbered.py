@@ -32,10 +32,10 @@ Numbering schemes (``SCHEMES``):
   random        a random permutation: the control case where no planner can use the signs.
 
 What real floors add on top of a scheme (:func:`generate_building`'s ``skip``, ``letters``,
-``extension`` and ``style``): numbers skipped (a slot numbered but without a door: rooms wider than
-one door spacing), a room's doors sharing its number with letter suffixes (``24a``, ``24b``), a
-later extension renumbered in a hundred-block of its own, and labels written with a wing prefix
-(``K201``) or as floor-dot-room (``2.14``).
+``extension`` and ``style``): numbers skipped (a share of the number range without a door, as
+rooms wider than a door spacing leave them), a room's doors sharing its number with letter
+suffixes (``24a``, ``24b``), a later extension renumbered in a hundred-block of its own, and labels
+written with a wing prefix (``K201``) or as floor-dot-room (``2.14``).
 """
 
 from __future__ import annotations
@@ -50,6 +50,7 @@ import yaml
 from ...errors import ScenarioError
 from ...geometry import GridFrame
 from ...kernels.grid import dijkstra
+from ..labels import parse_label
 from ..scenario_folder import map_image, scenario_dict, write_building
 from ..importers.mobilesim import spread_goals
 
@@ -234,7 +235,7 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
         order = sorted(range(len(slots)), key=lambda k: (slots[k].corridor, slots[k].t, -slots[k].side))
         nums = [0] * len(slots)
         for i, k in enumerate(order, start=1):
-            nums[k] = int(f"{floor}{i:02d}")
+            nums[k] = floor * 100 + i  # past 99 doors the numbers run on into the next hundred (300, 301, ...)
         return nums
     if scheme == "blocks":
         nums = [0] * len(slots)
@@ -250,7 +251,7 @@ def number_slots(slots: list[Slot], plan: Plan, scheme: str, img: np.ndarray, fr
         order = sorted(range(len(slots)), key=lambda k: (slots[k].corridor, -slots[k].side, slots[k].t * slots[k].side))
         nums = [0] * len(slots)
         for i, k in enumerate(order, start=1):
-            nums[k] = int(f"{floor}{i:02d}")
+            nums[k] = floor * 100 + i
         return nums
     if scheme == "random":
         return [int(x) for x in rng.permutation(len(slots)) + 1]
@@ -304,14 +305,17 @@ def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: 
 
     ``signs`` trims the doors (not the numbers) at random to that count, keeping ``goals``;
     ``scale`` stretches the layout (see :func:`scaled`), corridors keeping their width. What real
-    floors add (:func:`real_labels`): ``skip`` (0-0.95) the share of numbered slots left without a
-    door, ``letters`` (0-0.9) the share of doors that share a room's number with a letter suffix,
-    ``extension`` the last corridor renumbered in a hundred-block of its own, ``style`` how labels
-    are written (:data:`STYLES`). Goals given by number must survive these (the default goals are
-    drawn after them).
+    floors add (:func:`real_labels`): ``letters`` (0-0.9) the share of doors that share a room's
+    number with a letter suffix, ``extension`` the last corridor renumbered in a hundred-block of
+    its own, ``style`` how labels are written (:data:`STYLES`); then ``skip`` (0-0.95), the share
+    of each prefix's number range left without a door (:func:`skip_numbers`: the statistic
+    benchmarks/kth_labels.py measures on real floors). Goals given by number must survive these
+    (the default goals are drawn after them).
     """
     if style not in STYLES:
         raise ScenarioError("<command line>", "--style", f"unknown label style {style!r}; valid: {', '.join(STYLES)}")
+    if letter_case not in ("lower", "upper"):
+        raise ScenarioError("<command line>", "--letter-case", f"unknown letter case {letter_case!r}; valid: lower, upper")
     if not (0.0 <= skip <= 0.95 and 0.0 <= letters <= 0.9):
         raise ScenarioError("<command line>", "--skip" if not 0.0 <= skip <= 0.95 else "--letters",
                             "a share: --skip between 0 and 0.95, --letters between 0 and 0.9")
@@ -322,14 +326,13 @@ def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: 
     nums = number_slots(slots, plan, scheme, img, frame, rng, floor)
     keep = [i for i, s in enumerate(slots) if s.ok and nums[i] > 0]  # 0: a slot the scheme leaves unsigned
     goal_set = {int(g) if isinstance(g, int) else g for g in goals or []}
-    if skip > 0.0:  # drawn from their own generator: a floor with skip=0 is the one without
-        sub = np.random.default_rng([seed, 1])
-        keep = [i for i in keep if nums[i] in goal_set or sub.random() >= skip]
     labels = {i: nums[i] for i in keep}
-    if letters > 0.0 or extension or style != "plain":
+    if letters > 0.0 or extension or style != "plain":  # each from its own generator: a floor without them is the one before
         labels = real_labels(slots, keep, nums, np.random.default_rng([seed, 2]), letters, extension, style, floor,
                              letter_case)
-        keep = [i for i in keep if i in labels]
+    if skip > 0.0:
+        labels = skip_numbers(labels, skip, goal_set, np.random.default_rng([seed, 1]))
+    keep = [i for i in keep if i in labels]
     missing = goal_set - set(labels.values())
     if missing:
         raise ScenarioError("<command line>", "--goals", f"no door of this building carries {sorted(missing, key=str)} "
@@ -346,9 +349,38 @@ def generate_building(layout_name: str, scheme: str, seed: int, out: Path, res: 
         goals = spread_goals(free, frame, snapped, plan.start)
     scen = scenario_dict(name or f"{layout_name}-{scheme}-{seed}", res, plan.start, goals, planners, density_delta)
     extra = "".join(f" --{k} {v}" for k, v in (("skip", skip), ("letters", letters), ("style", style)) if v not in (0.0, "plain"))
+    extra += " --letter-case upper" if letters > 0.0 and letter_case == "upper" else ""
     extra += " --extension" if extension else ""
     return write_building(out, img, sorted(snapped, key=lambda s: (str(type(s[0])), s[0], s[1], s[2])), scen,
                           f"generated by `semsearch generate building --layout {layout_name} --numbering {scheme} --seed {seed}{extra}`")
+
+
+def skip_numbers(labels: dict, share: float, goals: set, rng: np.random.Generator) -> dict:
+    """``labels`` ({slot: label}) with doors taken away until, within each prefix, ``share`` of
+    the numbers from its smallest to its largest carries no door (``1 - distinct / (max - min +
+    1)``, as benchmarks/kth_labels.py measures real floors; rounded to whole numbers). The numbers
+    taken are drawn at random among those that are neither a prefix's smallest or largest nor a
+    goal's; every door of a number goes with it (a room's lettered doors together). A prefix
+    already missing that share of its range keeps every door."""
+    groups: dict = {}
+    for i, lab in labels.items():
+        p = parse_label(lab)
+        if p is not None:
+            groups.setdefault(p.prefix, {}).setdefault(p.number, []).append(i)
+    protected = {(p.prefix, p.number) for p in map(parse_label, goals) if p is not None}
+    drop = set()
+    for prefix, by_number in groups.items():
+        numbers = sorted(by_number)
+        if len(numbers) < 3:
+            continue
+        span = numbers[-1] - numbers[0] + 1
+        want = max(3, int(np.ceil((1.0 - share) * span)))  # numbers that keep a door
+        spare = [n for n in numbers[1:-1] if (prefix, n) not in protected]
+        k = min(len(spare), len(numbers) - want)
+        if k > 0:
+            for n in rng.choice(spare, size=k, replace=False):
+                drop.update(by_number[int(n)])
+    return {i: lab for i, lab in labels.items() if i not in drop}
 
 
 def real_labels(slots: list[Slot], keep: list[int], nums: list[int], rng: np.random.Generator, letters: float,
@@ -356,8 +388,11 @@ def real_labels(slots: list[Slot], keep: list[int], nums: list[int], rng: np.ran
     """The label of each kept slot (``{slot: label}``), as real floors write them:
 
     - ``letters``: walking each wall's doors in order, a door starts a room of 2 doors (3 in one
-      case of 4) with probability ``letters / 2.25``; the room's doors carry its first door's
-      number with the suffixes a, b, c (``letter_case``), the others' numbers are skipped;
+      case of 4, 2.25 on average) with probability ``q = letters / (2.25 - 1.25 letters)``, so that
+      the share of doors lettered is ``letters`` along a long wall (a room of ``g`` doors takes
+      ``g`` of them, a door alone one: ``2.25 q / (2.25 q + 1 - q)``); the room's doors carry its
+      first door's number with the suffixes a, b, c (``letter_case``), the others' numbers are
+      skipped;
     - ``extension``: the last corridor with doors is renumbered by a whole number of hundreds,
       into a hundred-block above every other number (parity kept);
     - ``style``: ``plain`` numbers; ``wing``: a wing letter per corridor before the number
@@ -382,7 +417,7 @@ def real_labels(slots: list[Slot], keep: list[int], nums: list[int], rng: np.ran
             doors.sort(key=lambda i: slots[i].t)
             k = 0
             while k < len(doors):
-                if rng.random() < letters / 2.25 and k + 1 < len(doors):
+                if rng.random() < letters / (2.25 - 1.25 * letters) and k + 1 < len(doors):
                     size = 3 if rng.random() < 0.25 and k + 2 < len(doors) else 2
                     room = doors[k : k + size]
                     for j, i in enumerate(room):
