@@ -154,6 +154,8 @@ def test_a_short_salt_and_an_unknown_suite_are_refused_in_words(tmp_path):
     assert res.exit_code == 2 and "at least 16" in res.stderr
     res = runner.invoke(app, ["bench", "run", "doors-v2", "--planner", "greedy", "--out", str(tmp_path / "o")])
     assert res.exit_code == 2 and "did you mean 'doors-v1'" in res.stderr
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner", "nsoss", "--limit", "1", "--out", str(tmp_path / "p")])
+    assert res.exit_code == 2 and "<command line>, field '--planner': unknown planner 'nsoss' (did you mean 'nsos'?)" in res.stderr
 
 
 # -- bench runs and verify ------------------------------------------------------------------------

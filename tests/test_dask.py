@@ -173,3 +173,17 @@ def test_a_local_cluster_runs_and_closes_cleanly_from_a_fresh_process(tmp_path):
     pool = api.run("demo", BatchOptions(seeds=2, workers=2, out=tmp_path / "pool"), plots=False)
     assert len(pool.runs) == 8
     pd.testing.assert_frame_equal(_rows(tmp_path / "dask"), _rows(tmp_path / "pool"))
+
+
+def test_a_bench_run_on_the_cluster_matches_the_process_pool_and_verifies(cluster, tmp_path):
+    """One client for every floor (the slice spans two), the rows as the pool's, every run replayed."""
+    address, _ = cluster
+    pool = api.bench_run("doors-v1", ["greedy"], tmp_path / "pool", options=BatchOptions(workers=2), limit=22)
+    dask = api.bench_run("doors-v1", ["greedy"], tmp_path / "dask", options=BatchOptions(executor="dask", scheduler=address),
+                         limit=22)
+    assert pool.floors == dask.floors == ["f000", "f001"]
+    cols = [c for c in SAME if c != "scenario"] + ["floor", "episode", "suite_hash", "decisions_sha256"]
+    key = ["floor", "episode", "seed"]
+    pd.testing.assert_frame_equal(pool.runs[cols].sort_values(key).reset_index(drop=True),
+                                  dask.runs[cols].sort_values(key).reset_index(drop=True))
+    assert api.verify(tmp_path / "dask", workers=1).verdict.verified == 22

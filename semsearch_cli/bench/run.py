@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import json
+from contextlib import nullcontext
 import shutil
 import tempfile
 from dataclasses import dataclass, field
@@ -26,7 +27,7 @@ from ..config import PlannerSpec
 from ..errors import ScenarioError
 from ..files import atomic_text, output_folder
 from ..report.build import write_meta
-from ..runner import Batch, BatchOptions, Loaded, folder_lock, read_runs
+from ..runner import Batch, BatchOptions, Loaded, folder_lock, make_executor, read_runs
 from ..runner.specs import RunList
 from ..runner.verify import Verdict, verify_folder
 from ..tasks.episodes import Episode
@@ -145,7 +146,13 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
         todo.append((f, take))
         left = None if left is None else left - take
     with folder_lock(out):
-        first = Loaded.load(materialise(sp, todo[0][0], numbering, out / todo[0][0].id / "scenario")).with_planners(planners)
+        first = Loaded.load(materialise(sp, todo[0][0], numbering, out / todo[0][0].id / "scenario"))
+        try:
+            first = first.with_planners(planners)
+        except ScenarioError as exc:  # a planner the command line named: said of --planner, not of the floor's copy
+            if not exc.field.startswith("planners"):
+                raise
+            raise ScenarioError("<command line>", "--planner", exc.message) from None
         labels = [v.label for v in first.task.variants()]
         meta = _check_bench_file(out, sp, numbering, labels)
         meta["floors"] = {f.id: floor_info(sp, f) for f in sp.floors}
@@ -153,25 +160,37 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
     total = sum(n for _, n in todo) * len(labels) * sp.suite.repeats
     stamp = {"suite": sp.suite.name, "split": sp.name, "suite_hash": sp.hash, "numbering": numbering}
     frames, finished = [], 0  # the runs of this run's specs on the floors before this one
-    for f, take in todo:
-        dest = out / f.id
-        loaded = first if f is todo[0][0] else Loaded.load(materialise(sp, f, numbering, dest / "scenario")).with_planners(planners)
-        specs = RunList(loaded.task.episodes[:take], loaded.task.variants(), sp.suite.repeats)
-        with Batch(loaded, specs, dest, options, stamp={**stamp, "floor": f.id}, own=("decisions_sha256",)) as batch:
-            write_meta(dest, loaded)
-            base = finished + sum(1 for k in _keys(batch.done) if specs.has_key(k))  # this floor's runs already there
-
-            def tick(row, n, _total, base=base):
-                if progress:
-                    progress(row, base + n, total)
-
-            rows = batch.run(tick)
-        own = rows[rows["stage"] == ""] if len(rows) else rows  # (a suite of chains would keep their stage rows too)
-        mine = np.array([specs.has_key(k) for k in _keys(own)], bool)  # not the runs a longer run left here
-        finished += int(mine.sum())
-        frames.append(own[mine] if len(own) else own)
+    # one Dask cluster (or client) for every floor; the process pool starts per floor (a fork costs little)
+    shared = (make_executor(options.workers, None, options.executor, options.scheduler) if options.executor != "processes"
+              else nullcontext())
+    with shared as runner:
+        for f, take in todo:
+            frames.append(_run_floor(sp, f, take, first if f is todo[0][0] else None, planners, numbering, out, options,
+                                     {**stamp, "floor": f.id}, runner, progress, total, finished))
+            finished += len(frames[-1])
     runs = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     return BenchOutput(out, sp, numbering, runs, [f.id for f, _ in todo])
+
+
+def _run_floor(sp: Split, f: Floor, take: int, loaded, planners, numbering: str, out: Path, options: BatchOptions,
+               stamp: dict, runner, progress, total: int, finished: int) -> pd.DataFrame:
+    """One floor's batch (its first ``take`` episodes) into ``out/<floor>``; its rows of this run."""
+    dest = out / f.id
+    if loaded is None:
+        loaded = Loaded.load(materialise(sp, f, numbering, dest / "scenario")).with_planners(planners)
+    specs = RunList(loaded.task.episodes[:take], loaded.task.variants(), sp.suite.repeats)
+    with Batch(loaded, specs, dest, options, stamp=stamp, own=("decisions_sha256",)) as batch:
+        write_meta(dest, loaded)
+        base = finished + sum(1 for k in _keys(batch.done) if specs.has_key(k))  # this floor's runs already there
+
+        def tick(row, n, _total):
+            if progress:
+                progress(row, base + n, total)
+
+        rows = batch.run(tick, runner=runner)
+    own = rows[rows["stage"] == ""] if len(rows) else rows  # (a suite of chains would keep their stage rows too)
+    mine = np.array([specs.has_key(k) for k in _keys(own)], bool)  # not the runs a longer run left here
+    return own[mine] if len(own) else own
 
 
 def _keys(rows: pd.DataFrame) -> list[tuple]:
