@@ -151,7 +151,9 @@ class DoorBelief:
         self.version = 0  # bumped whenever passable/cost change
         self.lost = 0  # cells that were free and are no longer (a wall seen where the map had free space)
         self._search_key = None  # (r, c, version) of the search search_state holds
-        self._search_of = None  # its (target rows, target cols, n_stop)
+        self._search_of = None  # its (target rows, target cols, n_stop, whether it searched again over every cell)
+        self._stopped_at = None  # the target cell a replayed search was stopped at (search_again), or None
+        self._again = None  # a search to run again at the next path from its cell (search_again), or None
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
@@ -428,45 +430,73 @@ class DoorBelief:
         cells for D). Targets it cannot reach that way (a gap in the windowed skeleton) are
         searched for again over every cell where the robot fits, under ``cost``.
         """
-        t_rows = np.asarray(t_rows, np.int64)
-        t_cols = np.asarray(t_cols, np.int64)
+        self._again = None
+        return self._search(r, c, np.asarray(t_rows, np.int64), np.asarray(t_cols, np.int64), n_stop)
+
+    def _search(self, r: int, c: int, t_rows, t_cols, n_stop: int, again: bool | None = None, stop=None) -> GridSearch:
+        """:meth:`search`; ``again`` (a replay: whether the search went on over every cell, as the
+        record says) skips the search that decided it, and ``stop`` ends the search at that cell
+        (its path is the whole search's: a settled cell's parent is final)."""
         need = n_stop if n_stop > 0 else len(t_rows)
-        rad = CONNECT_M / self.frame.res
         passable = self.passable
         if not passable[r, c]:  # robot squeezed near a wall: let it leave
             passable = passable.copy()
             pr, pc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
             passable[pr, pc] = True
-        # the band joined to each target and to the robot, set in place and undone after (a copy of
-        # the band per search cost as much as the search itself on a large map)
-        side = 2 * int(np.ceil(rad)) + 1
-        if self._joins.shape[0] < (len(t_rows) + 1) * side * side:
-            self._joins = np.empty((len(t_rows) + 1) * side * side, np.int64)
-        mask = self._search_mask
-        n = set_joins(self.passable, mask, t_rows, t_cols, rad, self._joins)
-        n += set_joins(passable, mask, np.array([r], np.int64), np.array([c], np.int64), rad, self._joins[n:])
         gs = self.search_state
+        if not again:
+            rad = CONNECT_M / self.frame.res
+            # the band joined to each target and to the robot, set in place and undone after (a copy of
+            # the band per search cost as much as the search itself on a large map)
+            side = 2 * int(np.ceil(rad)) + 1
+            if self._joins.shape[0] < (len(t_rows) + 1) * side * side:
+                self._joins = np.empty((len(t_rows) + 1) * side * side, np.int64)
+            mask = self._search_mask
+            n = set_joins(self.passable, mask, t_rows, t_cols, rad, self._joins)
+            n += set_joins(passable, mask, np.array([r], np.int64), np.array([c], np.int64), rad, self._joins[n:])
+            try:
+                settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop, stop=stop)
+            finally:
+                mask.ravel()[self._joins[:n]] = False
+        if again or (again is None and settled < need):
+            gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop, stop=stop)
+            again = True
         self._search_key = (r, c, self.version)
-        self._search_of = (t_rows, t_cols, n_stop)
-        try:
-            settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop)
-        finally:
-            mask.ravel()[self._joins[:n]] = False
-        if settled < need:
-            gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop)
+        self._search_of = (t_rows, t_cols, n_stop, bool(again))
+        self._stopped_at = stop
         return gs
 
     def held_search(self, r: int, c: int):
         """The search :meth:`path` would reuse from (r, c) on the current maps, as (target rows,
-        target cols, n_stop), or None: what a planner's own search leaves for the path to its
-        target (a decisions record keeps it, so that a replay without the planner runs it again)."""
+        target cols, n_stop, whether it went on over every cell), or None: what a planner's own
+        search leaves for the path to its target (a decisions record keeps it, so that a replay
+        without the planner runs it again: :meth:`search_again`)."""
         return self._search_of if self._search_key == (r, c, self.version) else None
+
+    def search_again(self, r: int, c: int, t_rows, t_cols, n_stop: int, again: bool | None = None) -> None:
+        """Put back the search a planner ran from (r, c) (a replay, from its record). With
+        ``again`` (whether it went on over every cell) known, it is run at the next :meth:`path`
+        from (r, c), stopped at that path's target: the same path at a fraction of the cost;
+        without (an older record), at once and in whole."""
+        t_rows, t_cols = np.asarray(t_rows, np.int64), np.asarray(t_cols, np.int64)
+        if again is None:
+            self.search(r, c, t_rows, t_cols, n_stop)
+            return
+        self._again = ((r, c, self.version), (t_rows, t_cols, n_stop, bool(again)))
+        self._search_key = None
 
     def path(self, r: int, c: int, tr: int, tc: int):
         """Cheapest path (rows, cols) from (r, c) to (tr, tc), reusing the last search when it
         started here on the current maps and reached the target; None when unreachable."""
+        key = (r, c, self.version)
+        if self._again is not None and self._again[0] == key:  # a replayed search: run now, up to this target
+            spec, self._again = self._again[1], None
+            self._search(r, c, *spec[:3], again=spec[3], stop=(tr, tc))
+        elif self._search_key == key and self._stopped_at is not None and self._stopped_at != (tr, tc):
+            rows, cols, n_stop, again = self._search_of  # stopped at another target: run it in whole, as it ran
+            self._search(r, c, rows, cols, n_stop, again=again)
         gs = self.search_state
-        if self._search_key != (r, c, self.version) or not gs.settled(tr, tc):
+        if self._search_key != key or not gs.settled(tr, tc):
             self.search(r, c, [tr], [tc], 1)
         return gs.path(tr, tc)
 

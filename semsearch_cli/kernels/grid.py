@@ -213,12 +213,15 @@ def _heap_drop_top(hk, hi, n):
 
 
 @njit(cache=True)
-def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, length, parent, touched, closed, gen, hk, hi):
+def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, length, parent, touched, closed, gen, hk, hi,
+              stop_idx):
     """Multi-source Dijkstra on an 8-connected grid with per-cell cost multipliers.
 
     Moving into cell q costs ``step * cost[q]`` with step 1 or sqrt(2); ``cost`` of shape (1, 1)
     means a uniform cost of 1. Cells with ``tmark == gen`` are targets; the search stops once
-    ``n_stop`` of them are settled (0: never) or the cost exceeds ``max_cost``. The state arrays
+    ``n_stop`` of them are settled (0: never), once the cell of index ``stop_idx`` is settled (-1:
+    no such cell), or when the cost exceeds ``max_cost``. A settled cell's parent is final, so a
+    search stopped at a cell holds the same path to it as the search run on. The state arrays
     are reused across searches: a value is valid only where its stamp (``touched`` / ``closed``)
     equals ``gen``, so a search costs what it explores, not the grid size.
 
@@ -259,6 +262,8 @@ def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, lengt
             settled_targets += 1
             if n_stop > 0 and settled_targets >= n_stop:
                 break
+        if idx == stop_idx:
+            break
         for k in range(8):
             nr = r + _DR8[k]
             nc = c + _DC8[k]
@@ -304,16 +309,19 @@ class GridSearch:
         self._hk = np.empty(4096)  # the search's heap (cost, cell), grown when a search fills it
         self._hi = np.empty(4096, np.int64)
 
-    def run(self, passable, cost, src_r, src_c, t_rows, t_cols, n_stop=0, max_cost=np.inf) -> int:
-        """Search from the source cells; returns the number of targets settled."""
+    def run(self, passable, cost, src_r, src_c, t_rows, t_cols, n_stop=0, max_cost=np.inf, stop=None) -> int:
+        """Search from the source cells; returns the number of targets settled. ``stop``: a cell
+        (row, col) at which to stop as soon as it is settled (the path to it is then the one the
+        whole search gives)."""
         src_r = np.atleast_1d(np.asarray(src_r, np.int64))
         src_c = np.atleast_1d(np.asarray(src_c, np.int64))
         self.source = (tuple(src_r), tuple(src_c))
         while True:  # a search that fills the heap runs again, from scratch, with a larger one
             self.gen += 1
             self.tmark[t_rows, t_cols] = self.gen
+            stop_idx = -1 if stop is None else int(stop[0]) * passable.shape[1] + int(stop[1])
             settled = _dijkstra(passable, cost, src_r, src_c, self.tmark, n_stop, max_cost, self.dist, self.length_,
-                                self.parent, self.touched, self.closed, self.gen, self._hk, self._hi)
+                                self.parent, self.touched, self.closed, self.gen, self._hk, self._hi, stop_idx)
             if settled >= 0:
                 return settled
             self._hk, self._hi = np.empty(2 * self._hk.size), np.empty(2 * self._hi.size, np.int64)

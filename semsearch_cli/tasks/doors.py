@@ -215,22 +215,35 @@ class DoorSearch(DoorSensing):
     @staticmethod
     def searched(ctx, cands) -> list | None:
         """The search the planner left in the belief, if the path to its target may reuse it
-        (from the robot's cell, on the current maps): ``[n_stop]`` over the candidates, or
-        ``[n_stop, rows, cols]`` over other cells; None when there is none."""
+        (from the robot's cell, on the current maps): ``[n_stop, again]`` over the candidates, or
+        ``[n_stop, rows, cols, again]`` over other cells (``again`` 1 when the search went on over
+        every cell, :meth:`~semsearch_cli.belief.DoorBelief.search`); None when there is none."""
         held = ctx.belief.held_search(ctx.row, ctx.col)
         if held is None:
             return None
-        rows, cols, n_stop = held
+        rows, cols, n_stop, again = held
         if np.array_equal(rows, cands.rows) and np.array_equal(cols, cands.cols):
-            return [int(n_stop)]
-        return [int(n_stop), [int(v) for v in rows], [int(v) for v in cols]]
+            return [int(n_stop), int(again)]
+        return [int(n_stop), [int(v) for v in rows], [int(v) for v in cols], int(again)]
 
     @staticmethod
     def search_again(ctx, cands, left) -> None:
-        """Run again the search :meth:`searched` recorded (a replay: the planner that ran it is absent)."""
-        n_stop, *cells = left
+        """Put back the search :meth:`searched` recorded (a replay: the planner that ran it is
+        absent), run at the path to the chosen target and stopped there
+        (:meth:`~semsearch_cli.belief.DoorBelief.search_again`). A record of semsearch 0.3 before
+        this (``[n_stop]``, ``[n_stop, rows, cols]``: no ``again``) runs it in whole at once."""
+        if len(left) in (2, 4):
+            *spec, again = left
+            if again not in (0, 1) or isinstance(again, bool):
+                raise ValueError("the search's last item is 0 or 1")
+            again = bool(again)
+        elif len(left) in (1, 3):
+            spec, again = left, None
+        else:
+            raise ValueError("expected [n_stop, again] or [n_stop, rows, cols, again]")
+        n_stop, *cells = spec
         rows, cols = (cands.rows, cands.cols) if not cells else (np.asarray(cells[0], np.int64), np.asarray(cells[1], np.int64))
-        ctx.belief.search(ctx.row, ctx.col, rows, cols, int(n_stop))
+        ctx.belief.search_again(ctx.row, ctx.col, rows, cols, int(n_stop), again)
 
     def prepare(self, st):
         """The first half of a re-plan: at a wall face the robot came to look at, look all round;
