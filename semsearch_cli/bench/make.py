@@ -134,6 +134,24 @@ def make_doors_v1(split: str, salt: str, out: Path) -> None:
     write_manifest(SUITE_DOORS, split, out, floors)
 
 
+def freeze_shipped(name: str, suite: Suite, dest: Path) -> None:
+    """The shipped scenario ``name`` frozen into ``dest`` for ``suite``: its map image and its
+    labels' file (the suite's ``labels`` key, when it has one) copied beside it, its episodes
+    frozen with the suite's repeats (:func:`freeze_episodes`)."""
+    src = CONFIGS / f"{name}.yaml"
+    doc = yaml.safe_load(src.read_text())
+    dest.mkdir()
+    files = [(doc["map"], "image")] + ([(doc, suite.labels)] if suite.labels else [])
+    for owner, key in files:
+        f = src.parent / owner[key]
+        shutil.copyfile(f, dest / f.name)
+        owner[key] = f.name
+    doc["experiment"].pop("out", None)
+    (dest / "scenario.yaml").write_text(f"# the shipped scenario {name} (configs/{name}.yaml), frozen for {suite.name}\n"
+                                        + yaml.safe_dump(doc, sort_keys=False))
+    freeze_episodes(dest / "scenario.yaml", suite.repeats)
+
+
 CLASSIC = ("normal", "inverse", "hotel_thesis", "kth")  # the shipped thesis door scenarios, in the thesis' order
 
 
@@ -143,21 +161,7 @@ def make_doors_classic(split: str, salt: str, out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     floors = []
     for name in CLASSIC:
-        src = CONFIGS / f"{name}.yaml"
-        doc = yaml.safe_load(src.read_text())
-        dest = out / name
-        dest.mkdir()
-        for key in ("image",):
-            f = src.parent / doc["map"][key]
-            shutil.copyfile(f, dest / f.name)
-            doc["map"][key] = f.name
-        f = src.parent / doc["doors"]
-        shutil.copyfile(f, dest / f.name)
-        doc["doors"] = f.name
-        doc["experiment"].pop("out", None)
-        (dest / "scenario.yaml").write_text(f"# the shipped scenario {name} (configs/{name}.yaml), frozen for doors-classic-v1\n"
-                                            + yaml.safe_dump(doc, sort_keys=False))
-        freeze_episodes(dest / "scenario.yaml", 10)
+        freeze_shipped(name, SUITE_CLASSIC, out / name)
         floors.append((name, {"scenario": f"configs/{name}.yaml"}))
     write_manifest(SUITE_CLASSIC, split, out, floors)
 
@@ -202,16 +206,7 @@ def make_objects(split: str, salt: str, out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     floors = []
     if split == "val":
-        src = CONFIGS / "office.yaml"
-        doc = yaml.safe_load(src.read_text())
-        dest = out / "office"
-        dest.mkdir()
-        f = src.parent / doc["map"]["image"]
-        shutil.copyfile(f, dest / f.name)
-        doc["map"]["image"] = f.name
-        (dest / "scenario.yaml").write_text("# the shipped scenario office (configs/office.yaml), frozen for objects-v1\n"
-                                            + yaml.safe_dump(doc, sort_keys=False))
-        freeze_episodes(dest / "scenario.yaml", 10)
+        freeze_shipped("office", SUITE_OBJECTS, out / "office")
         floors.append(("office", {"scenario": "configs/office.yaml"}))
     else:
         for i in range(OFFICES):

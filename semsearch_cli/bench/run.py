@@ -24,6 +24,7 @@ import pandas as pd
 import yaml
 
 from ..config import PlannerSpec
+from ..config.base import sign_label
 from ..errors import ScenarioError
 from ..files import atomic_text, output_folder
 from ..report.build import write_meta
@@ -36,11 +37,6 @@ from .predictability import predictability
 from .suites import Floor, Split, open_split, suite_named
 
 BENCH_FILE = "bench.json"
-
-
-def _label_value(text: str):
-    """A label as a scenario writes it: a whole number as an int, anything else as text."""
-    return int(text) if text.isdigit() and (text == "0" or not text.startswith("0")) else text
 
 
 def _copy_named(doc, base: Path, dest: Path):
@@ -79,9 +75,10 @@ def materialise(split: Split, floor: Floor, numbering: str, dest: Path) -> Path:
             r[k] = new[r[k].strip()]
         with door_file.open("w", newline="") as fh:
             csv.writer(fh, lineterminator="\n").writerows([head, *body])
-        doc["goals"] = [_label_value(new[str(g)]) for g in doc["goals"]]
+        canon = {str(sign_label(a)): b for a, b in new.items()}  # goals as the scenario reads them (a file's "024" is 24)
+        doc["goals"] = [sign_label(canon[str(sign_label(g))]) for g in doc["goals"]]
         eps = pd.read_csv(dest / doc["episodes"]["file"], dtype=str, keep_default_na=False)
-        eps["goal"] = [new[g] for g in eps["goal"]]
+        eps["goal"] = [str(sign_label(canon[str(sign_label(g))])) for g in eps["goal"]]
         eps["hash"] = [Episode(0, g, float(x), float(y), float(h) if h else None, int(r) if r else None).hash
                        for g, x, y, h, r in zip(eps["goal"], eps["start_x"], eps["start_y"], eps["start_heading"], eps["room"])]
         eps.to_csv(dest / doc["episodes"]["file"], index=False, lineterminator="\n")
