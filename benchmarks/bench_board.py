@@ -31,7 +31,8 @@ FIRST = {"doors": ["nsos[alpha=0.9]", "greedy"], "objects": ["lsos"]}  # listed 
 
 
 def planners_of(kind: str) -> list[str]:
-    rest = sorted(n for n, c in PLANNERS.items() if c.task == kind and n not in {p.split("[")[0] for p in FIRST.get(kind, [])})
+    rest = sorted(n for n, c in PLANNERS.items()
+                  if c.task == kind and not c.service and n not in {p.split("[")[0] for p in FIRST.get(kind, [])})
     return FIRST.get(kind, []) + rest
 
 

@@ -21,7 +21,8 @@ from .world.importers import kth, mobilesim, ros
 from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
-from .planners import PLANNERS, expand_variants, load_entry_points
+from .planners import PLANNERS, expand_variants, load_entry_points, planner_class
+from .planners.llm import FirstPrompt
 from .plugins import load_kinds
 from .report import build as report_build
 from .report.document import atomic_text, markdown_table
@@ -30,6 +31,7 @@ from .report.tables import summarise, sweep_table
 from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows, workers_for
 from .runner.verify import Verdict, verify_folder
 from .tasks import TASKS
+from .tasks.decisions import Seat
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import check_outputs, inside, output_file, output_folder, temp_path
@@ -84,6 +86,41 @@ def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=N
         if plots:
             report([out_dir], formats=("md", "csv", "png", "html"), replay=False)
     return RunOutput(out_dir, runs, summary)
+
+
+class _DrySeat(Seat):
+    """A dry run's seat: a planner that calls a language model stops at its first call
+    (:class:`~semsearch_cli.planners.llm.FirstPrompt`) instead of making it."""
+
+    def planner(self, variant):
+        p = variant.build()
+        p.dry_run = True
+        return self.seat(p)
+
+
+def first_prompt(scenario: str | Path, options: BatchOptions = BatchOptions()) -> str:
+    """The first prompt a run of the scenario would send to a language model (``semsearch run
+    --dry-run``): the first planner that calls one (``Planner.service``; among ``options.planners``
+    when given) on the first episode (of ``options.goals``) that asks it anything, repeat 0, as the
+    messages it would send (``--- system ---``, ``--- user ---``). Nothing is called and nothing
+    is written."""
+    loaded = Loaded.load(scenario_file(scenario))
+    task = loaded.task
+    chosen = set(map(str, options.planners or ()))
+    variants = [v for v in task.variants() if planner_class(v).service and (not chosen or {v.name, v.label} & chosen)]
+    if not variants:
+        raise ScenarioError(str(loaded.path), "planners", "no planner of this scenario calls a language model (llm); "
+                            "--dry-run prints the first prompt such a planner would send")
+    goals = set(map(str, options.goals or ()))
+    for ep in task.episodes:
+        if goals and str(ep.goal) not in goals:
+            continue
+        try:
+            task.run(variants[0], ep, 0, seat=_DrySeat())
+        except FirstPrompt as stop:
+            return stop.text()
+    raise ScenarioError(str(loaded.path), "planners", f"{variants[0].label} was asked nothing on these episodes (each "
+                        "found its goal before a decision)")
 
 
 def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", "html"), replay: bool | str = True) -> list[Path]:

@@ -86,6 +86,7 @@ GOALS = typer.Option(None, "--goal", help="Only these goals (repeat or comma-sep
 PLANNERS = typer.Option(None, "--planner", help="Only these planners, by name or label (repeat or comma-separate).")
 TRACE = typer.Option(False, "--trace", help="Also write each run's decisions (pose, candidates, factors, choice) to traces/<run>.jsonl.")
 FRAMES = typer.Option(False, "--frames", help="Also write each run's replay frames to frames/<run>.npz: the report then replays any run from them, without re-running it.")
+TRANSCRIPTS = typer.Option(False, "--transcripts", help="Also write each run's language-model transcript to transcripts/<run>.jsonl (the llm planner): {name: llm, replay: DIR} replays the runs from them, offline.")
 DECISIONS = typer.Option(False, "--decisions", help="Also write each run's decisions to decisions/<run>.json (a few bytes each): `semsearch verify` then replays every run from them, without its planner.")
 FORCE = typer.Option(False, "--force", help="Re-run everything when the folder holds rows of another (or an edited) scenario; the old runs.csv is kept as runs.<n>.csv.bak, its runs' paths, traces and frames in runs.<n>.bak/.")
 OVERSUBSCRIBE = typer.Option(False, "--oversubscribe", help="Allow more workers than CPUs (slower runs, more memory; e.g. a planner that waits on I/O).")
@@ -94,7 +95,7 @@ SCHEDULER = typer.Option(None, "--scheduler", help="A Dask scheduler's address, 
 
 
 def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames=False,
-             decisions=False) -> BatchOptions:
+             decisions=False, transcripts=False) -> BatchOptions:
     """The batch options of the command line (a bad --goal or --planner list exits with status 2)."""
     try:
         goals, planners = _split(goal, "--goal"), _split(planner, "--planner", labels=False)
@@ -102,7 +103,7 @@ def _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe
         _fail(exc)
     return BatchOptions(seeds=seeds, goals=goals, planners=planners, out=out_dir, workers=workers,
                         oversubscribe=oversubscribe, executor=executor, scheduler=scheduler, trace=trace, force=force,
-                        frames=frames, decisions=decisions)
+                        frames=frames, decisions=decisions, transcripts=transcripts)
 
 
 @app.command()
@@ -116,6 +117,8 @@ def run(
     trace: bool = TRACE,
     frames: bool = FRAMES,
     decisions: bool = DECISIONS,
+    transcripts: bool = TRANSCRIPTS,
+    dry_run: bool = typer.Option(False, "--dry-run", help="Print the first prompt a language-model planner (llm) of the scenario would send, and stop: nothing is called or written."),
     force: bool = FORCE,
     oversubscribe: bool = OVERSUBSCRIBE,
     executor: str = EXECUTOR,
@@ -125,7 +128,13 @@ def run(
     runs.csv as runs finish (an interrupted batch resumes), then summary.csv and plots/ are written."""
 
     opts = _options(seeds, workers, goal, planner, out_dir, trace, force, oversubscribe, executor, scheduler, frames,
-                    decisions)
+                    decisions, transcripts)
+    if dry_run:
+        try:
+            typer.echo(api.first_prompt(scenario, opts))
+        except ScenarioError as exc:
+            _fail(exc)
+        return
     _batch(lambda tick: api.run(scenario, opts, progress=tick))
 
 
@@ -491,6 +500,7 @@ def bench_run(
     limit: Optional[int] = typer.Option(None, "--limit", min=1, help="Only the first N episodes of the split (a first look)."),
     planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner(s)."),
     salt_file: Optional[Path] = typer.Option(None, "--salt-file", help="The salt of a hidden split (maintainers)."),
+    transcripts: bool = TRANSCRIPTS,
     workers: Optional[int] = WORKERS,
     oversubscribe: bool = OVERSUBSCRIBE,
     executor: str = EXECUTOR,
@@ -498,7 +508,8 @@ def bench_run(
 ):
     """Run planners on a suite's split: every run recorded with its decisions (semsearch verify
     DIR replays them), every row with the suite's hash; resumable."""
-    opts = BatchOptions(workers=workers, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler)
+    opts = BatchOptions(workers=workers, oversubscribe=oversubscribe, executor=executor, scheduler=scheduler,
+                        transcripts=transcripts)
     res = _with_progress(lambda tick: api.bench_run(suite, planner, out_dir, split, numbering, opts, limit, salt_file,
                                                     planner_file, progress=tick))
     runs = res.runs[res.runs["stage"] == ""]

@@ -49,6 +49,11 @@ class PlannerError(Exception):
     the value."""
 
 
+class BudgetSpent(PlannerError):
+    """A planner's own budget for a run (a language model's calls or tokens) is spent: the run
+    ends with outcome ``budget`` and this message, as when the scenario's distance budget is."""
+
+
 class RunTimeout(BaseException):
     """A run past its wall-clock limit (``experiment.run_time_limit``); a BaseException, so that a
     planner's ``except Exception`` cannot swallow it."""

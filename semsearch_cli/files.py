@@ -183,3 +183,13 @@ def inside(folder: Path, name, flag: str = "--out") -> Path:
     if path.resolve().parent != Path(folder).resolve():
         raise ScenarioError("<command line>", flag, f"{name!r} would write outside {folder}")
     return path
+
+
+def cache_dir() -> Path:
+    """Where semsearch keeps what it makes once per machine (generated bench splits, fetched
+    floors, the llm planner's request slots): ``$SEMSEARCH_CACHE``, else
+    ``$XDG_CACHE_HOME/semsearch``, else ``~/.cache/semsearch``."""
+    if os.environ.get("SEMSEARCH_CACHE"):
+        return Path(os.environ["SEMSEARCH_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "semsearch"

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 import math
 
+from .planners.base import COST_COLUMNS  # noqa: F401  (the rows' cost columns, read with the others from here)
+
 # the columns of runs.csv as 0.2.0 wrote them, for every kind: the ones every kind writes, and the
 # built-in kinds' own (room and time_s: indirect search; stage and map: chains), each in its place.
 # A runs.csv holds all of them through 0.2.x; a kind's columns beyond these (a kind from another
@@ -18,6 +20,7 @@ SHARED = [c for c in COLUMNS if c not in BUILT_IN_KIND_COLUMNS]  # what every ki
 # split's hash, the numbering its labels were run under, the floor (a folder of the split), and the
 # SHA-256 of the run's decisions file (decisions/<run>.json: the record that replays it)
 BENCH_COLUMNS = ("suite", "split", "suite_hash", "numbering", "floor", "decisions_sha256")
+# what a planner that pays for its decisions reports on each row: planners.base.COST_COLUMNS
 
 
 def columns_for(kind_columns) -> list[str]:

@@ -11,7 +11,8 @@ import pytest
 
 gym = pytest.importorskip("gymnasium")
 
-from semsearch_cli.envs.base import FRAME_TEXT, TEXT_CHARSET, TEXT_LENGTH, clip_text, deg, spell  # noqa: E402
+from semsearch_cli.envs.base import TEXT_CHARSET, TEXT_LENGTH, clip_text  # noqa: E402
+from semsearch_cli.planners.text import FRAME_TEXT, deg, spell  # noqa: E402
 
 from .test_envs import KWARGS, MODES, make  # noqa: E402
 

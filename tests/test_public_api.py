@@ -21,6 +21,7 @@ PLANNER_NAMES = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "
 # the Python API: each function with its parameters in order
 API = {
     "run": ["scenario", "options", "progress", "plots", "planner_specs"],
+    "first_prompt": ["scenario", "options"],
     "report": ["folders", "out", "formats", "replay"],
     "sweep_alpha": ["scenario", "alphas", "options", "progress"],
     "sweep": ["scenario", "param", "values", "options", "progress"],

@@ -24,6 +24,7 @@ from scipy.stats import kendalltau, spearmanr
 
 from ..errors import ScenarioError
 from ..files import atomic_text, output_folder
+from ..metrics import COST_COLUMNS
 from ..report.document import Document
 from ..report.figures.bench import plot_gain_vs_predictability
 from ..report.indirect import PAPER_SCALES, PAPER_TABLE3, claims_table
@@ -34,7 +35,6 @@ from .suites import PUBLISHED
 
 BASELINES = {"doors": "nsos[alpha=0.9]", "objects": "lsos"}  # each kind's planner of the thesis, the board's reference
 VERIFY_FILE = "verify.json"
-COST_COLUMNS = ("calls", "tokens")  # a planner that reports its cost (language models) adds these to its rows
 
 
 def rows_digest(folder: Path) -> str:
@@ -145,9 +145,12 @@ def tables(rows: pd.DataFrame) -> dict:
         sh = rows[(rows["numbering"] == "shuffled") & (rows["planner"] == lab)]
         m, lo, hi, n = paired_diff(d, sh) if len(sh) else (np.nan, np.nan, np.nan, 0)
         row["semantic gain"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
-        for c in COST_COLUMNS:
-            if c in d.columns and pd.to_numeric(d[c], errors="coerce").notna().any():
-                row[f"{c} per run"] = f"{pd.to_numeric(d[c], errors='coerce').mean():.1f}"
+        for c in COST_COLUMNS:  # what a planner that pays for its decisions reports (a language model): summed
+            v = pd.to_numeric(d[c], errors="coerce") if c in d.columns else pd.Series(dtype=float)
+            if v.notna().any():
+                row[c] = f"{v.sum():.1f}" if c == "llm_s" else f"{int(v.sum()):,}"
+                if c == "llm_calls":
+                    row["calls per run"] = f"{v.mean():.1f}"
         row["verified"] = ", ".join(sorted(set(d["verdict"])))
         row["official"] = "yes" if d["official"].all() else "no"
         out.append(row)

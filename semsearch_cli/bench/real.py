@@ -27,10 +27,11 @@ from pathlib import Path
 import yaml
 
 from ..errors import ScenarioError
+from ..files import cache_dir
 from ..world.importers.kth import import_kth
 from ..world.importers.mobilesim import import_mobilesim
 from .make import DEFAULT_PLANNER, DOORS_V1_MIN_DISTANCE, DOORS_V1_STARTS, floor_rng, freeze_episodes
-from .suites import DATA, Split, Suite, cache_dir, fetched_folder, read_split, scenario_content, write_manifest
+from .suites import DATA, Split, Suite, fetched_folder, read_split, scenario_content, write_manifest
 
 TIMEOUT_S = 60.0  # per file fetched
 

@@ -29,7 +29,7 @@ import numpy as np
 import yaml
 
 from ..errors import ScenarioError, did_you_mean
-from ..files import atomic_text
+from ..files import atomic_text, cache_dir
 from ..runner.specs import files_by_content
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "bench"
@@ -142,15 +142,6 @@ def split_hash(suite: Suite, split: str, floors) -> str:
     content = {"suite": suite.name, "split": split, "repeats": suite.repeats,
                "floors": [{"id": f.id, "scenario": scenario_content(f.scenario)} for f in floors]}
     return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
-
-
-def cache_dir() -> Path:
-    """Where generated splits and fetched floors are kept: ``$SEMSEARCH_CACHE``, else
-    ``$XDG_CACHE_HOME/semsearch``, else ``~/.cache/semsearch``."""
-    if os.environ.get("SEMSEARCH_CACHE"):
-        return Path(os.environ["SEMSEARCH_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "semsearch"
 
 
 def read_salt(salt_file: str | Path) -> str:

@@ -66,8 +66,8 @@ from ..tasks.decisions import DecisionPoint, StandIn
 from ..tasks.doors import DoorSearch
 from ..tasks.loop import Session
 from ..world.labels import parse_label
-from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, check_flag, check_number, clip_text, compass_moves,
-                   compass_step, deg, text_space, window)
+from .base import (BIG, SearchEnv, box, check_flag, check_number, clip_text, compass_moves, compass_step, text_space, window)
+from ..planners.text import FRAME_TEXT, answer_line, deg
 
 # The largest window radius (cells). 2048 gives a window of 4097 cells a side (410 m at 0.1 m
 # cells: the whole Hotel, 133 m x 70 m, from any pose); each uint8 grid of it is 16 MB and an

@@ -51,8 +51,8 @@ from ..planners import Goal
 from ..tasks.indirect import IndirectSearch
 from ..tasks.decisions import StandIn
 from ..tasks.loop import Session
-from .base import (BIG, FRAME_TEXT, TWO_PI, SearchEnv, answer_line, box, check_choice, check_flag, check_number, clip_text,
-                   deg, ended, text_space)
+from .base import (BIG, TWO_PI, SearchEnv, box, check_choice, check_flag, check_number, clip_text, ended, text_space)
+from ..planners.text import FRAME_TEXT, answer_line, deg
 
 HEADINGS = np.radians(np.arange(0, 360, 45))
 

@@ -45,8 +45,8 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..tasks.loop import Session
 from ..tasks.objects import ObjectSearch
-from .base import (BIG, FRAME_TEXT, SearchEnv, answer_line, box, clip_text, compass_moves, compass_step, deg,
-                   ended, text_space)
+from .base import (BIG, SearchEnv, box, clip_text, compass_moves, compass_step, ended, text_space)
+from ..planners.text import FRAME_TEXT, answer_line, deg
 
 
 class ObjectSearchEnv(SearchEnv):

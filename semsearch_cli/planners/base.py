@@ -43,6 +43,12 @@ from ..provenance import code_hash, files_hash
 from ..registry import Registry
 
 
+# the row columns of what a planner's decisions cost (``Planner.cost_columns``; the llm planner:
+# its calls to the model, their prompt and reply tokens, the replies it could not take, the
+# decisions it fell back on the nearest target for, and the seconds spent waiting for replies)
+COST_COLUMNS = ("llm_calls", "tokens_in", "tokens_out", "invalid_replies", "fallbacks", "llm_s")
+
+
 class NoParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -70,6 +76,7 @@ class DoorContext:
     - ``headings``: the robot's heading (radians) at every pose so far.
     - ``explain``: whether the caller keeps the numbers behind each choice (``Decision.info``,
       for traces and recordings); a planner may skip tabulating them when it is False.
+    - ``distance``: the metres travelled so far in the run (NaN when the caller does not say).
     """
 
     belief: DoorBelief
@@ -82,6 +89,7 @@ class DoorContext:
     rng: np.random.Generator
     headings: list = field(default_factory=list)
     explain: bool = True
+    distance: float = float("nan")  # m travelled so far in the run (NaN: not known)
 
 
 @dataclass
@@ -175,9 +183,30 @@ class Planner:
     # the attributes that shape a run besides the planner's choices: a run's decisions record
     # keeps them, and its replay seats a stand-in that has them (semsearch_cli.tasks.decisions)
     run_attributes: ClassVar[tuple] = ()
+    # the row columns of what the planner's decisions cost (metrics.COST_COLUMNS: a language
+    # model's calls and tokens), filled from its ``costs()`` after each run and summed by reports
+    cost_columns: ClassVar[tuple] = ()
+    # answers through a service outside semsearch (a language model's endpoint) and needs its
+    # parameters to run: what takes every built-in planner with its defaults (the bench board,
+    # the golden runs) leaves it out
+    service: ClassVar[bool] = False
 
     def __init__(self, params: BaseModel):
         self.params = params
+
+    @classmethod
+    def fault(cls, params: BaseModel) -> tuple[str, str] | None:
+        """What is wrong with parameters that are each valid but do not go together (the field to
+        name, the message), checked when the scenario loads; None when nothing is. The defaults
+        may be faulty this way (the llm planner needs a model named)."""
+        return None
+
+    @classmethod
+    def inputs(cls, params: BaseModel) -> str:
+        """What the planner's results depend on besides its code and its parameters' values, as
+        text that :func:`code_of` hashes: the bytes of the files its parameters name (the llm
+        planner's prompt and transcripts). Nothing by default."""
+        return ""
 
 
 class DoorPlanner(Planner):
@@ -481,6 +510,7 @@ class Variant:
     name: str
     params: tuple  # sorted (key, value) pairs as given by the user
     module: str | None = None
+    base: str | None = None  # the scenario's folder (absolute), for a planner whose parameters name files (path_fields)
 
     @property
     def label(self) -> str:
@@ -490,7 +520,23 @@ class Variant:
 
     def build(self) -> Planner:
         cls = planner_class(self)
-        return cls(cls.Params(**dict(self.params)))
+        return cls(self.resolved(cls))
+
+    def resolved(self, cls: type[Planner] | None = None) -> BaseModel:
+        """The variant's parameters as its planner takes them: the files they name (its
+        :func:`path_fields`) relative to the scenario's folder, as written in the label."""
+        cls = cls or planner_class(self)
+        params = dict(self.params)
+        for k in path_fields(cls.Params):
+            if params.get(k) is not None and self.base is not None:
+                params[k] = str(Path(self.base) / str(params[k]))
+        return cls.Params(**params)
+
+
+def path_fields(params: type[BaseModel]) -> tuple[str, ...]:
+    """The parameters of a planner that name a file or folder (relative to the scenario's
+    folder): fields declared with ``Field(json_schema_extra={"path": True})``."""
+    return tuple(k for k, f in params.model_fields.items() if isinstance(f.json_schema_extra, dict) and f.json_schema_extra.get("path"))
 
 
 def planner_named(label: str) -> type[Planner] | None:
@@ -567,7 +613,11 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
         for combo in itertools.product(*values):
             p = tuple(zip(keys, combo))
             try:
-                PLANNERS[name].Params(**dict(p))
+                fault = PLANNERS[name].fault(PLANNERS[name].Params(**dict(p)))
+                if fault:
+                    raise ScenarioError(file, f"planners[{i}].{fault[0]}", fault[1])
+            except ScenarioError:
+                raise
             except ValidationError as exc:
                 e = exc.errors()[0]
                 loc = ".".join(str(x) for x in e["loc"])
@@ -583,7 +633,12 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                 raise ScenarioError(file, f"planners[{i}]", f"planner {name!r} with "
                                     f"{', '.join(f'{k}={v!r}' for k, v in p) or 'its defaults'}: its Params raised "
                                     f"{type(exc).__name__}: {exc}{at}") from None
-            v = Variant(name, p, module)
+            paths = path_fields(PLANNERS[name].Params)
+            for k, value in p:
+                if k in paths and value is not None and not ((base or Path(".")) / str(value)).exists():
+                    raise ScenarioError(file, f"planners[{i}].{k}", f"{value} does not exist (a path relative to the "
+                                        "scenario's folder)")
+            v = Variant(name, p, module, str((base or Path(".")).resolve()) if paths else None)
             key = (v.label, module)  # rows name a variant by its label; a set keeps a big sweep linear
             if key not in seen:
                 seen.add(key)
@@ -614,8 +669,10 @@ def code_of(variant: Variant) -> dict:
     :func:`~semsearch_cli.provenance.code_hash`) and the planner's: a user's file by its bytes and
     those of the other Python files beside it (modules it may import); a planner from an
     installed package by that distribution's name and version and the hash of its package's
-    Python files (an editable install changes with its files). ``hash`` (16 hex digits) combines
-    them; rows carry it in their ``code`` column."""
+    Python files (an editable install changes with its files); and the files its parameters name
+    (:meth:`Planner.inputs`: the llm planner's prompt and transcripts). ``hash`` (16 hex digits)
+    combines them; rows carry it in their ``code`` column, and a batch sets aside rows whose hash
+    is not the variant's."""
     cls = planner_class(variant)
     out = {"planner": variant.label, "semsearch": __version__, "semsearch_code": code_hash()}
     mod = cls.__module__
@@ -638,6 +695,10 @@ def code_of(variant: Variant) -> dict:
             root = Path(src).parent if Path(src).name == "__init__.py" else None
             out["package_code"] = files_hash(root) if root else hashlib.sha256(Path(src).read_bytes()).hexdigest()[:16]
         own = out["distribution"] + out.get("package_code", "")
+    inputs = cls.inputs(variant.resolved(cls))
+    if inputs:  # the files its parameters name (a prompt, transcripts): rows made from others are not reused
+        out["inputs_sha256"] = hashlib.sha256(inputs.encode()).hexdigest()
+        own += out["inputs_sha256"]
     parts = [out["semsearch"], out["semsearch_code"], own]
     out["hash"] = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     return out

@@ -30,7 +30,7 @@ from . import doors, objects, chain, indirect  # noqa: F401  (each registers its
 from ..plugins import load_kinds
 from .sections import SECTIONS, replaying
 from .stats import episodes
-from .tables import goal_key, planner_order
+from .tables import cost_table, goal_key, planner_order
 from .document import Code, Document, atomic_text
 
 ABSOLUTE = re.compile(r"(?<![\w.])/[^\s:;,()'\"]+")  # an absolute path in a message (a report names none)
@@ -292,6 +292,14 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
     notes: list[str] = []
     for kind, parts in parts_by_kind.items():
         SECTIONS[kind].section(doc, parts, out, formats, replay, notes)
+    costs = cost_table(pd.concat([p.runs for ps in parts_by_kind.values() for p in ps], ignore_index=True))
+    if len(costs):  # a planner that pays for its decisions (a language model), whatever the kind
+        doc.heading(2, "What the planners' decisions cost")
+        doc.para("Summed over each planner's runs (the rows' llm_calls, tokens_in, tokens_out, invalid_replies, "
+                 "fallbacks, llm_s): calls to the language model, tokens as its server counted them, replies that "
+                 "could not be taken, decisions taken by the fallback (the nearest target), seconds waiting for replies.")
+        doc.table(costs)
+        atomic_text(out / "tables" / "costs.csv", costs.to_csv(index=False))
     here = [relative(f, out) for f in folders]
     rebuild = "semsearch report " + " ".join(shlex.quote(f) for f in here) + ("" if here == ["."] else " --out .")
     for folder, meta in metas.items():

@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from ..metrics import CAUSES as OUTCOME_CAUSES
+from ..metrics import CAUSES as OUTCOME_CAUSES, COST_COLUMNS
 from ..planners.base import baseline_of, planner_order  # noqa: F401  (planner_order: the report order, used across report/)
 from . import stats as S
 
@@ -331,3 +331,27 @@ def sweep_table(runs: pd.DataFrame, param: str) -> pd.DataFrame:
                 std_ratio=("ratio", "std"), median_m=("distance_m", "median")).reset_index()
     out = out.rename(columns={"value": param})
     return out.round(3)
+
+
+def cost_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Per scenario and planner that reports what its decisions cost (a language model:
+    :data:`~semsearch_cli.metrics.COST_COLUMNS`), the runs, each cost summed over them, and calls
+    and tokens per run; empty when no row holds a cost."""
+    have = [c for c in COST_COLUMNS if c in runs.columns]
+    if not have:
+        return pd.DataFrame()
+    costs = runs[have].apply(pd.to_numeric, errors="coerce")
+    rows = runs.loc[costs.notna().any(axis=1)]
+    if rows.empty:
+        return pd.DataFrame()
+    out = []
+    for (scenario, planner), g in rows.groupby(["scenario", "planner"], sort=False):
+        c = costs.loc[g.index]
+        row = {"scenario": scenario, "planner": planner, "runs": len(g)}
+        row |= {k: round(float(c[k].sum()), 3) if k == "llm_s" else int(c[k].sum()) for k in have}
+        if "llm_calls" in have:
+            row["calls per run"] = round(float(c["llm_calls"].mean()), 1)
+        if {"tokens_in", "tokens_out"} <= set(have):
+            row["tokens per run"] = round(float((c["tokens_in"] + c["tokens_out"]).mean()), 1)
+        out.append(row)
+    return pd.DataFrame(out)

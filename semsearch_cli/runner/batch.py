@@ -14,7 +14,7 @@ import pandas as pd
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
 from ..metrics import columns_for
-from ..planners import code_of
+from ..planners import code_of, planner_class
 from .execution import Executor, Watch
 from .executors import SerialExecutor, make_executor
 from .options import BatchOptions
@@ -206,7 +206,7 @@ class Batch:
         loaded, specs, out, options, done = self.loaded, self.specs, self.out, self.options, self.done
         runs_csv = out / "runs.csv"
         workers, executor = options.workers or 1, options.executor
-        watch = Watch(options.trace, options.frames, options.decisions)
+        watch = Watch(options.trace, options.frames, options.decisions, options.transcripts)
         fp = loaded.fingerprint
         codes = self.codes
         have = {(str(p), str(g), int(e), int(s)) for p, g, e, s in zip(done["planner"], done["goal"], done["episode"], done["seed"])} \
@@ -222,7 +222,8 @@ class Batch:
             serial = total == 0 or (executor == "processes" and total == 1)
             runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), options.start_method, executor,
                                                                    options.scheduler)
-        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *self.stamp, *self.own]))
+        costs = [c for v in self.variants for c in planner_class(v).cost_columns]  # a language model's calls and tokens
+        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *costs, *self.stamp, *self.own]))
         n = 0
         try:
             for rows in runner.rows(loaded, todo, out, watch):

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import RunTimeout
 from ..kernels import announce_compiling
 from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
-from ..tasks.decisions import Recording
+from ..tasks.decisions import Recording, Seat
 from ..tasks.loop import running
 from .specs import Loaded, RunSpec
 from .store import decisions_digest, save_run_files
@@ -28,11 +28,14 @@ class Watch:
     """What a batch keeps of each run beside its rows: its decisions' ``trace`` (traces/<run>.jsonl),
     its replay's ``frames`` (frames/<run>.npz, which a report replays without re-running) and its
     ``decisions`` (decisions/<run>.json, the choices that replay it without its planner:
-    :mod:`semsearch_cli.tasks.decisions`, ``semsearch verify``)."""
+    :mod:`semsearch_cli.tasks.decisions`, ``semsearch verify``) and its planner's ``transcripts``
+    (transcripts/<run>.jsonl: a language model's prompts and replies, which replay it offline:
+    :mod:`semsearch_cli.planners.llm`)."""
 
     trace: bool = False
     frames: bool = False
     decisions: bool = False
+    transcripts: bool = False
 
 
 def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list[dict], RunResult]:
@@ -49,12 +52,13 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
         with wall_clock_limit(limit):
             tracer = TraceObserver() if watch.trace else None
             recorder = FrameRecorder() if watch.frames else None
-            seat = Recording() if watch.decisions else None
+            seat = Recording() if watch.decisions else Seat()
             watching = Observers(tracer, recorder) if tracer or recorder else None
-            res = (task.run(spec.variant, spec.episode, spec.seed, watching) if seat is None
-                   else task.run(spec.variant, spec.episode, spec.seed, watching, seat=seat))
-            if seat is not None:
+            res = task.run(spec.variant, spec.episode, spec.seed, watching, seat=seat)
+            if watch.decisions:
                 res.decisions_record = {**seat.record(task.kind), **identity(loaded, spec)}
+            if not watch.transcripts:
+                res.transcripts = []
             if tracer is not None:
                 res.trace = tracer.rows
             if recorder is not None:

@@ -28,7 +28,9 @@ class BatchOptions:
     :class:`~semsearch_cli.runner.ProcessExecutor`); ``trace``: write each run's decisions to
     ``traces/``; ``frames``: write each run's replay frames to ``frames/`` (a report then replays
     any run without re-running it); ``decisions``: write each run's decisions to ``decisions/``
-    (``semsearch verify`` replays them without the planner); ``force``: start afresh in a folder holding rows of another scenario (the old
+    (``semsearch verify`` replays them without the planner); ``transcripts``: write each run's
+    language-model transcript to ``transcripts/`` (the ``llm`` planner replays them offline,
+    ``{name: llm, replay: DIR}``); ``force``: start afresh in a folder holding rows of another scenario (the old
     runs.csv is kept as ``runs.<n>.csv.bak``)."""
 
     seeds: int | None = None
@@ -43,6 +45,7 @@ class BatchOptions:
     trace: bool = False
     frames: bool = False
     decisions: bool = False
+    transcripts: bool = False
     force: bool = False
 
     def replace(self, **changes) -> "BatchOptions":

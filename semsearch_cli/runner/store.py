@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError, did_you_mean
-from ..metrics import BENCH_COLUMNS, CAUSES, COLUMNS, columns_for
+from ..metrics import BENCH_COLUMNS, CAUSES, COLUMNS, COST_COLUMNS, columns_for
 from ..planners.base import MAX_INFO_DEPTH
 from ..plugins import load_kinds
 from ..tasks import TASKS
@@ -69,7 +69,7 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
             if c in df.columns:
                 df[c] = _lossless(df[c])
     load_kinds()
-    known = columns_for([*(c for t in TASKS.values() for c in t.columns), *BENCH_COLUMNS])  # every registered kind's, a bench's
+    known = columns_for([*(c for t in TASKS.values() for c in t.columns), *COST_COLUMNS, *BENCH_COLUMNS])  # every kind's, costs, a bench's
     extra = [c for c in df.columns if c not in known]
     if extra:
         raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), known)} "
@@ -86,6 +86,8 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     df = df.dropna(subset=["wall_s"])
     failed = df["outcome"].isin(["error", "timeout"]).to_numpy()  # a run that failed has no distance
     for c in NUMBERS:  # every number a run writes is finite; a few are never missing
+        if c not in df.columns:  # a column only some folders have (a language model's costs)
+            continue
         v = df[c].to_numpy(float)
         inf = np.isneginf(v) if c in UNREACHABLE else np.isinf(v)  # a goal nothing reaches: an infinite shortest path
         bad = inf | (np.isnan(v) & ~failed if c == "distance_m" else False) | (v < 0 if c in MEASURED else False)
@@ -119,7 +121,7 @@ MISSING = ["", "nan", "NaN", "NA", "N/A", "null", "None", "<NA>"]  # what pandas
 UNREACHABLE = ("shortest_m", "left_m", "ratio")  # +inf where nothing achieves the goal (an absent object)
 MEASURED = ("episode", "seed", "distance_m", "wall_s")  # never negative; a distance missing only in a failed run's row
 NUMBERS = ["episode", "seed", "start_x", "start_y", "start_heading", "success", "distance_m", "shortest_m", "ratio", "spl",
-           "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s"]
+           "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s", *COST_COLUMNS]
 
 
 def _whole_lines(fh) -> int:
@@ -223,7 +225,8 @@ def _json_safe(v, outer: tuple):
 
 def save_run_files(out: Path, stem: str, res) -> None:
     """``paths/<stem>.npz`` (path, signs read) and, for traced runs, ``traces/<stem>.jsonl``
-    (one JSON object per decision); each written atomically."""
+    (one JSON object per decision); its frames, decisions and transcripts when kept; each written
+    atomically."""
     paths = out / "paths"
     paths.mkdir(parents=True, exist_ok=True)
     tmp = temp_path(paths / f"{stem}.npz")
@@ -231,17 +234,23 @@ def save_run_files(out: Path, stem: str, res) -> None:
         np.savez_compressed(fh, path=res.path, read_signs=np.asarray(res.read_signs, np.int64))
     os.replace(tmp, paths / f"{stem}.npz")
     if res.trace:
-        traces = out / "traces"
-        traces.mkdir(parents=True, exist_ok=True)
-        tmp = temp_path(traces / f"{stem}.jsonl")
-        with open(tmp, "w") as fh:
-            for d in res.trace:
-                fh.write(json.dumps(json_safe(d), allow_nan=False) + "\n")
-        os.replace(tmp, traces / f"{stem}.jsonl")
+        write_jsonl(out / "traces" / f"{stem}.jsonl", res.trace)
     if res.frames:
         write_frames(out / "frames" / f"{stem}.npz", res.frames)
     if res.decisions_record is not None:
         write_decisions(out / "decisions" / f"{stem}.json", res.decisions_record)
+    for k, transcript in enumerate(res.transcripts):  # a language model's: transcripts/<run>.jsonl (a chain's later stages __stage<k>)
+        write_jsonl(out / "transcripts" / f"{stem}{f'__stage{k}' if k else ''}.jsonl", transcript)
+
+
+def write_jsonl(path: Path, items: list) -> None:
+    """JSON objects, one a line, atomically."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = temp_path(path)
+    with open(tmp, "w", encoding="utf-8") as fh:
+        for d in items:
+            fh.write(json.dumps(json_safe(d), allow_nan=False) + "\n")
+    os.replace(tmp, path)
 
 
 def decisions_text(record: dict) -> str:

@@ -179,7 +179,8 @@ class RunResult:
     left_m: float = float("nan")  # geodesic distance left to the goal where the run ended (0 when found)
     start_heading: float = float("nan")  # rad, the heading the run started with
     decisions_record: dict | None = None  # the run's decisions, when recorded (runner.execute; tasks.decisions)
-    record: dict = field(default_factory=dict)  # the kind's own columns of the run's row (Outcome.record)
+    record: dict = field(default_factory=dict)  # the kind's own columns of the run's row (Outcome.record), and its planners' costs
+    transcripts: list = field(default_factory=list)  # its planners' transcripts (language models: one list of JSON objects each)
 
 
 def checked_cell(planner: str, row, col, free: np.ndarray) -> tuple[int, int]:
@@ -350,12 +351,16 @@ class Task:
         rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
         st = self.start_state(ep, rng)
         heading = st.heading
-        out = self.search(variant, ep, seed, st, rng, Seat() if seat is None else seat, observer)
+        seat = Seat() if seat is None else seat
+        seat.run = {"scenario": self.sc.name, "planner": variant.label, "goal": str(ep.goal), "episode": int(ep.index),
+                    "seed": int(seed)}
+        out = self.search(variant, ep, seed, st, rng, seat, observer)
         left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
+        message = out.message or (seat.notes() if out.outcome == "budget" else "")
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
                          np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=out.stages,
-                         message=out.message, time_s=out.time_s, left_m=left, start_heading=heading,
-                         record=dict(out.record))
+                         message=message, time_s=out.time_s, left_m=left, start_heading=heading,
+                         record={**out.record, **seat.costs()}, transcripts=seat.transcripts())
 
     def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng: np.random.Generator, seat: Seat,
                observer: Observer | None) -> Outcome:

@@ -31,7 +31,8 @@ The record of a run (``decisions/<run>.json``)::
 
 ``decisions`` holds one item per decision point in the order the run met them (a chain's stages,
 kept and from scratch, in the order they ran): each kind's code of the choice (see its
-``Codec``), or ``0`` for "the same choice as the decision before"; ``rng`` the generator's state
+``Codec``), ``0`` for "the same choice as the decision before", or ``"budget"`` where the
+planner's own budget (a language model's ``max_calls``) ended the run; ``rng`` the generator's state
 (PCG64, hexadecimal) after the decisions at which the planner drew from it; ``left`` what the
 planner left behind that the run reads (door search: the path search it ran, which the path to
 its target reuses), by decision.
@@ -45,9 +46,12 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..errors import BudgetSpent
+
 FORMAT = "semsearch-decisions"
 VERSION = 1
 SAME = 0  # a decision's item: the same choice as the decision before
+SPENT = "budget"  # a decision's item: the planner's own budget (a language model's calls) ended the run here
 
 
 class ReplayError(Exception):
@@ -103,12 +107,50 @@ def ask(point: DecisionPoint):
 
 # ---- who sits in the planner's seat -------------------------------------------------------------
 class Seat:
-    """The batch's seat: each search's planner is the variant's, built afresh, and it answers."""
+    """The batch's seat: each search's planner is the variant's, built afresh, and it answers.
+
+    The seat keeps the planners it built for the run (``seated``), so that the run can read what
+    they report of themselves: a cost (a language model's calls and tokens, :meth:`costs`), a
+    transcript (:meth:`transcripts`), why a planner's own budget ended the run (:meth:`notes`).
+    ``run``: the run's identity (scenario, planner label, goal, episode, seed), which a planner
+    that wants it (``start_run(identity)``, e.g. to find its transcript) is given when built,
+    with ``stage`` its place among the run's planners (0, 1, ... in a chain)."""
+
+    def __init__(self):
+        self.seated: list = []
+        self.run: dict = {}
 
     def planner(self, variant):
-        return variant.build()
+        return self.seat(variant.build())
+
+    def seat(self, planner):
+        """Keep ``planner`` among the run's, and give it the run's identity when it asks for it."""
+        start = getattr(planner, "start_run", None)
+        if callable(start) and self.run:
+            start({**self.run, "stage": len(self.seated)})
+        self.seated.append(planner)
+        return planner
 
     decide = staticmethod(ask)
+
+    def costs(self) -> dict:
+        """The costs the run's planners report (``costs()``: column -> number), summed over them."""
+        out: dict = {}
+        for p in self.seated:
+            report = getattr(p, "costs", None)
+            if callable(report):
+                for k, v in report().items():
+                    out[k] = out.get(k, 0) + v
+        return out
+
+    def transcripts(self) -> list:
+        """The transcripts of the run's planners that keep one (``transcript``: a list of JSON
+        objects), in the order they were seated."""
+        return [t for t in (getattr(p, "transcript", None) for p in self.seated) if t]
+
+    def notes(self) -> str:
+        """Why a planner's own budget ended the run (``spent``), if one did."""
+        return "; ".join(s for s in (getattr(p, "spent", "") for p in self.seated) if s)
 
 
 def run_attributes(planner) -> dict:
@@ -125,6 +167,7 @@ class Recording(Seat):
     """The batch's seat, keeping each choice (see the module docstring): :meth:`record`."""
 
     def __init__(self):
+        super().__init__()
         self.items: list = []
         self.rng: dict[str, str] = {}
         self.left: dict[str, list] = {}
@@ -134,11 +177,15 @@ class Recording(Seat):
     def planner(self, variant):
         p = variant.build()
         self.seats.setdefault(variant.label, run_attributes(p))
-        return p
+        return self.seat(p)
 
     def decide(self, point: DecisionPoint):
         before = rng_word(point.rng)
-        choice = point.ask()
+        try:
+            choice = point.ask()
+        except BudgetSpent:  # the planner's own budget ended the run here: so does the replay
+            self.items.append(SPENT)
+            raise
         code = point.encode(choice)
         if code is not None and not isinstance(code, list):  # 0 stands for "the same again"
             raise TypeError(f"the {point.kind} codec wrote {code!r}: a choice's code is a JSON list, or None")
@@ -179,6 +226,7 @@ class Replay(Seat):
     :meth:`finish` checks that every one was asked for."""
 
     def __init__(self, record: dict):
+        super().__init__()
         check_record(record)
         self.items = list(record["decisions"])
         self.rng = {int(k): v for k, v in record.get("rng", {}).items()}
@@ -196,6 +244,9 @@ class Replay(Seat):
         if self.k >= len(self.items):
             raise ReplayError(f"the run asks for decision {self.k + 1}, and the record holds {len(self.items)}")
         item = self.items[self.k]
+        if item == SPENT:
+            self.k += 1
+            raise BudgetSpent("the planner's own budget ended the run here (as the record says)")
         if item == SAME and not isinstance(item, bool) and self.k:
             item = self._last
         try:

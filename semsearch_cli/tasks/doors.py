@@ -269,7 +269,7 @@ class DoorSearch(DoorSensing):
             b.refresh_derived()
             cands = b.candidates()
         ctx = DoorContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
-                          explain=self.observer is not None)
+                          explain=self.observer is not None, distance=st.distance)
         return ctx, cands
 
     def attempt(self, st, ctx, cands, dec):

@@ -14,6 +14,7 @@ import time
 from collections.abc import Generator
 from typing import Protocol
 
+from ..errors import BudgetSpent
 from ..navigation import advance
 from .base import RobotState
 from .decisions import DecisionPoint, ask
@@ -186,9 +187,14 @@ def run_loop(search: Search, st: RobotState, step: float, max_distance: float, m
              decide=ask) -> str:
     """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
     :meth:`Search.plan` returns when there is nowhere to go (see :class:`Stepper`), each decision
-    point answered by ``decide`` (by default the seated planner)."""
+    point answered by ``decide`` (by default the seated planner). A planner whose own budget is
+    spent (:class:`~semsearch_cli.errors.BudgetSpent`) ends the run as ``budget``."""
     session = Session(search, st, step, max_distance, max_steps, move)
     point = session.start()
     while isinstance(point, DecisionPoint):
-        point = session.answer(decide(point))
+        try:
+            choice = decide(point)
+        except BudgetSpent:  # the planner's own budget (a language model's calls or tokens): the run's budget outcome
+            return "budget"
+        point = session.answer(choice)
     return point

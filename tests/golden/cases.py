@@ -25,9 +25,10 @@ DEFAULTS = {"nsos": (("alpha", 0.9),)}
 
 
 def planners(kind: str) -> list[Variant]:
-    """Every registered built-in planner of ``kind``, with its default parameters (nsos at 0.9)."""
+    """Every registered built-in planner of ``kind``, with its default parameters (nsos at 0.9); not
+    llm, which needs a server (tests/test_llm.py)."""
     return [Variant(n, DEFAULTS.get(n, ())) for n, c in PLANNERS.items()
-            if c.task == kind and c.__module__.startswith("semsearch_cli.")]
+            if c.task == kind and c.__module__.startswith("semsearch_cli.") and not c.service]
 
 
 def golden_rows(out: Path) -> pd.DataFrame:

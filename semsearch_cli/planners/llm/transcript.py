@@ -1,0 +1,85 @@
+"""Transcripts: what a language model was asked and answered in one run, enough to replay the run
+offline (``{name: llm, replay: DIR}``).
+
+``semsearch run --transcripts`` writes ``transcripts/<run>.jsonl`` (a chain's later stages
+``<run>__stage<k>.jsonl``), one JSON object a line, schema ``semsearch-transcript`` version 1:
+
+- the first line, ``{"type": "header", "format": "semsearch-transcript", "version": 1, "kind":
+  "doors", "run": {"scenario", "planner", "goal", "episode", "seed", "stage"}, "params": {...},
+  "prompt_sha256": "..."}``: the run, the planner's parameters (the key's variable's name, never
+  the key) and the prompt template's hash;
+- one ``{"type": "call", "decision": k, "attempt": a, "observation": "...", "messages": [...],
+  "reply": "..." or null, "error": "", "choice": ..., "valid": true, "reason": "", "tokens_in":
+  n, "tokens_out": n, "latency_s": s, "model": "..."}`` per call to the model: decision ``k``
+  (0, 1, ... in the order the run asked), its attempt ``a`` (0, then each re-ask), the
+  observation, every message sent, the raw reply (null when there was none, ``error`` saying
+  why), the parsed choice (a target's number; the estimator's probabilities by target), whether
+  the planner could take it and, if not, why;
+- one ``{"type": "fallback", "decision": k, "choice": 0, "reason": "..."}`` per decision the
+  planner took its stated fallback for (the nearest target) after the re-asks ran out.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+from ...errors import PlannerError
+
+FORMAT = "semsearch-transcript"
+VERSION = 1
+RUN_KEYS = ("scenario", "goal", "episode", "seed", "stage")  # what finds a run's transcript in a replay
+
+
+def header(kind: str, run: dict, params: dict, prompt_sha256: str) -> dict:
+    return {"type": "header", "format": FORMAT, "version": VERSION, "kind": kind, "run": dict(run), "params": params,
+            "prompt_sha256": prompt_sha256}
+
+
+def run_key(run: dict) -> tuple:
+    return tuple(str(run.get(k, "")) for k in RUN_KEYS)
+
+
+def read(path: Path) -> list[dict]:
+    """A transcript's lines; a :class:`PlannerError` naming the file and line when one is not a
+    JSON object, or the first is not a header this version reads."""
+    out = []
+    with open(path, encoding="utf-8") as fh:
+        for n, line in enumerate(fh, 1):
+            try:
+                item = json.loads(line)
+            except ValueError:
+                raise PlannerError(f"transcript {path}: line {n} is not JSON") from None
+            if not isinstance(item, dict):
+                raise PlannerError(f"transcript {path}: line {n} is not a JSON object")
+            out.append(item)
+    if not out or out[0].get("format") != FORMAT or out[0].get("type") != "header":
+        raise PlannerError(f"transcript {path}: not a {FORMAT} file (its first line is no header)")
+    if out[0].get("version") != VERSION:
+        raise PlannerError(f"transcript {path}: version {out[0].get('version')!r}; this semsearch reads version {VERSION}")
+    return out
+
+
+def index(folder: Path) -> dict[tuple, list[tuple[str, Path]]]:
+    """The transcripts under ``folder`` (a results folder's ``transcripts/``, or that folder
+    itself), by run: run key -> [(planner label, file)]."""
+    where = folder / "transcripts" if (folder / "transcripts").is_dir() else folder
+    out: dict[tuple, list[tuple[str, Path]]] = {}
+    for path in sorted(where.glob("*.jsonl")):
+        with open(path, encoding="utf-8") as fh:
+            first = fh.readline()
+        try:
+            head = json.loads(first)
+        except ValueError:
+            continue
+        if isinstance(head, dict) and head.get("format") == FORMAT and isinstance(head.get("run"), dict):
+            out.setdefault(run_key(head["run"]), []).append((str(head["run"].get("planner", "")), path))
+    return out
+
+
+def folder_text(folder: Path) -> str:
+    """The transcripts under ``folder`` as text to hash (names and bytes, in name order): what a
+    replay's rows depend on."""
+    where = folder / "transcripts" if (folder / "transcripts").is_dir() else folder
+    return "".join(f"{p.name}\0{hashlib.sha256(p.read_bytes()).hexdigest()}\0" for p in sorted(where.glob("*.jsonl")))

@@ -1,0 +1,343 @@
+"""The llm planner against a real OpenAI-compatible server on loopback (tests/llm_server.py): the
+client, its retries and timeouts, the parsing of replies, the counts on the rows, transcripts that
+replay offline, and the key kept out of every file."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import re
+import shutil
+import uuid
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+pytest.importorskip("openai")
+
+from semsearch_cli import api  # noqa: E402
+from semsearch_cli.cli import app  # noqa: E402
+from semsearch_cli.errors import ScenarioError  # noqa: E402
+from semsearch_cli.planners.llm import LlmParams, LlmPlanner, load_prompt  # noqa: E402
+from semsearch_cli.planners.llm.replies import parse_number, parse_probabilities  # noqa: E402
+from semsearch_cli.runner import BatchOptions, Loaded  # noqa: E402
+from semsearch_cli.tasks.decisions import Seat  # noqa: E402
+
+from .llm_server import Answer, ChatServer, first_target  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+SAME = ["goal", "episode", "seed", "outcome", "distance_m", "steps", "decisions", "spl"]
+COSTS = ["llm_calls", "tokens_in", "tokens_out", "invalid_replies", "fallbacks", "llm_s"]
+
+
+@pytest.fixture(autouse=True)
+def own_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))  # the request slots' lock files
+
+
+def scenario(tmp_path: Path, planners: list, name: str = "demo", seeds: int = 2, goals=None) -> Path:
+    """A copy of a shipped door scenario (demo) or a generated floor (name 'floor') with these planners."""
+    if name == "floor":
+        src = api.generate_building("hall", "blocks", 3, tmp_path / "floor")
+    else:
+        api.init(name, tmp_path / name, force=True)
+        src = tmp_path / name / f"{name}.yaml"
+    d = yaml.safe_load(src.read_text())
+    d["planners"] = planners
+    d["experiment"]["seeds"] = seeds
+    d["goals"] = goals or d["goals"][:2]
+    out = src.with_name(f"{src.stem}_llm.yaml")
+    out.write_text(yaml.safe_dump(d))
+    return out
+
+
+def llm(srv, **kw) -> dict:
+    return {"name": "llm", "base_url": srv.base_url, "model": "scripted", **kw}
+
+
+def rows_of(folder: Path, prefix: str) -> pd.DataFrame:
+    df = pd.read_csv(folder / "runs.csv")
+    return df[df["planner"].str.startswith(prefix)].sort_values(["goal", "episode", "seed"]).reset_index(drop=True)
+
+
+# ---- the harness adds nothing of its own to a decision -------------------------------------------
+@pytest.mark.parametrize("name", ["demo", "floor"])
+def test_a_nearest_target_model_makes_greedys_runs(tmp_path, name):
+    with ChatServer(first_target) as srv:
+        sc = scenario(tmp_path, [{"name": "greedy"}, llm(srv)], name)
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+    greedy, model = rows_of(tmp_path / "out", "greedy"), rows_of(tmp_path / "out", "llm")
+    assert len(greedy) == len(model) >= 4
+    pd.testing.assert_frame_equal(greedy[SAME], model[SAME])
+    assert (model["llm_calls"] >= model["decisions"]).all() and model["llm_calls"].sum() == len(srv.requests)
+    assert model["invalid_replies"].sum() == 0 and model["fallbacks"].sum() == 0
+    assert model["tokens_in"].sum() == 100 * len(srv.requests) and model["tokens_out"].sum() == 3 * len(srv.requests)
+    assert greedy[COSTS].isna().all().all()  # a planner that reports no cost leaves them empty
+
+
+# ---- transcripts ---------------------------------------------------------------------------------
+def flaky(request, n):
+    """Every third reply prose (invalid), else the first target: re-asks appear in the transcript."""
+    return Answer("I would rather look around first.") if n % 3 == 1 else first_target(request, n)
+
+
+def test_a_replay_from_transcripts_gives_the_live_rows_with_no_server(tmp_path):
+    with ChatServer(flaky) as srv:
+        sc = scenario(tmp_path, [llm(srv, reasks=1)])
+        api.run(sc, BatchOptions(out=tmp_path / "live", workers=2, transcripts=True, decisions=True), plots=False)
+        label = rows_of(tmp_path / "live", "llm")["planner"].iloc[0]
+    live = rows_of(tmp_path / "live", "llm")
+    assert live["invalid_replies"].sum() > 0 and live["llm_calls"].sum() == len(srv.requests)
+    files = sorted((tmp_path / "live" / "transcripts").glob("*.jsonl"))
+    assert len(files) == len(live)
+    lines = [json.loads(x) for x in files[0].read_text().splitlines()]
+    head, calls = lines[0], [x for x in lines if x["type"] == "call"]
+    assert head["format"] == "semsearch-transcript" and head["version"] == 1 and head["run"]["planner"] == label
+    assert set(calls[0]) == {"type", "decision", "attempt", "observation", "messages", "reply", "error", "choice", "valid",
+                             "reason", "tokens_in", "tokens_out", "latency_s", "model"}
+    assert calls[0]["model"] == "scripted-1" and calls[0]["messages"][1]["content"] == calls[0]["observation"]
+    # the server is gone: a replay calls nothing
+    rp = scenario(tmp_path, [{"name": "llm", "replay": str(tmp_path / "live")}])
+    api.run(rp, BatchOptions(out=tmp_path / "replay", workers=1, transcripts=True), plots=False)
+    again = rows_of(tmp_path / "replay", "llm")
+    pd.testing.assert_frame_equal(live[SAME + COSTS], again[SAME + COSTS], check_dtype=False)
+    # the replay's own transcripts are the live ones, line for line
+    mine = sorted((tmp_path / "replay" / "transcripts").glob("*.jsonl"))
+    assert [p.read_text().splitlines()[1:] for p in mine] == [p.read_text().splitlines()[1:] for p in files]
+    # and semsearch verify replays the live runs from their decisions, without any model
+    assert api.verify(tmp_path / "live").verdict.verified == len(live)
+
+
+def test_a_replay_whose_run_diverges_names_the_run_and_the_step(tmp_path):
+    with ChatServer(first_target) as srv:
+        sc = scenario(tmp_path, [llm(srv)], seeds=1, goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "live", workers=1, transcripts=True), plots=False)
+    f = next((tmp_path / "live" / "transcripts").glob("*.jsonl"))
+    lines = [json.loads(x) for x in f.read_text().splitlines()]
+    call = next(x for x in lines if x.get("decision") == 2)
+    call["observation"] = call["observation"].replace("Goal: read", "Goal: find")
+    f.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    rp = scenario(tmp_path, [{"name": "llm", "replay": str(tmp_path / "live")}], seeds=1, goals=[304])
+    api.run(rp, BatchOptions(out=tmp_path / "replay", workers=1), plots=False)
+    row = rows_of(tmp_path / "replay", "llm").iloc[0]
+    assert row["outcome"] == "error"
+    assert "goal 304 episode 0 seed 0: decision 3: the observation differs from the transcript's (line 1:" in row["message"]
+
+
+def test_rows_of_another_prompt_are_not_reused(tmp_path):
+    prompt = tmp_path / "mine.txt"
+    prompt.write_text("=== system ===\nFind $label.\n=== user ===\n$observation\n")
+    with ChatServer(first_target) as srv:
+        sc = scenario(tmp_path, [llm(srv, prompt=str(prompt))], seeds=1, goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+        n = len(srv.requests)
+        assert srv.requests[0]["messages"][0] == {"role": "system", "content": "Find 304."}
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+        assert len(srv.requests) == n  # done: resumed, nothing asked again
+        prompt.write_text("=== system ===\nFind the sign $label.\n=== user ===\n$observation\n")
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+        assert len(srv.requests) > n and srv.requests[n]["messages"][0]["content"] == "Find the sign 304."
+
+
+# ---- invalid replies are counted, never hidden ----------------------------------------------------
+def first_decision(tmp_path):
+    """A real decision of a demo run: (ctx, cands) at the run's first re-plan with candidates."""
+    L = Loaded.load(scenario(tmp_path, [{"name": "greedy"}], seeds=1, goals=[304]))
+
+    class Stop(Exception):
+        pass
+
+    class Capture(Seat):
+        def decide(self, point):
+            if len(point.choices) >= 2:
+                self.point = point
+                raise Stop()
+            return point.ask()
+
+    seat = Capture()
+    with pytest.raises(Stop):
+        L.task.run(L.task.variants()[0], L.task.episodes[0], 0, seat=seat)
+    return seat.point.observation, seat.point.choices
+
+
+KINDS = ["valid", "valid_bracket", "valid_answer", "empty", "none", "prose", "out_of_range", "negative", "huge", "unicode",
+         "json", "http500", "http429", "http400", "not_json", "wrong_shape", "no_choices"]
+
+
+def kind_of(n: int) -> str:
+    """The fuzz kind of request n: one of KINDS, drawn; every 400th a server that hangs past the timeout."""
+    return "hang" if n % 400 == 399 else random.Random(n).choice(KINDS)
+
+
+def fuzz(request, n):
+    kind = kind_of(n)
+    offered = re.findall(r"^\[(\d+)\]", request["messages"][1]["content"], re.M)
+    first = offered[0]
+    return {"valid": Answer(first), "valid_bracket": Answer(f"[{first}]"), "valid_answer": Answer(f"Let me see.\nAnswer: {first}"),
+            "empty": Answer(""), "none": Answer(None), "prose": Answer("The corridor to the north looks promising."),
+            "out_of_range": Answer(str(len(offered) + 7)), "negative": Answer("-1"), "huge": Answer("7" * 200_000),
+            "unicode": Answer("\u0663 \u2603 \ud83d\ude80".encode("utf-8", "surrogatepass").decode("utf-8", "replace")),
+            "json": Answer('{"target": 0}'), "http500": Answer(status=500), "http429": Answer(status=429),
+            "http400": Answer(status=400), "not_json": Answer(raw=b"{not json"), "wrong_shape": Answer(raw=b'{"foo": 1}'),
+            "no_choices": Answer(raw=b'{"id": "x", "object": "chat.completion", "choices": []}'),
+            "hang": Answer("0", delay=2.0)}[kind]
+
+
+def test_ten_thousand_fuzzed_replies_give_no_traceback_and_every_one_is_counted(tmp_path):
+    ctx, cands = first_decision(tmp_path)
+    with ChatServer(fuzz) as srv:
+        p = LlmPlanner(LlmParams(base_url=srv.base_url, model="fuzz", retries=0, timeout_s=0.5, max_calls=10**6, reasks=2))
+        p.start_run({"scenario": "demo", "planner": "llm", "goal": "304", "episode": 0, "seed": 0})
+        decisions = 0
+        while len(srv.requests) < 10_000:
+            dec = p.choose(ctx, cands)  # never raises
+            decisions += 1
+            assert dec is None or (int(dec.row), int(dec.col)) in set(zip(cands.rows.tolist(), cands.cols.tolist()))
+    kinds = [kind_of(n) for n in range(len(srv.requests))]  # one client, no retries: request n is call n
+    calls = [x for x in p.transcript if x["type"] == "call"]
+    falls = [x for x in p.transcript if x["type"] == "fallback"]
+    assert p.calls == len(srv.requests) == len(calls) >= 10_000
+    # a fuzzed reply is never taken; a good one always is, unless a loaded machine made it late (then it is counted as such)
+    assert not [c for c, k in zip(calls, kinds) if c["valid"] != k.startswith("valid") and c["reason"] != "no reply within timeout_s"]
+    assert not [c for c, k in zip(calls, kinds) if c["valid"] and not k.startswith("valid")]
+    valid = sum(c["valid"] for c in calls)
+    assert p.invalid == len(srv.requests) - valid and valid >= sum(k.startswith("valid") for k in kinds) - 5
+    assert p.fallbacks == len(falls) and p.fallbacks + valid == decisions  # each decision: one valid reply, or the fallback
+    assert all(c["reason"] for c in calls if not c["valid"])
+    reasons = {c["reason"] for c in calls if not c["valid"]}
+    assert {"no reply within timeout_s", "HTTP 500 from the server", "HTTP 429 from the server", "the reply is empty",
+            "the reply is too long (200,000 characters)"} <= reasons
+    print(f"fuzz: {p.calls} calls, {p.calls - p.invalid} valid, {p.invalid} invalid, {p.fallbacks} fallbacks over "
+          f"{decisions} decisions; reasons: {len(reasons)}")
+
+
+def test_a_server_that_fails_then_answers_is_retried_with_backoff(tmp_path):
+    ctx, cands = first_decision(tmp_path)
+    with ChatServer(lambda r, n: Answer(status=429) if n < 2 else first_target(r, n)) as srv:
+        p = LlmPlanner(LlmParams(base_url=srv.base_url, model="m", retries=2))
+        p.choose(ctx, cands)
+    assert len(srv.requests) == 3 and p.calls == 1 and p.invalid == 0
+    assert p.transcript[-1]["latency_s"] > 0.5  # two waits: 0.5 s and 1 s, less jitter
+    with ChatServer(lambda r, n: Answer("0", delay=1.0)) as srv:
+        p = LlmPlanner(LlmParams(base_url=srv.base_url, model="m", retries=1, timeout_s=0.2, reasks=0))
+        p.choose(ctx, cands)
+    assert len(srv.requests) == 2 and p.calls == 1 and p.invalid == 1 and p.fallbacks == 1
+    assert p.transcript[-2]["error"] == "no reply within timeout_s"
+
+
+def test_a_run_whose_calls_are_spent_ends_as_budget(tmp_path):
+    with ChatServer(first_target) as srv:
+        sc = scenario(tmp_path, [llm(srv, max_calls=5)], seeds=1, goals=[452])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, decisions=True), plots=False)
+    row = rows_of(tmp_path / "out", "llm").iloc[0]
+    assert (row["outcome"], row["cause"], row["llm_calls"]) == ("budget", "budget", 5)
+    assert row["message"] == "the llm planner made max_calls = 5 calls"
+    record = json.loads(next((tmp_path / "out" / "decisions").glob("*.json")).read_text())
+    assert record["decisions"][-1] == "budget"  # where the budget ended the run: its replay ends there too
+    v = api.verify(tmp_path / "out").verdict
+    assert (v.verified, v.failed) == (1, [])
+
+
+def test_the_key_is_sent_and_never_written(tmp_path, monkeypatch):
+    secret = f"sk-test-{uuid.uuid4().hex}"
+    monkeypatch.setenv("SEMSEARCH_TEST_KEY", secret)
+    with ChatServer(flaky) as srv:
+        sc = scenario(tmp_path, [llm(srv, api_key_env="SEMSEARCH_TEST_KEY")], seeds=1)
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, transcripts=True, decisions=True, trace=True, frames=True))
+        api.report([tmp_path / "out"], tmp_path / "report")
+    assert set(srv.keys) == {f"Bearer {secret}"}
+    written = [p for p in tmp_path.rglob("*") if p.is_file() and "cache" not in p.parts]
+    assert len(written) > 10
+    assert not [p for p in written if secret.encode() in p.read_bytes()]
+
+
+# ---- the estimator -------------------------------------------------------------------------------
+def test_the_estimator_chooses_by_expected_cost():
+    d = np.array([1.0, 5.0, 9.0])  # mean 5: cost_i = d_i + (1 - p_i) (d_i + 5)
+    assert LlmPlanner.by_expected_cost({2: 1.0}, d) == 0  # 7, 15, 9
+    assert LlmPlanner.by_expected_cost({1: 1.0}, d) == 1  # 7, 5, 23
+    assert LlmPlanner.by_expected_cost({0: 0.0, 2: 1.0}, np.array([4.0, 5.0, 6.0])) == 2  # 13, 15, 6
+    assert LlmPlanner.by_expected_cost({0: 2 / 3, 2: 2 / 3}, np.array([6.0, 9.0, 6.0])) == 0  # scaled to 1/2: a tie, the nearer
+
+
+def test_an_estimator_run_reads_json_probabilities(tmp_path):
+    def estimate(request, n):
+        k = len(re.findall(r"^\[(\d+)\]", request["messages"][1]["content"], re.M))
+        return Answer("```json\n" + json.dumps({str(i): round(1 / (i + 1), 3) for i in range(k)}) + "\n```")
+
+    with ChatServer(estimate) as srv:
+        sc = scenario(tmp_path, [llm(srv, mode="estimator")], seeds=1, goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+        assert "JSON object" in srv.requests[0]["messages"][1]["content"]
+    row = rows_of(tmp_path / "out", "llm").iloc[0]
+    assert row["outcome"] == "found" and row["invalid_replies"] == 0 and row["fallbacks"] == 0
+
+
+# ---- replies, prompts, parameters -----------------------------------------------------------------
+def test_replies_parse_strictly():
+    r = range(5)
+    assert [parse_number(x, r)[0] for x in ("3", " [3] ", "3.", '"3"', "Answer: 3", "I think 1.\n**Answer:** [3]",
+                                          "<think>0 or 1?</think>3")] == [3] * 7
+    assert parse_number("3 or 4", r) == (None, "the reply is not one number (answer with the number alone)")
+    assert parse_number("7", r) == (None, "7 is not one of the choices offered")
+    assert parse_number("\u0663", r)[0] is None  # an Arabic-Indic three is not a number of the choices
+    assert parse_number("", r) == (None, "the reply is empty") == parse_number(None, r)
+    assert parse_probabilities('{"0": 0.2, "2": 1}', 3) == ({0: 0.2, 2: 1.0}, "")
+    assert parse_probabilities('{"3": 0.2}', 3)[1] == "'3' is not one of the targets offered (0 to 2)"
+    assert parse_probabilities('{"0": 1.5}', 3)[1] == "the probability of target 0 is 1.5, not a number from 0 to 1"
+    assert parse_probabilities("[0.2]", 3)[1] == "the reply is JSON, but not an object mapping targets to probabilities"
+    assert parse_probabilities("{}", 3)[1] == "the object gives no target a probability"
+
+
+def test_prompt_templates_are_checked_where_they_are_named(tmp_path):
+    system, user, sha = load_prompt(None, "actor")
+    assert user == "$observation" and "door sign" in system and len(sha) == 64
+    bad = tmp_path / "bad.txt"
+    bad.write_text("=== system ===\nFind $goal_label.\n=== user ===\n$observation\n")
+    with pytest.raises(ScenarioError, match=r"no field \$goal_label; the fields: \$observation, \$goal"):
+        load_prompt(str(bad), "actor")
+    bad.write_text("Find the door.\n")
+    with pytest.raises(ScenarioError, match="a line '=== system ===' and, after it, a line '=== user ==='"):
+        load_prompt(str(bad), "actor")
+
+
+def test_a_scenario_without_a_model_is_refused_naming_the_field(tmp_path):
+    sc = scenario(tmp_path, [{"name": "llm"}])
+    res = CliRunner().invoke(app, ["validate", str(sc)])
+    assert res.exit_code == 2 and "planners[0].model" in res.output and "name the model the server serves" in res.output
+    sc = scenario(tmp_path, [{"name": "llm", "model": "m", "prompt": "nowhere.txt"}])
+    res = CliRunner().invoke(app, ["validate", str(sc)])
+    assert res.exit_code == 2 and "planners[0].prompt" in res.output and "nowhere.txt does not exist" in res.output
+
+
+def test_dry_run_prints_the_first_prompt_and_calls_nothing(tmp_path):
+    sc = scenario(tmp_path, [{"name": "greedy"}, {"name": "llm", "base_url": "http://127.0.0.1:9/v1", "model": "m"}])
+    res = CliRunner().invoke(app, ["run", str(sc), "--dry-run", "--out", str(tmp_path / "out")])
+    assert res.exit_code == 0, res.output
+    assert res.output.startswith("--- system ---\nYou control a mobile robot")
+    assert "--- user ---\nGoal: read the door sign 304.\n" in res.output and "Answer with one number: 0" in res.output
+    assert not (tmp_path / "out").exists()
+    res = CliRunner().invoke(app, ["run", str(scenario(tmp_path, [{"name": "greedy"}])), "--dry-run"])
+    assert res.exit_code == 2 and "no planner of" in res.output
+
+
+def test_the_bench_runs_and_verifies_a_language_model(tmp_path):
+    with ChatServer(first_target) as srv:
+        spec = f"llm[base_url={srv.base_url},model=scripted]"
+        api.bench_run("doors-classic-v1", [spec], tmp_path / "b", options=BatchOptions(workers=1), limit=2)
+    runs = pd.concat([pd.read_csv(p) for p in sorted((tmp_path / "b").glob("*/runs.csv"))])
+    assert len(runs) >= 1 and (runs["llm_calls"] > 0).all() and runs["suite"].eq("doors-classic-v1").all()
+    assert api.verify(tmp_path / "b").verdict.failed == []
+    shutil.rmtree(tmp_path / "b")
+
+
+def test_the_key_variable_is_named_not_read_into_params():
+    p = LlmPlanner(LlmParams(model="m"))
+    p.start_run({"scenario": "s", "planner": "llm", "goal": "1", "episode": 0, "seed": 0})
+    assert p.transcript[0]["params"]["api_key_env"] == "OPENAI_API_KEY"
+    assert os.environ.get("OPENAI_API_KEY", "\0") not in json.dumps(p.transcript)
