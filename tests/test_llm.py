@@ -251,6 +251,9 @@ def test_the_key_is_sent_and_never_written(tmp_path, monkeypatch):
         api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, transcripts=True, decisions=True, trace=True, frames=True))
         api.report([tmp_path / "out"], tmp_path / "report")
     assert set(srv.keys) == {f"Bearer {secret}"}
+    costs = pd.read_csv(tmp_path / "report" / "tables" / "costs.csv")  # the report sums what the model cost
+    assert costs["llm_calls"].tolist() == [len(srv.requests)] and costs["runs"].tolist() == [2]
+    assert "What the planners' decisions cost" in (tmp_path / "report" / "report.md").read_text()
     written = [p for p in tmp_path.rglob("*") if p.is_file() and "cache" not in p.parts]
     assert len(written) > 10
     assert not [p for p in written if secret.encode() in p.read_bytes()]
@@ -341,3 +344,24 @@ def test_the_key_variable_is_named_not_read_into_params():
     p.start_run({"scenario": "s", "planner": "llm", "goal": "1", "episode": 0, "seed": 0})
     assert p.transcript[0]["params"]["api_key_env"] == "OPENAI_API_KEY"
     assert os.environ.get("OPENAI_API_KEY", "\0") not in json.dumps(p.transcript)
+
+
+def test_the_model_as_a_gymnasium_policy_travels_greedys_runs(tmp_path):
+    gym = pytest.importorskip("gymnasium")
+    import semsearch_cli.envs  # noqa: F401  (registers the environments)
+    from semsearch_cli.envs import PlannerPolicy
+    sc = scenario(tmp_path, [{"name": "greedy"}], seeds=2, goals=[304])
+    api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+    rows = rows_of(tmp_path / "out", "greedy")
+    with ChatServer(first_target) as srv:
+        policy = PlannerPolicy("llm", base_url=srv.base_url, model="scripted")
+        env = gym.make("semsearch/DoorSearch-v0", scenario=str(sc), **policy.env_kwargs)
+        for _, row in rows.iterrows():
+            env.reset(options={"episode": int(row["episode"]), "repeat": int(row["seed"])})
+            policy.reset()
+            done = False
+            while not done:
+                _, _, term, trunc, info = env.step(policy(env))
+                done = term or trunc
+            assert (info["outcome"], info["distance_m"]) == (row["outcome"], pytest.approx(row["distance_m"], abs=1e-3))
+    assert len(srv.requests) > 0 and policy.planner.calls > 0
