@@ -22,6 +22,7 @@ from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points, planner_class
+from .planners.base import path_fields
 from .planners.llm import FirstPrompt
 from .plugins import load_kinds
 from .report import build as report_build
@@ -592,7 +593,9 @@ _PLANNER = re.compile(r"(?P<name>[A-Za-z_][\w.-]*)(?:\[(?P<params>[^\[\]]*)\])?"
 
 def planner_spec(text: str, module: str | Path | None = None) -> PlannerSpec:
     """A planner given on the command line, ``NAME`` or ``NAME[key=value,...]`` (as rows label
-    it: ``nsos[alpha=0.9]``), registered by ``module`` (a user's Python file) when given."""
+    it: ``nsos[alpha=0.9]``), registered by ``module`` (a user's Python file) when given. A
+    parameter that names a file (the llm planner's ``prompt``, ``replay``) is taken relative to the
+    working folder, and written absolute."""
     m = _PLANNER.fullmatch(text.strip())
     if m is None:
         raise ScenarioError("<command line>", "--planner", f"{text!r}: give NAME or NAME[key=value,...], e.g. nsos[alpha=0.9]")
@@ -607,6 +610,10 @@ def planner_spec(text: str, module: str | Path | None = None) -> PlannerSpec:
         if not mod.is_file():
             raise ScenarioError(str(mod), "", "no such planner file (--planner-file)")
         params["module"] = str(mod.resolve())
+    cls = PLANNERS.get(m["name"])
+    for k in path_fields(cls.Params) if cls is not None else ():  # a file named here is relative to this folder, not the floor's
+        if isinstance(params.get(k), str) and not Path(params[k]).is_absolute():
+            params[k] = str(Path(params[k]).resolve())
     return PlannerSpec(name=m["name"], **params)
 
 

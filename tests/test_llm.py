@@ -10,6 +10,7 @@ import random
 import re
 import shutil
 import uuid
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -125,8 +126,17 @@ def test_a_replay_whose_run_diverges_names_the_run_and_the_step(tmp_path):
     rp = scenario(tmp_path, [{"name": "llm", "replay": str(tmp_path / "live")}], seeds=1, goals=[304])
     api.run(rp, BatchOptions(out=tmp_path / "replay", workers=1), plots=False)
     row = rows_of(tmp_path / "replay", "llm").iloc[0]
-    assert row["outcome"] == "error"
+    assert row["outcome"] == "error" and row["llm_calls"] == 2  # what a failed run paid for is still counted
     assert "goal 304 episode 0 seed 0: decision 3: the observation differs from the transcript's (line 1:" in row["message"]
+    # a replay that ends before its transcript does (a smaller budget) is named too
+    d = yaml.safe_load(rp.read_text())
+    d["experiment"]["max_distance"] = 3.0
+    rp.write_text(yaml.safe_dump(d))
+    call["observation"] = call["observation"].replace("Goal: find", "Goal: read")  # the transcript as it was
+    f.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    api.run(rp, BatchOptions(out=tmp_path / "short", workers=1), plots=False)
+    row = rows_of(tmp_path / "short", "llm").iloc[0]
+    assert row["outcome"] == "error" and "the run ended after" in row["message"] and "the transcript holds" in row["message"]
 
 
 def test_rows_of_another_prompt_are_not_reused(tmp_path):
@@ -166,7 +176,8 @@ def first_decision(tmp_path):
 
 
 KINDS = ["valid", "valid_bracket", "valid_answer", "empty", "none", "prose", "out_of_range", "negative", "huge", "unicode",
-         "json", "http500", "http429", "http400", "not_json", "wrong_shape", "no_choices"]
+         "json", "http500", "http429", "http400", "not_json", "wrong_shape", "no_choices", "bytes", "deep_json", "digits",
+         "newlines", "think_unclosed"]
 
 
 def kind_of(n: int) -> str:
@@ -176,8 +187,13 @@ def kind_of(n: int) -> str:
 
 def fuzz(request, n):
     kind = kind_of(n)
-    offered = re.findall(r"^\[(\d+)\]", request["messages"][1]["content"], re.M)
+    prompt = request["messages"][1]["content"]
+    offered = re.findall(r"^\[(\d+)\]", prompt, re.M)
     first = offered[0]
+    if "JSON object" in prompt and kind.startswith("valid"):  # an estimator's valid replies
+        return Answer({"valid": f'{{"{first}": 0.7}}', "valid_bracket": f'```json\n{{"{first}": 1}}\n```',
+                       "valid_answer": json.dumps({o: 0.1 for o in offered})}[kind])
+    rng = random.Random(-n)
     return {"valid": Answer(first), "valid_bracket": Answer(f"[{first}]"), "valid_answer": Answer(f"Let me see.\nAnswer: {first}"),
             "empty": Answer(""), "none": Answer(None), "prose": Answer("The corridor to the north looks promising."),
             "out_of_range": Answer(str(len(offered) + 7)), "negative": Answer("-1"), "huge": Answer("7" * 200_000),
@@ -185,22 +201,31 @@ def fuzz(request, n):
             "json": Answer('{"target": 0}'), "http500": Answer(status=500), "http429": Answer(status=429),
             "http400": Answer(status=400), "not_json": Answer(raw=b"{not json"), "wrong_shape": Answer(raw=b'{"foo": 1}'),
             "no_choices": Answer(raw=b'{"id": "x", "object": "chat.completion", "choices": []}'),
+            "bytes": Answer("#" + bytes(rng.randrange(256) for _ in range(rng.randrange(1, 400))).decode("utf-8", "replace")),
+            "deep_json": Answer(raw=b'{"choices": ' + b"[" * 20_000 + b"]" * 20_000 + b"}"),
+            "digits": Answer("9" * rng.choice([10, 4_400, 19_000])), "newlines": Answer("a" + "\n" * 19_000 + "a"),
+            "think_unclosed": Answer("<think>" * 2_000 + first),
             "hang": Answer("0", delay=2.0)}[kind]
 
 
 def test_ten_thousand_fuzzed_replies_give_no_traceback_and_every_one_is_counted(tmp_path):
     ctx, cands = first_decision(tmp_path)
+    planners, decisions = [], 0
     with ChatServer(fuzz) as srv:
-        p = LlmPlanner(LlmParams(base_url=srv.base_url, model="fuzz", retries=0, timeout_s=0.5, max_calls=10**6, reasks=2))
-        p.start_run({"scenario": "demo", "planner": "llm", "goal": "304", "episode": 0, "seed": 0})
-        decisions = 0
-        while len(srv.requests) < 10_000:
-            dec = p.choose(ctx, cands)  # never raises
-            decisions += 1
-            assert dec is None or (int(dec.row), int(dec.col)) in set(zip(cands.rows.tolist(), cands.cols.tolist()))
+        for mode, upto in (("actor", 6_000), ("estimator", 10_000)):  # the first 6,000 replies to an actor, then an estimator
+            p = LlmPlanner(LlmParams(base_url=srv.base_url, model="fuzz", mode=mode, retries=0, timeout_s=0.5, max_calls=10**6))
+            p.start_run({"scenario": "demo", "planner": "llm", "goal": "304", "episode": 0, "seed": 0})
+            planners.append(p)
+            while len(srv.requests) < upto:
+                dec = p.choose(ctx, cands)  # never raises
+                decisions += 1
+                assert dec is None or (int(dec.row), int(dec.col)) in set(zip(cands.rows.tolist(), cands.cols.tolist()))
     kinds = [kind_of(n) for n in range(len(srv.requests))]  # one client, no retries: request n is call n
-    calls = [x for x in p.transcript if x["type"] == "call"]
-    falls = [x for x in p.transcript if x["type"] == "fallback"]
+    calls = [x for p in planners for x in p.transcript if x["type"] == "call"]
+    falls = [x for p in planners for x in p.transcript if x["type"] == "fallback"]
+    p = LlmPlanner(LlmParams(model="tally"))
+    for q in planners:
+        p.calls, p.invalid, p.fallbacks = p.calls + q.calls, p.invalid + q.invalid, p.fallbacks + q.fallbacks
     assert p.calls == len(srv.requests) == len(calls) >= 10_000
     # a fuzzed reply is never taken; a good one always is, unless a loaded machine made it late (then it is counted as such)
     assert not [c for c, k in zip(calls, kinds) if c["valid"] != k.startswith("valid") and c["reason"] != "no reply within timeout_s"]
@@ -212,8 +237,11 @@ def test_ten_thousand_fuzzed_replies_give_no_traceback_and_every_one_is_counted(
     reasons = {c["reason"] for c in calls if not c["valid"]}
     assert {"no reply within timeout_s", "HTTP 500 from the server", "HTTP 429 from the server", "the reply is empty",
             "the reply is too long (200,000 characters)"} <= reasons
+    assert planners[1].transcript[-1].get("reason") != "" or planners[1].calls  # the estimator was fuzzed too
     print(f"fuzz: {p.calls} calls, {p.calls - p.invalid} valid, {p.invalid} invalid, {p.fallbacks} fallbacks over "
           f"{decisions} decisions; reasons: {len(reasons)}")
+    print("\n".join(f"  {n:5d}  {r}" for r, n in sorted(Counter(c["reason"] for c in calls if not c["valid"]).items(),
+                                                        key=lambda kv: -kv[1])))
 
 
 def test_a_server_that_fails_then_answers_is_retried_with_backoff(tmp_path):
@@ -339,11 +367,12 @@ def test_the_bench_runs_and_verifies_a_language_model(tmp_path):
     shutil.rmtree(tmp_path / "b")
 
 
-def test_the_key_variable_is_named_not_read_into_params():
+def test_the_key_variable_is_named_not_read_into_params(monkeypatch):
+    monkeypatch.setenv("OPENAI_API_KEY", "sk-not-in-any-transcript")
     p = LlmPlanner(LlmParams(model="m"))
     p.start_run({"scenario": "s", "planner": "llm", "goal": "1", "episode": 0, "seed": 0})
     assert p.transcript[0]["params"]["api_key_env"] == "OPENAI_API_KEY"
-    assert os.environ.get("OPENAI_API_KEY", "\0") not in json.dumps(p.transcript)
+    assert os.environ["OPENAI_API_KEY"] not in json.dumps(p.transcript)
 
 
 def test_the_model_as_a_gymnasium_policy_travels_greedys_runs(tmp_path):

@@ -222,7 +222,9 @@ class Batch:
             serial = total == 0 or (executor == "processes" and total == 1)
             runner = SerialExecutor() if serial else make_executor(max(1, min(workers, total)), options.start_method, executor,
                                                                    options.scheduler)
-        costs = [c for v in self.variants for c in planner_class(v).cost_columns]  # a language model's calls and tokens
+        # a language model's calls and tokens: the columns of every planner of the scenario, so that a
+        # folder first run with another planner alone (--planner) still has them
+        costs = [c for v in [*self.variants, *loaded.task.variants()] for c in planner_class(v).cost_columns]
         writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *costs, *self.stamp, *self.own]))
         n = 0
         try:

@@ -22,7 +22,7 @@ from typing import Iterable, Iterator
 
 from ..errors import ScenarioError
 from ..optional import lazy_module
-from .execution import NO_PATH, Executor, Watch, execute
+from .execution import Executor, Watch, execute
 from .executors import register_executor
 from .specs import Loaded, RunSpec
 from .store import save_run_files
@@ -121,8 +121,7 @@ class DaskExecutor(Executor):
                 fut.release()
                 submit(1)
                 for stem, rows, res in done:
-                    if res.outcome not in NO_PATH:
-                        save_run_files(out, stem, res)
+                    save_run_files(out, stem, res)  # a failed run: its transcripts alone
                     yield rows
         except BaseException:
             client.cancel(list(pending.futures))

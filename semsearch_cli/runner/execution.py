@@ -48,11 +48,11 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
     empty = np.zeros((0, 2), np.float32)
     announce_compiling()
     running(f"{spec.variant.label} goal {spec.episode.goal} episode {spec.episode.index} seed {spec.seed}")
+    seat = Recording() if watch.decisions else Seat()
     try:
         with wall_clock_limit(limit):
             tracer = TraceObserver() if watch.trace else None
             recorder = FrameRecorder() if watch.frames else None
-            seat = Recording() if watch.decisions else Seat()
             watching = Observers(tracer, recorder) if tracer or recorder else None
             res = task.run(spec.variant, spec.episode, spec.seed, watching, seat=seat)
             if watch.decisions:
@@ -72,6 +72,9 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
         res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=msg)
     finally:
         running(None)
+    if res.outcome in ("error", "timeout"):  # what its planner paid for before the run failed is still counted
+        res.record = {**seat.costs(), **res.record}
+        res.transcripts = seat.transcripts() if watch.transcripts else []
     rows = task.rows(spec.variant, spec.episode, spec.seed, res)
     if res.decisions_record is not None:  # a bench row names its record (metrics.BENCH_COLUMNS); other folders drop it
         digest = decisions_digest(res.decisions_record)
@@ -107,13 +110,9 @@ def wall_clock_limit(seconds: float):
         signal.signal(signal.SIGALRM, before)
 
 
-NO_PATH = ("error", "timeout")  # outcomes of runs that leave no path to save
-
-
 def run_and_save(loaded: Loaded, spec: RunSpec, out: Path, watch: Watch) -> list[dict]:
     rows, res = execute(loaded, spec, watch)
-    if res.outcome not in NO_PATH:
-        save_run_files(out, spec.stem, res)
+    save_run_files(out, spec.stem, res)  # a failed run: its transcripts alone
     return rows
 
 

@@ -226,7 +226,12 @@ def _json_safe(v, outer: tuple):
 def save_run_files(out: Path, stem: str, res) -> None:
     """``paths/<stem>.npz`` (path, signs read) and, for traced runs, ``traces/<stem>.jsonl``
     (one JSON object per decision); its frames, decisions and transcripts when kept; each written
-    atomically."""
+    atomically. A run that failed (error, timeout) leaves no path: only its transcripts, what its
+    planner paid for, are written."""
+    for k, transcript in enumerate(res.transcripts):  # a language model's: transcripts/<run>.jsonl (a chain's later stages __stage<k>)
+        write_jsonl(out / "transcripts" / f"{stem}{f'__stage{k}' if k else ''}.jsonl", transcript)
+    if res.outcome in ("error", "timeout"):
+        return
     paths = out / "paths"
     paths.mkdir(parents=True, exist_ok=True)
     tmp = temp_path(paths / f"{stem}.npz")
@@ -239,8 +244,6 @@ def save_run_files(out: Path, stem: str, res) -> None:
         write_frames(out / "frames" / f"{stem}.npz", res.frames)
     if res.decisions_record is not None:
         write_decisions(out / "decisions" / f"{stem}.json", res.decisions_record)
-    for k, transcript in enumerate(res.transcripts):  # a language model's: transcripts/<run>.jsonl (a chain's later stages __stage<k>)
-        write_jsonl(out / "transcripts" / f"{stem}{f'__stage{k}' if k else ''}.jsonl", transcript)
 
 
 def write_jsonl(path: Path, items: list) -> None:

@@ -355,6 +355,7 @@ class Task:
         seat.run = {"scenario": self.sc.name, "planner": variant.label, "goal": str(ep.goal), "episode": int(ep.index),
                     "seed": int(seed)}
         out = self.search(variant, ep, seed, st, rng, seat, observer)
+        seat.finish()
         left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
         message = out.message or (seat.notes() if out.outcome == "budget" else "")
         return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,

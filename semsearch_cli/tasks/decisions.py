@@ -152,6 +152,14 @@ class Seat:
         """Why a planner's own budget ended the run (``spent``), if one did."""
         return "; ".join(s for s in (getattr(p, "spent", "") for p in self.seated) if s)
 
+    def finish(self) -> None:
+        """The run is over: each planner that checks something then (``finish_run()``: a replayed
+        transcript used up) does."""
+        for p in self.seated:
+            end = getattr(p, "finish_run", None)
+            if callable(end):
+                end()
+
 
 def run_attributes(planner) -> dict:
     """The attributes of ``planner`` that shape a run besides its choices (its protocol's
@@ -175,9 +183,9 @@ class Recording(Seat):
         self._last = None
 
     def planner(self, variant):
-        p = variant.build()
+        p = self.seat(variant.build())  # seated first: a planner may set its run attributes when the run starts
         self.seats.setdefault(variant.label, run_attributes(p))
-        return self.seat(p)
+        return p
 
     def decide(self, point: DecisionPoint):
         before = rng_word(point.rng)

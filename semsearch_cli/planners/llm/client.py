@@ -11,7 +11,8 @@ What a lab relies on, and where it is done:
 - the API key read from the environment variable ``api_key_env`` when the client is made, and
   kept nowhere else: not in rows, transcripts or meta.json (a request's headers are never
   recorded);
-- nothing a server does raises out of :meth:`Chat.ask`: a reply, or the reason there is none
+- nothing a server does raises out of :meth:`Chat.ask` (any ``Exception``; a run's wall-clock
+  limit, a ``BaseException``, still ends the run): a reply, or the reason there is none
   (``error``), always comes back, so the planner counts it.
 """
 
@@ -100,9 +101,12 @@ class Chat:
         self.slots = Slots(base_url, max_concurrent)
 
     def ask(self, messages: list[dict]) -> Reply:
+        """The reply to ``messages``; its seconds count from when a request slot was free (the wait
+        for one is not the model's)."""
         t0 = time.perf_counter()
         try:
             with self.slots:
+                t0 = time.perf_counter()
                 resp = self.client.chat.completions.create(model=self.model, messages=messages, temperature=self.temperature,
                                                            max_tokens=self.max_tokens)
             usage = getattr(resp, "usage", None)
@@ -122,8 +126,7 @@ class Chat:
         except openai.APIConnectionError as exc:
             return Reply(None, f"no connection to the server ({type(exc.__cause__ or exc).__name__})",
                          latency_s=time.perf_counter() - t0)
-        except (openai.APIError, ValueError, TypeError, AttributeError, KeyError, IndexError) as exc:
-            # a body that is not a chat completion (not JSON, another shape)
+        except Exception as exc:  # noqa: BLE001  (a body that is not a chat completion: not JSON, another shape, nested too deep)
             return Reply(None, f"the server's reply is not a chat completion ({type(exc).__name__})",
                          latency_s=time.perf_counter() - t0)
 

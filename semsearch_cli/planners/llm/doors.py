@@ -43,7 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ...errors import BudgetSpent, PlannerError, ScenarioError
 from ..base import COST_COLUMNS, Decision, DoorPlanner, register_planner
-from ..text import ANGLES_TEXT, answer_line, deg
+from ..text import ANGLES_TEXT, answer_line, deg, spell
 from .transcript import folder_text, header, index, read, run_key
 from .client import Chat, Reply, prompt_path, require_openai
 from .replies import parse_number, parse_probabilities
@@ -59,6 +59,7 @@ FIELDS = {  # the fields a prompt template may use ($name), each documented in d
     "answer": "the answer line: which numbers may be answered",
 }
 SPLIT = ("=== system ===", "=== user ===")
+REPEAT_CHARS = 2000  # characters of an invalid reply sent back with the re-ask (a reply of 20,000 is not sent back whole)
 
 
 class LlmParams(BaseModel):
@@ -134,7 +135,8 @@ def observation(ctx, dist: np.ndarray, order: np.ndarray, cands, mode: str) -> d
     if mode == "actor":
         lines.append(f"[{n}] look at the nearest wall face no camera has read yet")
     f["targets"] = "\n".join(lines)
-    f["answer"] = answer_line(np.ones(n + (mode == "actor"), bool))
+    f["answer"] = (answer_line(np.ones(n + 1, bool)) if mode == "actor" else
+                   f"Answer with one JSON object mapping target numbers ({spell(range(n))}) to probabilities from 0 to 1.")
     f["observation"] = "\n".join(f[k] for k in ("goal", "frame", "pose", "signs", "targets", "answer"))
     return f
 
@@ -225,7 +227,16 @@ class LlmPlanner(DoorPlanner):
                 "invalid_replies": self.invalid, "fallbacks": self.fallbacks, "llm_s": round(self.llm_s, 3)}
 
     # ---- a decision -------------------------------------------------------------------------
+    def finish_run(self) -> None:
+        """A replay must use its transcript up: a run that asked fewer calls went another way."""
+        if self._replay is not None and self.calls < len(self._replay):
+            raise PlannerError(f"replay of run {self.describe_run()}: the run ended after {self.calls} calls, and the "
+                               f"transcript holds {len(self._replay)} (the run went another way: another budget or map?)")
+
     def choose(self, ctx, cands):
+        if self.params.replay is not None and self._replay is None:
+            raise PlannerError("a replay finds each run's transcript by the run (scenario, goal, episode, seed): replay "
+                               "through semsearch run or bench run, not as a policy of an environment")
         if len(cands) == 0:
             return None
         b, res = ctx.belief, ctx.belief.frame.res
@@ -263,8 +274,8 @@ class LlmPlanner(DoorPlanner):
         reason, last = "", None
         for attempt in range(live.reasks + 1):
             self.check_budget()
-            if attempt and self._replay is None:
-                messages = messages + [{"role": "assistant", "content": last or ""},
+            if attempt and self._replay is None and last is not None:  # after no reply at all (an HTTP error): the same messages again
+                messages = messages + [{"role": "assistant", "content": last[:REPEAT_CHARS]},
                                        {"role": "user", "content": f"Your reply could not be used: {reason}. {fields['answer']}"}]
             if self.dry_run:
                 raise FirstPrompt(messages)

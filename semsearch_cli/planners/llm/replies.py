@@ -3,8 +3,10 @@ is asked again, and the transcript keeps). Nothing here guesses: a reply that do
 legal choice is invalid, never mapped to a default.
 
 - an actor's reply names one number: the whole reply is that number (``3``, ``[3]``, ``3.``,
-  ``"3"``), or its last line that starts with ``Answer`` gives it (``Answer: 3``), so that a
-  model that reasons first may; a reasoning model's ``<think>...</think>`` block is set aside;
+  ``"3"``), or its last line of the form ``Answer: 3`` (among its last 20 lines) gives it, so
+  that a model that reasons first may; a reasoning model's ``<think>...</think>`` block is set
+  aside; a number of more than 9 digits names no choice; a reply longer than 20,000 characters
+  is not read;
 - an estimator's reply is one JSON object (bare, or in a ```json fence) mapping shown targets'
   numbers to probabilities in [0, 1]; a target it leaves out counts as 0.
 """
@@ -15,11 +17,27 @@ import json
 import math
 import re
 
-MAX_REPLY = 100_000  # characters of a reply that are read (a longer one is invalid: "too long")
-THINK = re.compile(r"<think>.*?</think>", re.S | re.I)
-BARE = re.compile(r"\s*[\[\"'(]?\s*(-?[0-9]+)\s*[\]\"')]?\s*\.?\s*")
-ANSWER = re.compile(r"^\s*\**\s*answer\s*\**\s*[:=\-]?\s*\**\s*[\[\"'(]?\s*(-?[0-9]+)\s*[\]\"')]?\s*\.?\s*\**\s*$", re.I | re.M)
-FENCE = re.compile(r"```(?:json)?\s*(.*?)```", re.S | re.I)
+MAX_REPLY = 20_000  # characters of a reply that are read (a longer one is invalid: "too long")
+MAX_DIGITS = 9  # a number longer than this names no choice (and int() of thousands of digits refuses)
+LAST_LINES = 20  # the lines at a reply's end where an "Answer: N" line is looked for
+# each pattern is matched against one stripped line at most, never searched across a whole reply:
+# no pattern here can take more than linear time in what it is given
+BARE = re.compile(r"[\[\"'(]?[ \t]*(-?[0-9]+)[ \t]*[\]\"')]?[ \t]*\.?")
+ANSWER = re.compile(r"\**[ \t]*answer[ \t]*\**[ \t]*[:=\-]?[ \t]*\**[ \t]*[\[\"'(]?[ \t]*(-?[0-9]+)[ \t]*[\]\"')]?[ \t]*\.?[ \t]*\**", re.I)
+
+
+def strip_thinking(text: str) -> str:
+    """``text`` without its ``<think>...</think>`` blocks (a reasoning model's), by plain search."""
+    out, i, low = [], 0, text.lower()
+    while True:
+        a = low.find("<think>", i)
+        if a < 0:
+            return "".join(out) + text[i:]
+        b = low.find("</think>", a)
+        if b < 0:  # an unclosed block: everything after it is thinking
+            return "".join(out) + text[i:a]
+        out.append(text[i:a])
+        i = b + len("</think>")
 
 
 def _text(reply) -> tuple[str | None, str]:
@@ -27,10 +45,22 @@ def _text(reply) -> tuple[str | None, str]:
         return None, "the reply is empty"
     if len(reply) > MAX_REPLY:
         return None, f"the reply is too long ({len(reply):,} characters)"
-    text = THINK.sub("", reply).strip()
+    text = strip_thinking(reply).strip()
     if not text:
         return None, "the reply is empty"
     return text, ""
+
+
+def _fenced(text: str) -> str:
+    """The body of the first ```json fence in ``text`` (or of the first ``` fence), else ``text``."""
+    a = text.find("```")
+    if a < 0:
+        return text
+    b = text.find("```", a + 3)
+    if b < 0:
+        return text
+    body = text[a + 3:b]
+    return body[4:] if body[:4].lower() == "json" else body
 
 
 def parse_number(reply, allowed: range) -> tuple[int | None, str]:
@@ -38,10 +68,13 @@ def parse_number(reply, allowed: range) -> tuple[int | None, str]:
     text, why = _text(reply)
     if text is None:
         return None, why
-    m = BARE.fullmatch(text)
-    found = [m.group(1)] if m else ANSWER.findall(text)
+    m = BARE.fullmatch(text) if "\n" not in text else None
+    found = [m.group(1)] if m else [a.group(1) for line in text.splitlines()[-LAST_LINES:]
+                                     if (a := ANSWER.fullmatch(line.strip()))]
     if not found:
         return None, "the reply is not one number (answer with the number alone)"
+    if len(found[-1].lstrip("-")) > MAX_DIGITS:
+        return None, f"{found[-1][:12]}... is not one of the choices offered"
     n = int(found[-1])
     if n not in allowed:
         return None, f"{n} is not one of the choices offered"
@@ -53,11 +86,10 @@ def parse_probabilities(reply, targets: int) -> tuple[dict[int, float] | None, s
     text, why = _text(reply)
     if text is None:
         return None, why
-    fenced = FENCE.search(text)
-    body = fenced.group(1).strip() if fenced else text
+    body = _fenced(text).strip()
     try:
         obj = json.loads(body)
-    except ValueError:
+    except (ValueError, RecursionError):  # RecursionError: JSON nested thousands deep
         return None, "the reply is not one JSON object"
     if not isinstance(obj, dict):
         return None, "the reply is JSON, but not an object mapping targets to probabilities"

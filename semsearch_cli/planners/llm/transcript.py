@@ -61,12 +61,31 @@ def read(path: Path) -> list[dict]:
     return out
 
 
+_INDEX: dict = {}  # the last folder's index and what it was read from (a replay reads one folder, run after run)
+
+
+def files(folder: Path) -> list[Path]:
+    """The transcript files under ``folder``: a results folder's ``transcripts/``, a bench
+    folder's ``<floor>/transcripts/``, or the files in ``folder`` itself."""
+    if (folder / "transcripts").is_dir():
+        return sorted((folder / "transcripts").glob("*.jsonl"))
+    nested = sorted(folder.glob("*/transcripts/*.jsonl"))
+    return nested or sorted(folder.glob("*.jsonl"))
+
+
 def index(folder: Path) -> dict[tuple, list[tuple[str, Path]]]:
-    """The transcripts under ``folder`` (a results folder's ``transcripts/``, or that folder
-    itself), by run: run key -> [(planner label, file)]."""
-    where = folder / "transcripts" if (folder / "transcripts").is_dir() else folder
+    """The transcripts under ``folder`` (:func:`files`), by run: run key -> [(planner label,
+    file)]."""
+    paths = files(Path(folder))
+    key = (str(Path(folder).resolve()), len(paths), max((p.stat().st_mtime_ns for p in paths), default=0))
+    if _INDEX.get("key") != key:  # read again when a transcript was added or rewritten
+        _INDEX["key"], _INDEX["index"] = key, _index(paths)
+    return _INDEX["index"]
+
+
+def _index(paths: list[Path]) -> dict[tuple, list[tuple[str, Path]]]:
     out: dict[tuple, list[tuple[str, Path]]] = {}
-    for path in sorted(where.glob("*.jsonl")):
+    for path in paths:
         with open(path, encoding="utf-8") as fh:
             first = fh.readline()
         try:
@@ -81,5 +100,4 @@ def index(folder: Path) -> dict[tuple, list[tuple[str, Path]]]:
 def folder_text(folder: Path) -> str:
     """The transcripts under ``folder`` as text to hash (names and bytes, in name order): what a
     replay's rows depend on."""
-    where = folder / "transcripts" if (folder / "transcripts").is_dir() else folder
-    return "".join(f"{p.name}\0{hashlib.sha256(p.read_bytes()).hexdigest()}\0" for p in sorted(where.glob("*.jsonl")))
+    return "".join(f"{p.relative_to(folder)}\0{hashlib.sha256(p.read_bytes()).hexdigest()}\0" for p in files(folder))
