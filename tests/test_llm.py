@@ -360,10 +360,15 @@ def test_dry_run_prints_the_first_prompt_and_calls_nothing(tmp_path):
 def test_the_bench_runs_and_verifies_a_language_model(tmp_path):
     with ChatServer(first_target) as srv:
         spec = f"llm[base_url={srv.base_url},model=scripted]"
-        api.bench_run("doors-classic-v1", [spec], tmp_path / "b", options=BatchOptions(workers=1), limit=2)
+        api.bench_run("doors-classic-v1", [spec], tmp_path / "b", options=BatchOptions(workers=1, transcripts=True), limit=1)
     runs = pd.concat([pd.read_csv(p) for p in sorted((tmp_path / "b").glob("*/runs.csv"))])
     assert len(runs) >= 1 and (runs["llm_calls"] > 0).all() and runs["suite"].eq("doors-classic-v1").all()
     assert api.verify(tmp_path / "b").verdict.failed == []
+    # the bench folder's transcripts replay the same runs, offline
+    api.bench_run("doors-classic-v1", [f"llm[replay={tmp_path / 'b'}]"], tmp_path / "r", options=BatchOptions(workers=1), limit=1)
+    again = pd.concat([pd.read_csv(p) for p in sorted((tmp_path / "r").glob("*/runs.csv"))])
+    pd.testing.assert_frame_equal(runs[["floor", *SAME, *COSTS]].reset_index(drop=True),
+                                  again[["floor", *SAME, *COSTS]].reset_index(drop=True), check_dtype=False)
     shutil.rmtree(tmp_path / "b")
 
 
