@@ -67,7 +67,7 @@ class LlmParams(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
     base_url: str = Field("http://localhost:8000/v1", description="the OpenAI-compatible endpoint (ends in /v1)")
-    model: str = Field("", description="the model's name as the server knows it")
+    model: str = Field("", description="the model's name as the server knows it (required, unless replay)")
     mode: Literal["actor", "estimator"] = Field("actor", description="actor: answers a target; estimator: probabilities")
     api_key_env: str = Field("OPENAI_API_KEY", description="the environment variable that holds the key (never written)")
     temperature: float = Field(0.0, ge=0.0, le=2.0)
