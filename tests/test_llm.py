@@ -364,6 +364,11 @@ def test_the_bench_runs_and_verifies_a_language_model(tmp_path):
     runs = pd.concat([pd.read_csv(p) for p in sorted((tmp_path / "b").glob("*/runs.csv"))])
     assert len(runs) >= 1 and (runs["llm_calls"] > 0).all() and runs["suite"].eq("doors-classic-v1").all()
     assert api.verify(tmp_path / "b").verdict.failed == []
+    api.bench_board([tmp_path / "b"], tmp_path / "site")  # the board sums what the model cost
+    board = (tmp_path / "site" / "board.md").read_text()
+    header = next(line for line in board.splitlines() if line.startswith("| planner |"))
+    assert "| llm_calls |" in header and "| calls per run |" in header
+    assert f"| {int(runs['llm_calls'].sum()):,} |" in board
     # the bench folder's transcripts replay the same runs, offline
     api.bench_run("doors-classic-v1", [f"llm[replay={tmp_path / 'b'}]"], tmp_path / "r", options=BatchOptions(workers=1), limit=1)
     again = pd.concat([pd.read_csv(p) for p in sorted((tmp_path / "r").glob("*/runs.csv"))])
