@@ -18,6 +18,7 @@ from semsearch_cli import api
 from semsearch_cli.cli import app
 from semsearch_cli.errors import ScenarioError
 from semsearch_cli.runner import BatchOptions, expand, folder_lock, Loaded, ProcessExecutor, read_runs, run_batch
+from semsearch_cli.runner.execution import Watch
 
 runner = CliRunner()
 
@@ -148,7 +149,7 @@ def test_workers_are_handed_runs_as_they_free_up(demo_loaded, tmp_path):
             pulled.append(s)
             yield s
 
-    rows = ProcessExecutor(2).rows(demo_loaded, stream(), tmp_path, False)
+    rows = ProcessExecutor(2).rows(demo_loaded, stream(), tmp_path, Watch())  # nothing kept beside the rows
     next(rows)
     # a few runs per worker ahead, not the 200 of the batch: 2 per worker submitted, then one more per
     # run finished before the first result is read (runs that end together are refilled together)
