@@ -4,6 +4,8 @@ parameter sweeps (:func:`plot_alpha_sweep`, :func:`plot_sweep`)."""
 
 from __future__ import annotations
 
+import textwrap
+
 import inspect
 from pathlib import Path
 
@@ -146,7 +148,9 @@ def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), c
             ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(3, integer=True))
             if r == 0:
                 n = int(e["n"].iloc[0]) if len(e) else 0
-                ax.set_title(f"{lab}\n(n={n})" if len(lab) > 12 else f"{lab} (n={n})", fontsize=8, color=colors[lab])
+                # a long label (a language model's endpoint and model) broken at its parameters, to the panel's width
+                head = "\n".join(textwrap.wrap(lab.replace(",", ", "), 22, break_on_hyphens=False)).replace(", ", ",")
+                ax.set_title(f"{head}\n(n={n})" if len(lab) > 12 else f"{lab} (n={n})", fontsize=8, color=colors[lab])
             if j == 0:
                 ax.set_ylabel(f"goal {g}\nsuccess rate")
     for ax in axes[-1]:
