@@ -199,7 +199,7 @@ def planners_page() -> str:
            "(else the last in report order)."]
     for kind in dict.fromkeys(t.planner_kind for t in TASKS.values()):
         kinds = [k for k, t in TASKS.items() if t.planner_kind == kind]
-        names = planner_order([n for n, c in builtin.items() if c.task == kind])
+        names = planner_order([n for n, c in builtin.items() if c.answers(kind)])
         out += ["", f"## For {', '.join(kinds)} scenarios", "", "| planner | role | summary |", "|---|---|---|"]
         for n in names:
             c = builtin[n]

@@ -204,8 +204,8 @@ def sweep_alpha(scenario: str | Path, alphas: list[float], options: BatchOptions
     scenario = scenario_file(scenario)
     sc = load_scenario(scenario)
     answers = TASKS[sc.kind].planner_kind
-    sweeping = {n: c for n, c in PLANNERS.items() if c.swept == "alpha" and c.task == answers}
-    baseline = next((n for n, c in PLANNERS.items() if c.baseline and c.task == answers), None)
+    sweeping = {n: c for n, c in PLANNERS.items() if c.swept == "alpha" and c.answers(answers)}
+    baseline = next((n for n, c in PLANNERS.items() if c.baseline and c.answers(answers)), None)
     if not sweeping or baseline is None:
         raise ScenarioError(str(scenario), "kind", f"no registered planner for {sc.kind} scenarios sweeps alpha beside a "
                             "baseline; sweep a planner's own parameter with `semsearch sweep --param PLANNER.PARAM=V1,V2`")

@@ -25,6 +25,7 @@ from semsearch_cli import api  # noqa: E402
 from semsearch_cli.cli import app  # noqa: E402
 from semsearch_cli.errors import ScenarioError  # noqa: E402
 from semsearch_cli.planners.llm import LlmParams, LlmPlanner, load_prompt  # noqa: E402
+from semsearch_cli.planners.llm.core import by_expected_cost  # noqa: E402
 from semsearch_cli.planners.llm.replies import parse_number, parse_probabilities  # noqa: E402
 from semsearch_cli.runner import BatchOptions, Loaded  # noqa: E402
 from semsearch_cli.tasks.decisions import Seat  # noqa: E402
@@ -290,10 +291,13 @@ def test_the_key_is_sent_and_never_written(tmp_path, monkeypatch):
 # ---- the estimator -------------------------------------------------------------------------------
 def test_the_estimator_chooses_by_expected_cost():
     d = np.array([1.0, 5.0, 9.0])  # mean 5: cost_i = d_i + (1 - p_i) (d_i + 5)
-    assert LlmPlanner.by_expected_cost({2: 1.0}, d) == 0  # 7, 15, 9
-    assert LlmPlanner.by_expected_cost({1: 1.0}, d) == 1  # 7, 5, 23
-    assert LlmPlanner.by_expected_cost({0: 0.0, 2: 1.0}, np.array([4.0, 5.0, 6.0])) == 2  # 13, 15, 6
-    assert LlmPlanner.by_expected_cost({0: 2 / 3, 2: 2 / 3}, np.array([6.0, 9.0, 6.0])) == 0  # scaled to 1/2: a tie, the nearer
+    every = [0, 1, 2]
+    assert by_expected_cost({2: 1.0}, d, every) == 0  # 7, 15, 9
+    assert by_expected_cost({1: 1.0}, d, every) == 1  # 7, 5, 23
+    assert by_expected_cost({0: 0.0, 2: 1.0}, np.array([4.0, 5.0, 6.0]), every) == 2  # 13, 15, 6
+    assert by_expected_cost({0: 2 / 3, 2: 2 / 3}, np.array([6.0, 9.0, 6.0]), every) == 0  # scaled to 1/2: a tie, the nearer
+    # among the choices offered only (an object search leaves out the place just looked at): mean of 5 and 9 is 7
+    assert by_expected_cost({}, d, [1, 2]) == 1  # 5 + 12, 9 + 16
 
 
 def test_an_estimator_run_reads_json_probabilities(tmp_path):
@@ -318,23 +322,29 @@ def test_replies_parse_strictly():
     assert parse_number("7", r) == (None, "7 is not one of the choices offered")
     assert parse_number("\u0663", r)[0] is None  # an Arabic-Indic three is not a number of the choices
     assert parse_number("", r) == (None, "the reply is empty") == parse_number(None, r)
-    assert parse_probabilities('{"0": 0.2, "2": 1}', 3) == ({0: 0.2, 2: 1.0}, "")
-    assert parse_probabilities('{"3": 0.2}', 3)[1] == "'3' is not one of the targets offered (0 to 2)"
-    assert parse_probabilities('{"0": 1.5}', 3)[1] == "the probability of target 0 is 1.5, not a number from 0 to 1"
-    assert parse_probabilities("[0.2]", 3)[1] == "the reply is JSON, but not an object mapping targets to probabilities"
-    assert parse_probabilities("{}", 3)[1] == "the object gives no target a probability"
+    t = range(3)
+    assert parse_probabilities('{"0": 0.2, "2": 1}', t) == ({0: 0.2, 2: 1.0}, "")
+    assert parse_probabilities('{"3": 0.2}', t)[1] == "'3' is not one of the choices offered (0-2)"
+    assert parse_probabilities('{"1": 0.2}', {0, 2})[1] == "'1' is not one of the choices offered (0 or 2)"
+    assert parse_probabilities('{"0": 1.5}', t)[1] == "the probability of target 0 is 1.5, not a number from 0 to 1"
+    assert parse_probabilities("[0.2]", t)[1] == "the reply is JSON, but not an object mapping targets to probabilities"
+    assert parse_probabilities("{}", t)[1] == "the object gives no target a probability"
 
 
 def test_prompt_templates_are_checked_where_they_are_named(tmp_path):
-    system, user, sha = load_prompt(None, "actor")
+    system, user, sha = load_prompt(None, "doors", "actor")
     assert user == "$observation" and "door sign" in system and len(sha) == 64
     bad = tmp_path / "bad.txt"
     bad.write_text("=== system ===\nFind $goal_label.\n=== user ===\n$observation\n")
-    with pytest.raises(ScenarioError, match=r"no field \$goal_label; the fields: \$observation, \$goal"):
-        load_prompt(str(bad), "actor")
+    with pytest.raises(ScenarioError, match=r"no field \$goal_label in doors search; its fields: \$observation, \$goal"):
+        load_prompt(str(bad), "doors", "actor")
+    bad.write_text("=== system ===\nFind it.\n=== user ===\n$signs\n")  # a door search's field, in object search
+    with pytest.raises(ScenarioError, match=r"no field \$signs in objects search; its fields: \$observation, \$goal, "
+                       r"\$frame, \$pose, \$places, \$answer"):
+        load_prompt(str(bad), "objects", "actor")
     bad.write_text("Find the door.\n")
     with pytest.raises(ScenarioError, match="a line '=== system ===' and, after it, a line '=== user ==='"):
-        load_prompt(str(bad), "actor")
+        load_prompt(str(bad), "doors", "actor")
 
 
 def test_a_scenario_without_a_model_is_refused_naming_the_field(tmp_path):
@@ -380,7 +390,7 @@ def test_the_bench_runs_and_verifies_a_language_model(tmp_path):
 def test_the_key_variable_is_named_not_read_into_params(monkeypatch):
     monkeypatch.setenv("OPENAI_API_KEY", "sk-not-in-any-transcript")
     p = LlmPlanner(LlmParams(model="m"))
-    p.start_run({"scenario": "s", "planner": "llm", "goal": "1", "episode": 0, "seed": 0})
+    p.start_run({"scenario": "s", "kind": "doors", "planner": "llm", "goal": "1", "episode": 0, "seed": 0})
     assert p.transcript[0]["params"]["api_key_env"] == "OPENAI_API_KEY"
     assert os.environ["OPENAI_API_KEY"] not in json.dumps(p.transcript)
 
@@ -404,3 +414,25 @@ def test_the_model_as_a_gymnasium_policy_travels_greedys_runs(tmp_path):
                 done = term or trunc
             assert (info["outcome"], info["distance_m"]) == (row["outcome"], pytest.approx(row["distance_m"], abs=1e-3))
     assert len(srv.requests) > 0 and policy.planner.calls > 0
+
+
+def test_a_gymnasium_policy_replays_the_batchs_transcripts_with_no_server(tmp_path):
+    gym = pytest.importorskip("gymnasium")
+    import semsearch_cli.envs  # noqa: F401  (registers the environments)
+    from semsearch_cli.envs import PlannerPolicy
+    with ChatServer(flaky) as srv:
+        sc = scenario(tmp_path, [llm(srv, reasks=1)], seeds=2, goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, transcripts=True), plots=False)
+    rows = rows_of(tmp_path / "out", "llm")
+    assert rows["invalid_replies"].sum() > 0
+    policy = PlannerPolicy("llm", replay=str(tmp_path / "out"))
+    env = gym.make("semsearch/DoorSearch-v0", scenario=str(sc), **policy.env_kwargs)
+    for _, row in rows.iterrows():
+        env.reset(options={"episode": int(row["episode"]), "repeat": int(row["seed"])})
+        policy.reset()
+        done = False
+        while not done:
+            _, _, term, trunc, info = env.step(policy(env))
+            done = term or trunc
+        assert (info["outcome"], info["distance_m"]) == (row["outcome"], pytest.approx(row["distance_m"], abs=1e-3))
+        assert policy.planner.costs() == {c: (int(row[c]) if c != "llm_s" else row[c]) for c in COSTS}

@@ -48,14 +48,12 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..planners import Goal
+from ..planners.indirect import Lattice
 from ..tasks.indirect import IndirectSearch
 from ..tasks.decisions import StandIn
 from ..tasks.loop import Session
 from .base import (BIG, TWO_PI, SearchEnv, box, check_choice, check_flag, check_number, clip_text, ended, text_space)
-from ..planners.text import FRAME_TEXT, answer_line, deg
-
-HEADINGS = np.radians(np.arange(0, 360, 45))
-
+from ..planners.text import indirect_fields, lattice_choices
 
 class IndirectSearchEnv(SearchEnv):
     """Indirect search over an indirect scenario (see the module docstring for the spaces)."""
@@ -98,13 +96,8 @@ class IndirectSearchEnv(SearchEnv):
         self.state = st = t.start_state(ep, self.rng)
         st.belief = self.search.new_belief()
         self.max_steps = int(round(t.spec.time_limit * t.spec.camera.fps))
-        gx, gy = np.meshgrid(self.lx, self.ly)
-        r, c = self.grid.frame.to_index(gx.ravel(), gy.ravel())
-        H, W = self.grid.stand.shape
-        ok = (r >= 0) & (r < H) & (c >= 0) & (c < W)
-        self.standable = np.zeros(self.N, bool)
-        self.standable[ok] = self.grid.stand[r[ok], c[ok]]
-        self.points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        self.lattice_poses = Lattice.over(self.grid.frame, self.grid.stand, self.grid.room.size, self.lattice)
+        self.standable, self.points = self.lattice_poses.standable, self.lattice_poses.points
         if self.action_mode == "macro":
             self.session = Session(self.search, st, 0.0, math.inf, self.max_steps, move=self.search.move)
             self.outcome = ended(self.session.start())
@@ -135,12 +128,8 @@ class IndirectSearchEnv(SearchEnv):
             found, _ = self.search.sense(st)
             self.search.update(st)
             return st.distance - d0, "found" if found else "budget" if st.steps >= self.max_steps else None
-        k, h = divmod(a, 8)
-        if not self.standable[k]:  # the nearest lattice point the robot can stand on
-            d = np.hypot(*(self.points - self.points[k]).T)
-            d[~self.standable] = np.inf
-            k = int(np.argmin(d))
-        goal = Goal(float(self.points[k, 0]), float(self.points[k, 1]), float(HEADINGS[h]), {"action": a})
+        x, y, heading = self.lattice_poses.pose(a)  # a point the robot cannot stand on: the nearest that it can
+        goal = Goal(x, y, heading, {"action": a})
         out = ended(self.session.answer(goal))
         return st.distance - d0, out
 
@@ -149,7 +138,7 @@ class IndirectSearchEnv(SearchEnv):
         on in this room; primitive: every action."""
         if self.action_mode == "primitive":
             return np.ones(4, bool)
-        return np.repeat(self.standable, 8)
+        return self.lattice_poses.mask()
 
     def _info(self) -> dict:
         return {**super()._info(), "room": self.grid.room.name}
@@ -178,37 +167,24 @@ class IndirectSearchEnv(SearchEnv):
                 "time": np.array([t_s, float(self.episode.goal)], np.float32)}
 
     def _text(self, t_s: float) -> str:
-        """The text observation: the goal, the frame, the pose, the objects detected, the five
-        likeliest cells of the target, the choices and an answer line naming exactly the actions
+        """The text observation (:func:`~semsearch_cli.planners.text.indirect_fields`, as the llm
+        planner reads it): the goal, the frame, the pose, the objects detected, the five likeliest
+        cells of the target, the choices and an answer line naming exactly the actions
         :meth:`action_masks` allows (macro: ranges of action numbers)."""
         st, spec = self.state, self.task.spec
-        p = self._belief()
-        top = np.argsort(p.ravel())[::-1][:5]
-        xs, ys = self.grid.frame.to_world(*np.unravel_index(top, p.shape))
-        seen = [f"{cls} at x {s[1] + st.x:.2f} m, y {s[2] + st.y:.2f} m ({math.hypot(s[1], s[2]):.2f} m away, bearing "
-                f"{deg(math.atan2(s[2], s[1]))} deg)" for cls, s in zip(self.secondary, self._secondary()) if s[0]]
-        lines = [f"Goal: find the {spec.target} in room {self.grid.room.name}; your camera detects it up to "
-                 f"{float(self.episode.goal):g} m away. Time used: {t_s:.1f} s of {spec.time_limit:g} s.",
-                 FRAME_TEXT + " Positions are measured from the room's south-west corner.",
-                 f"You are at x {st.x:.2f} m, y {st.y:.2f} m, heading {deg(st.heading)} deg.",
-                 "Other objects detected: " + ("; ".join(seen) or "none yet") + ".",
-                 f"Likeliest cells of the {spec.target} (cell centre, probability): "
-                 + "; ".join(f"({x:.2f}, {y:.2f}) m {p.ravel()[i]:.4f}" for x, y, i in zip(xs, ys, top)) + "."]
         if self.action_mode == "macro":
-            nx, ny, a = len(self.lx), len(self.ly), self.lattice
-            lines.append(f"Choices: answer 8 k + h to drive to lattice point k and turn to heading h x 45 deg "
-                         f"(h 0-7: 0 east, 2 north, 4 west, 6 south); point k = i + {nx} j is at "
-                         f"x = {a / 2:g} + {a:g} i m, y = {a / 2:g} + {a:g} j m (i 0-{nx - 1}, j 0-{ny - 1}), and the "
-                         f"points you cannot stand on are left out. You choose again after {spec.replan_every:g} s, "
-                         "on arrival, or when an object is detected.")
+            lat = self.lattice_poses
+            choices = lattice_choices(len(lat.xs), len(lat.ys), lat.step, spec.replan_every)
         else:
             dt = 1.0 / spec.camera.fps
             turn = f"{spec.robot.turn_rate * dt:.3g} deg"
-            lines.append(f"Choices (each takes one camera frame, {dt:.2f} s): [0] drive {spec.robot.speed * dt:.3g} m "
-                         f"forward, along your heading (not into an obstacle); [1] turn {turn} left (counter-clockwise); "
-                         f"[2] turn {turn} right; [3] wait.")
-        lines.append(answer_line(self.action_masks()))
-        return clip_text("\n".join(lines))
+            choices = (f"Choices (each takes one camera frame, {dt:.2f} s): [0] drive {spec.robot.speed * dt:.3g} m "
+                       f"forward, along your heading (not into an obstacle); [1] turn {turn} left (counter-clockwise); "
+                       f"[2] turn {turn} right; [3] wait.")
+        f = indirect_fields(spec.target, self.grid.room.name, float(self.episode.goal), t_s, spec.time_limit,
+                            (st.x, st.y, st.heading), self.search.seen, self._belief(), self.grid.frame, choices,
+                            self.action_masks())
+        return clip_text(f["observation"])
 
     def render(self):
         if self.render_mode != "rgb_array" or self.episode is None:

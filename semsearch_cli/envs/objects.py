@@ -34,8 +34,6 @@ the action space (macro 0..P-1, primitive 0..9); -1 or P is refused, not read as
 
 from __future__ import annotations
 
-import math
-
 import cv2
 import gymnasium as gym
 import numpy as np
@@ -46,7 +44,7 @@ from ..sensors import PlaceCamera
 from ..tasks.loop import Session
 from ..tasks.objects import ObjectSearch
 from .base import (BIG, SearchEnv, box, clip_text, compass_moves, compass_step, ended, text_space)
-from ..planners.text import FRAME_TEXT, answer_line, deg
+from ..planners.text import object_fields, place_history
 
 
 class ObjectSearchEnv(SearchEnv):
@@ -81,10 +79,7 @@ class ObjectSearchEnv(SearchEnv):
         self.ctx = ObjectContext(t.world.frame, t.known, t.places, list(t.route), t.world.start_xy, req.cls, req.hour, log, self.rng)
         self.search = ObjectSearch(t, None, req.cls, instances, camera, self.ctx, self.rng)  # the agent answers
         self.search.planner_name = "agent"
-        cls_log = log[log["class"] == req.cls]
-        near = cls_log[np.abs(((cls_log["hour"] - req.hour + 12.0) % 24.0) - 12.0) <= 1.0]
-        self.history = np.array([[float((cls_log["place"] == n).sum()), float((near["place"] == n).sum())] for n in self.names],
-                                np.float32).reshape(self.P, 2)
+        self.history = place_history(log, req.cls, req.hour, self.names)
         if self.action_mode == "macro":
             self.session = Session(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
             self.outcome = ended(self.session.start())
@@ -130,27 +125,16 @@ class ObjectSearchEnv(SearchEnv):
                 "pose": np.array([st.x, st.y, wrap_angle(st.heading)], np.float32)}
 
     def _text(self) -> str:
-        """The text observation: the request, the frame, the pose, the places (the choices, each
-        ``[n]``, in the macro mode) and an answer line naming exactly the actions
-        :meth:`action_masks` allows."""
-        st, req, macro = self.state, self.request, self.action_mode == "macro"
-        h = f"{req.hour:g}"
-        lines = [f"Goal: find a {req.cls}; the request was made at hour {h} of the day.", FRAME_TEXT,
-                 f"You are at x {st.x:.1f} m, y {st.y:.1f} m, heading {deg(st.heading)} deg; travelled {st.distance:.1f} m.",
-                 ("Choices: drive to a place and look around there. " if macro else "")
-                 + f"Places (distance, bearing; whether your camera has had the place in view in this "
-                 f"search; the detections of a {req.cls} there in the recorded log, in all and within an hour of hour {h}):"]
-        for k, (n, p) in enumerate(zip(self.names, self._places())):
-            lines.append(f"{f'[{k}] ' if macro else ''}{n}: {math.hypot(p[0], p[1]):.1f} m, bearing "
-                         f"{deg(math.atan2(p[1], p[0]))} deg, {'viewed' if p[2] else 'not viewed yet'}; "
-                         f"log: {p[3]:.0f} detections, {p[4]:.0f} within the hour")
-        if not macro:
-            lines.append(compass_moves(self.step_m))
-        elif self.search.here is not None:
-            here = self.search.here
-            lines.append(f"[{here}] {self.names[here]} is left out: you have just looked around there.")
-        lines.append(answer_line(self.action_masks()))
-        return clip_text("\n".join(lines))
+        """The text observation (:func:`~semsearch_cli.planners.text.object_fields`, as the llm
+        planner reads it): the request, the frame, the pose, the places (the choices, each ``[n]``,
+        in the macro mode) and an answer line naming exactly the actions :meth:`action_masks`
+        allows."""
+        st, req = self.state, self.request
+        here = self.search.here if self.action_mode == "macro" else None
+        moves = None if self.action_mode == "macro" else compass_moves(self.step_m)
+        f = object_fields(req.cls, req.hour, (st.x, st.y, st.heading), st.distance, self.names, self.task.places,
+                          self.ctx.seen_places, self.history, here, self.action_masks(), moves)
+        return clip_text(f["observation"])
 
     def render(self):
         if self.render_mode != "rgb_array" or self.episode is None:

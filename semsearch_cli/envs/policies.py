@@ -9,7 +9,9 @@
 The planner sees what it sees in the batch (the belief, the pose, every candidate) and its choice
 becomes the candidate's slot (planners that choose among the frontier candidates: greedy, nsos,
 geometric, draft; bvp picks cells of its own and cannot), so the run is the one ``semsearch run`` records for that episode and
-seed (tests/test_envs.py checks it run for run).
+seed (tests/test_envs.py checks it run for run). Call ``policy.reset()`` after each
+``env.reset()``: the policy's first choice then gives the planner the episode and repeat, so the
+llm planner replays its transcripts as a policy too (``PlannerPolicy("llm", replay=DIR)``).
 
 A name that is not a registered door planner is a ``ValueError`` listing the door planners (with
 "did you mean"); a parameter the planner does not take, or out of its range, is its parameters'
@@ -38,7 +40,7 @@ class PlannerPolicy:
             raise ValueError(f"name must be a registered door planner{near}, not {repr(name)[:60]}; door planners: "
                              f"{', '.join(valid)} (semsearch planners lists them with their parameters)")
         self.variant = Variant(name, tuple(sorted(params.items())))
-        self.planner = self.variant.build()
+        self.reset()
 
     @property
     def env_kwargs(self) -> dict:
@@ -48,6 +50,17 @@ class PlannerPolicy:
     def reset(self) -> None:
         """A fresh planner for a new episode (the batch builds one per run)."""
         self.planner = self.variant.build()
+        self._started = False
+
+    def _start(self, u) -> None:
+        """Give a planner that wants it (``start_run``) the run's identity, as the batch does: the
+        scenario, the episode and the repeat of ``env.reset`` (the llm planner's replay finds its
+        transcript by them)."""
+        start = getattr(self.planner, "start_run", None)
+        if callable(start):
+            start({"scenario": u.task.sc.name, "kind": u.kind, "planner": self.variant.label, "goal": str(u.episode.goal),
+                   "episode": int(u.episode.index), "seed": int(u.repeat), "stage": 0})
+        self._started = True
 
     def __call__(self, env) -> int:
         u = getattr(env, "unwrapped", None)
@@ -56,6 +69,8 @@ class PlannerPolicy:
                              f"action_mode='macro'), not {str(env)[:80]}")
         if getattr(u, "decision", None) is None:
             raise ValueError("env has no choice to make: call env.reset() first (an ended episode asks for none)")
+        if not getattr(self, "_started", False):
+            self._start(u)
         ctx, cands = u.decision
         dec = self.planner.choose(ctx, cands)
         if dec is None:

@@ -175,6 +175,7 @@ class Planner:
 
     name: ClassVar[str] = ""
     task: ClassVar[str] = ""  # which kind of scenario the planner answers (a task's planner_kind)
+    kinds: ClassVar[tuple] = ()  # every kind it answers, when more than its task (llm answers all three)
     Params: ClassVar[type[BaseModel]] = NoParams
     rank: ClassVar[float] = 100  # where reports list it among its kind's planners (lower first; then by name)
     baseline: ClassVar[bool] = False  # reports compare the other planners with this one, paired
@@ -195,10 +196,16 @@ class Planner:
         self.params = params
 
     @classmethod
-    def fault(cls, params: BaseModel) -> tuple[str, str] | None:
-        """What is wrong with parameters that are each valid but do not go together (the field to
-        name, the message), checked when the scenario loads; None when nothing is. The defaults
-        may be faulty this way (the llm planner needs a model named)."""
+    def answers(cls, kind: str) -> bool:
+        """Whether the planner answers scenarios of ``kind`` (its ``task``, or one of its ``kinds``)."""
+        return kind == cls.task or kind in cls.kinds
+
+    @classmethod
+    def fault(cls, params: BaseModel, kind: str | None = None) -> tuple[str, str] | None:
+        """What is wrong with parameters that are each valid but do not go together, or do not
+        suit a scenario of ``kind`` (the field to name, the message), checked when the scenario
+        loads (the files they name already found to exist); None when nothing is. The defaults may
+        be faulty this way (the llm planner needs a model named)."""
         return None
 
     @classmethod
@@ -594,11 +601,11 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                 raise ScenarioError(file, f"planners[{i}].name", f"{module} registers {', '.join(names)}, not {name!r}")
         elif name not in PLANNERS:
             load_entry_points()
-        valid = sorted(n for n, c in PLANNERS.items() if task is None or c.task == task)
+        valid = sorted(n for n, c in PLANNERS.items() if task is None or c.answers(task))
         if name not in PLANNERS:
             raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}{did_you_mean(name, valid)}; valid: "
                                 f"{', '.join(valid)} (semsearch planners lists them with their parameters)")
-        if task is not None and PLANNERS[name].task != task:
+        if task is not None and not PLANNERS[name].answers(task):
             raise ScenarioError(file, f"planners[{i}].name", f"{name!r} answers {PLANNERS[name].task} scenarios, not {task} "
                                 f"ones; valid: {', '.join(valid)}")
         keys = sorted(params)
@@ -613,11 +620,7 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
         for combo in itertools.product(*values):
             p = tuple(zip(keys, combo))
             try:
-                fault = PLANNERS[name].fault(PLANNERS[name].Params(**dict(p)))
-                if fault:
-                    raise ScenarioError(file, f"planners[{i}].{fault[0]}", fault[1])
-            except ScenarioError:
-                raise
+                PLANNERS[name].Params(**dict(p))
             except ValidationError as exc:
                 e = exc.errors()[0]
                 loc = ".".join(str(x) for x in e["loc"])
@@ -639,6 +642,13 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                     raise ScenarioError(file, f"planners[{i}].{k}", f"{value} does not exist (a path relative to the "
                                         "scenario's folder)")
             v = Variant(name, p, module, str((base or Path(".")).resolve()) if paths else None)
+            try:
+                fault = PLANNERS[name].fault(v.resolved(PLANNERS[name]), task)
+            except (Exception, SystemExit) as exc:  # a user's fault() that raises
+                raise ScenarioError(file, f"planners[{i}]", f"planner {name!r}: its fault() raised {type(exc).__name__}: "
+                                    f"{exc}") from None
+            if fault:
+                raise ScenarioError(file, f"planners[{i}].{fault[0]}", fault[1])
             key = (v.label, module)  # rows name a variant by its label; a set keeps a big sweep linear
             if key not in seen:
                 seen.add(key)

@@ -65,7 +65,9 @@ class IndirectContext:
     pose had each point in its view cone of A; path_length : (x, y) -> m along the free cells from
     the robot (lazy);
     relations : class -> the mixed relation mask over every offset (ISUP's particles);
-    cooccurrence : class -> p(o | A), the share of Table 2 in which o is seen with A (AOSEOOR).
+    cooccurrence : class -> p(o | A), the share of Table 2 in which o is seen with A (AOSEOOR);
+    target : the target's class (A); room : the room's name; room_size : (width, height) m of the
+    room, whose south-west corner is the frame's origin; time_limit : s the search may take.
     """
 
     belief: IndirectBelief | None
@@ -88,6 +90,10 @@ class IndirectContext:
     path_length: Any = None
     relations: dict = field(default_factory=dict)
     cooccurrence: dict = field(default_factory=dict)
+    target: str = ""
+    room: str = ""
+    room_size: tuple = (0.0, 0.0)
+    time_limit: float = math.inf
 
 
 @dataclass
@@ -99,6 +105,52 @@ class Goal:
     y: float
     heading: float | None
     info: dict = field(default_factory=dict)
+
+
+HEADINGS = np.radians(np.arange(0, 360, 45))  # the 8 headings of a lattice pose (0 east, 45, ..., 315 deg)
+
+
+@dataclass(frozen=True)
+class Lattice:
+    """Poses over a room: points every ``step`` m from ``step / 2`` (``xs`` by ``ys``, point ``k
+    = i + len(xs) j`` at ``(xs[i], ys[j])``), each with the 8 :data:`HEADINGS`; pose ``8 k + h``.
+    ``standable``: (N,) whether the robot can stand at each point (inside the grid, on a cell of
+    ``stand``)."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    points: np.ndarray
+    standable: np.ndarray
+    step: float
+
+    @classmethod
+    def over(cls, frame: GridFrame, stand: np.ndarray, size: tuple, step: float) -> "Lattice":
+        xs, ys = np.arange(step / 2, size[0], step), np.arange(step / 2, size[1], step)
+        gx, gy = np.meshgrid(xs, ys)
+        r, c = frame.to_index(gx.ravel(), gy.ravel())
+        H, W = stand.shape
+        inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+        ok = np.zeros(gx.size, bool)
+        ok[inside] = stand[r[inside], c[inside]]
+        return cls(xs, ys, np.stack([gx.ravel(), gy.ravel()], axis=1), ok, step)
+
+    @property
+    def n(self) -> int:
+        return len(self.points)
+
+    def mask(self) -> np.ndarray:
+        """(8 N,) bool: every heading of the points the robot can stand on."""
+        return np.repeat(self.standable, 8)
+
+    def pose(self, action: int) -> tuple[float, float, float]:
+        """Pose ``action`` = 8 k + h as (x, y m, heading rad); a point the robot cannot stand on
+        is taken as the nearest that it can."""
+        k, h = divmod(int(action), 8)
+        if not self.standable[k]:
+            d = np.hypot(*(self.points - self.points[k]).T)
+            d[~self.standable] = np.inf
+            k = int(np.argmin(d))
+        return float(self.points[k, 0]), float(self.points[k, 1]), float(HEADINGS[h])
 
 
 class IndirectPlanner(Planner):

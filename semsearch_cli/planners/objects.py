@@ -10,6 +10,7 @@ robot to drive to until the object camera detects an instance of the requested c
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import ClassVar, Iterator
 
@@ -30,7 +31,10 @@ class ObjectContext:
     places : name -> (x, y) m; route : the places to search, in patrol order; home : (x, y) m
     where a patrol ends, or None; cls, hour : the request; log : the detection log (columns
     day, hour, class, x, y, robot_x, robot_y, place); seen_places : the places the camera has had
-    in view so far in this search (kept up to date while the robot drives).
+    in view so far in this search (kept up to date while the robot drives); x, y, heading,
+    distance : the robot's pose (m, rad) and the distance it has driven in this search (m), and
+    here : the place it has just looked around at (None when it has not), each brought up to date
+    before each target is asked for.
     """
 
     frame: GridFrame
@@ -43,6 +47,11 @@ class ObjectContext:
     log: pd.DataFrame
     rng: np.random.Generator
     seen_places: set = field(default_factory=set)
+    x: float = math.nan
+    y: float = math.nan
+    heading: float = math.nan
+    distance: float = 0.0
+    here: str | None = None
 
 
 class ObjectPlanner(Planner):

@@ -352,7 +352,7 @@ class Task:
         st = self.start_state(ep, rng)
         heading = st.heading
         seat = Seat() if seat is None else seat
-        seat.run = {"scenario": self.sc.name, "planner": variant.label, "goal": str(ep.goal), "episode": int(ep.index),
+        seat.run = {"scenario": self.sc.name, "kind": self.planner_kind, "planner": variant.label, "goal": str(ep.goal), "episode": int(ep.index),
                     "seed": int(seed)}
         out = self.search(variant, ep, seed, st, rng, seat, observer)
         seat.finish()

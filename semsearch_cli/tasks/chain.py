@@ -95,7 +95,8 @@ class ChainTask(OnMapTask):
             task.doors.check_goals([s.door for s in stages], f"{field}.stages")
             if any(s.cls is not None for s in stages):
                 task._check_object_stages(ch, stages, field)
-                answers = sorted(n for n, c in PLANNERS.items() if c.task == ObjectTask.planner_kind)
+                # a chain names its object planner alone, with its defaults: one that needs parameters to run (llm) cannot
+                answers = sorted(n for n, c in PLANNERS.items() if c.answers(ObjectTask.planner_kind) and not c.service)
                 if ch.object_planner not in answers:
                     raise ScenarioError(task.file, f"{field}.object_planner", f"unknown object-search planner "
                                         f"{ch.object_planner!r}; valid: {', '.join(answers)}")

@@ -308,7 +308,7 @@ class IndirectSearch:
                               self.task.cones(self.scale), spec.robot.speed, math.radians(spec.robot.turn_rate),
                               spec.replan_every, self.rng, dict(self.seen), set(self.latest),
                               np.asarray(self.since_plan).reshape(-1, 3), self.sees, path_length, self.task.relations,
-                              self.task.cooccurrence)
+                              self.task.cooccurrence, spec.target, g.room.name, tuple(g.room.size), spec.time_limit)
         stand = g.stand.view()
         stand.flags.writeable = False  # the room's own cells: a driver reads them, never writes
         goal = yield DecisionPoint("indirect", ctx, stand, stand, lambda: self.planner.plan(ctx), INDIRECT_CODEC, self.rng)
@@ -569,8 +569,10 @@ class IndirectTask(Task):
         return self.grids[ep.room].room.name
 
     def record(self, ep: Episode, res: RunResult) -> dict:
-        """The room searched and the simulated time (s) the search took."""
-        return {"room": self.room_name(ep), "time_s": round(res.time_s, 2) if res.time_s == res.time_s else ""}
+        """The room searched and the simulated time (s) the search took (beside what the planner's
+        decisions cost, when it reports any)."""
+        return {**super().record(ep, res), "room": self.room_name(ep),
+                "time_s": round(res.time_s, 2) if res.time_s == res.time_s else ""}
 
     def episode_row(self, ep: Episode) -> dict:
         return ep.row() | {"room": self.room_name(ep)}

@@ -225,6 +225,9 @@ class ObjectSearch:
             if self.look and self._look_around(st):
                 return "found"
             self.look = False
+            c = self.ctx  # where the robot is, for the planner that reads it
+            c.x, c.y, c.heading, c.distance = st.x, st.y, st.heading, st.distance - self.start_distance
+            c.here = None if self.here is None else self.names[self.here]
             nxt = yield self.point()
             if nxt is None:
                 return "not_found"

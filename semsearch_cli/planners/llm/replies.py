@@ -7,7 +7,7 @@ legal choice is invalid, never mapped to a default.
   that a model that reasons first may; a reasoning model's ``<think>...</think>`` block is set
   aside; a number of more than 9 digits names no choice; a reply longer than 20,000 characters
   is not read;
-- an estimator's reply is one JSON object (bare, or in a ```json fence) mapping shown targets'
+- an estimator's reply is one JSON object (bare, or in a ```json fence) mapping shown choices'
   numbers to probabilities in [0, 1]; a target it leaves out counts as 0.
 """
 
@@ -16,6 +16,8 @@ from __future__ import annotations
 import json
 import math
 import re
+
+from ..text import spell
 
 MAX_REPLY = 20_000  # characters of a reply that are read (a longer one is invalid: "too long")
 MAX_DIGITS = 9  # a number longer than this names no choice (and int() of thousands of digits refuses)
@@ -81,8 +83,9 @@ def parse_number(reply, allowed: range) -> tuple[int | None, str]:
     return n, ""
 
 
-def parse_probabilities(reply, targets: int) -> tuple[dict[int, float] | None, str]:
-    """An estimator's reply -> ({target: probability}, "") or (None, why not)."""
+def parse_probabilities(reply, allowed) -> tuple[dict[int, float] | None, str]:
+    """An estimator's reply -> ({choice: probability}, "") or (None, why not); ``allowed``: the
+    choices' numbers that may be given a probability."""
     text, why = _text(reply)
     if text is None:
         return None, why
@@ -100,8 +103,8 @@ def parse_probabilities(reply, targets: int) -> tuple[dict[int, float] | None, s
             t = int(key)
         except (TypeError, ValueError):
             return None, f"{str(k)[:20]!r} is not a target's number"
-        if str(t) != str(key) or not 0 <= t < targets:
-            return None, f"{str(k)[:20]!r} is not one of the targets offered (0 to {targets - 1})"
+        if str(t) != str(key) or t not in allowed:
+            return None, f"{str(k)[:20]!r} is not one of the choices offered ({spell(sorted(allowed))})"
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not 0 <= v <= 1:
             return None, f"the probability of target {t} is {str(v)[:20]}, not a number from 0 to 1"
         out[t] = float(v)
