@@ -197,6 +197,7 @@ def planners_page() -> str:
            "the planner reports compare the others with, paired on the same episodes; the **swept** parameter is "
            "the one `semsearch sweep-alpha` varies; a report's replay shows the planner **replayed by default** "
            "(else the last in report order)."]
+    described: set = set()  # a planner of several kinds (llm) is described once, under its first
     for kind in dict.fromkeys(t.planner_kind for t in TASKS.values()):
         kinds = [k for k, t in TASKS.items() if t.planner_kind == kind]
         names = planner_order([n for n, c in builtin.items() if c.answers(kind)])
@@ -208,6 +209,9 @@ def planners_page() -> str:
             first = _own_doc(c).split("\n\n")[0]
             out.append(f"| [`{n}`](#{_anchor(n)}) | {role} | {_cell(first)} |")
         for n in names:
+            if n in described:
+                continue
+            described.add(n)
             c = builtin[n]
             out += ["", f"### {n}", "", f"`{c.__module__}.{c.__qualname__}`", "", _own_doc(c), ""]
             out += _param_rows(c.Params.model_fields)

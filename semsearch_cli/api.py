@@ -443,8 +443,9 @@ def _shown(path: str | Path) -> str:
 
 def planners(scenario: str | Path | None = None) -> list[dict]:
     """Every planner semsearch can run: built-in, from installed packages (entry points) and,
-    with ``scenario``, from the files it names; each with its kind of search, where it comes
-    from, its description and its parameters (name, type, default, description)."""
+    with ``scenario``, from the files it names; each with its kind of search (comma-separated
+    for one that answers several), where it comes from, its description and its parameters
+    (name, type, default, description)."""
     load_kinds()
     load_entry_points()
     own = {}
@@ -462,7 +463,7 @@ def planners(scenario: str | Path | None = None) -> list[dict]:
         params = [{"name": k, "type": getattr(f.annotation, "__name__", str(f.annotation)),
                    "default": None if f.is_required() else f.default, "description": f.description or ""}
                   for k, f in cls.Params.model_fields.items()]
-        out.append({"name": name, "kind": cls.task, "source": source, "description": " ".join(doc.split()), "params": params})
+        out.append({"name": name, "kind": ", ".join(cls.kinds) if cls.kinds else cls.task, "source": source, "description": " ".join(doc.split()), "params": params})
     return out
 
 

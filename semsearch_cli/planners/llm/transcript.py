@@ -5,9 +5,9 @@ offline (``{name: llm, replay: DIR}``).
 ``<run>__stage<k>.jsonl``), one JSON object a line, schema ``semsearch-transcript`` version 1:
 
 - the first line, ``{"type": "header", "format": "semsearch-transcript", "version": 1, "kind":
-  "doors", "run": {"scenario", "planner", "goal", "episode", "seed", "stage"}, "params": {...},
-  "prompt_sha256": "..."}``: the run, the planner's parameters (the key's variable's name, never
-  the key) and the prompt template's hash;
+  "doors", "run": {"scenario", "kind", "planner", "goal", "episode", "seed", "stage"}, "params":
+  {...}, "prompt_sha256": "..."}``: the kind of search (doors, objects, indirect), the run, the
+  planner's parameters (the key's variable's name, never the key) and the prompt template's hash;
 - one ``{"type": "call", "decision": k, "attempt": a, "observation": "...", "messages": [...],
   "reply": "..." or null, "error": "", "choice": ..., "valid": true, "reason": "", "tokens_in":
   n, "tokens_out": n, "latency_s": s, "model": "..."}`` per call to the model: decision ``k``
@@ -15,8 +15,8 @@ offline (``{name: llm, replay: DIR}``).
   observation, every message sent, the raw reply (null when there was none, ``error`` saying
   why), the parsed choice (a target's number; the estimator's probabilities by target), whether
   the planner could take it and, if not, why;
-- one ``{"type": "fallback", "decision": k, "choice": 0, "reason": "..."}`` per decision the
-  planner took its stated fallback for (the nearest target) after the re-asks ran out.
+- one ``{"type": "fallback", "decision": k, "choice": n, "reason": "..."}`` per decision the
+  planner took its kind's stated fallback ``n`` for after the re-asks ran out.
 """
 
 from __future__ import annotations
