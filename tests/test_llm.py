@@ -406,14 +406,19 @@ def test_the_model_as_a_gymnasium_policy_travels_greedys_runs(tmp_path):
         policy = PlannerPolicy("llm", base_url=srv.base_url, model="scripted")
         env = gym.make("semsearch/DoorSearch-v0", scenario=str(sc), **policy.env_kwargs)
         for _, row in rows.iterrows():
-            env.reset(options={"episode": int(row["episode"]), "repeat": int(row["seed"])})
-            policy.reset()
-            done = False
-            while not done:
-                _, _, term, trunc, info = env.step(policy(env))
-                done = term or trunc
-            assert (info["outcome"], info["distance_m"]) == (row["outcome"], pytest.approx(row["distance_m"], abs=1e-3))
+            play(policy, env, row)
     assert len(srv.requests) > 0 and policy.planner.calls > 0
+
+
+def play(policy, env, row) -> None:
+    """The policy on the row's episode and repeat travels what the row records."""
+    env.reset(options={"episode": int(row["episode"]), "repeat": int(row["seed"])})
+    policy.reset()
+    done = False
+    while not done:
+        _, _, term, trunc, info = env.step(policy(env))
+        done = term or trunc
+    assert (info["outcome"], info["distance_m"]) == (row["outcome"], pytest.approx(row["distance_m"], abs=1e-3))
 
 
 def test_a_gymnasium_policy_replays_the_batchs_transcripts_with_no_server(tmp_path):
@@ -428,11 +433,5 @@ def test_a_gymnasium_policy_replays_the_batchs_transcripts_with_no_server(tmp_pa
     policy = PlannerPolicy("llm", replay=str(tmp_path / "out"))
     env = gym.make("semsearch/DoorSearch-v0", scenario=str(sc), **policy.env_kwargs)
     for _, row in rows.iterrows():
-        env.reset(options={"episode": int(row["episode"]), "repeat": int(row["seed"])})
-        policy.reset()
-        done = False
-        while not done:
-            _, _, term, trunc, info = env.step(policy(env))
-            done = term or trunc
-        assert (info["outcome"], info["distance_m"]) == (row["outcome"], pytest.approx(row["distance_m"], abs=1e-3))
+        play(policy, env, row)
         assert policy.planner.costs() == {c: (int(row[c]) if c != "llm_s" else row[c]) for c in COSTS}
