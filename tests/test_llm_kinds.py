@@ -179,3 +179,17 @@ def test_a_dry_run_prints_an_object_searchs_first_prompt(tmp_path):
     assert res.exit_code == 0, res.output
     assert "--- system ---" in res.output and "searches an office" in res.output
     assert re.search(r"^\[0\] A: [0-9.]+ m, bearing -?\d+ deg, not viewed yet; log: \d+ detections", res.output, re.M)
+
+
+@pytest.mark.parametrize("suite", ["objects-v1", "indirect-v1"])
+def test_the_bench_runs_and_verifies_a_model_on_object_and_indirect_suites(tmp_path, suite):
+    def script(request, n):
+        text = request["messages"][1]["content"]
+        return Answer(str((toward_the_likeliest_cell if "lattice point" in text else nearest_unviewed_place)(text)))
+
+    with ChatServer(script) as srv:
+        api.bench_run(suite, [f"llm[base_url={srv.base_url},model=scripted]"], tmp_path / "b",
+                      options=BatchOptions(workers=1), limit=1)
+    runs = pd.concat([pd.read_csv(p) for p in sorted((tmp_path / "b").rglob("runs.csv"))])
+    assert len(runs) >= 1 and runs["suite"].eq(suite).all() and runs["llm_calls"].sum() == len(srv.requests) > 0
+    assert api.verify(tmp_path / "b").verdict.failed == []
