@@ -426,11 +426,12 @@ def test_a_gymnasium_policy_replays_the_batchs_transcripts_with_no_server(tmp_pa
     import semsearch_cli.envs  # noqa: F401  (registers the environments)
     from semsearch_cli.envs import PlannerPolicy
     with ChatServer(flaky) as srv:
-        sc = scenario(tmp_path, [llm(srv, reasks=1)], seeds=2, goals=[304])
+        sc = scenario(tmp_path, [llm(srv, reasks=1, replan_on_signs=True)], seeds=2, goals=[304])
         api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, transcripts=True), plots=False)
     rows = rows_of(tmp_path / "out", "llm")
     assert rows["invalid_replies"].sum() > 0
     policy = PlannerPolicy("llm", replay=str(tmp_path / "out"))
+    assert policy.env_kwargs == {"replan_on_signs": True}  # the transcripts' cadence, before any run starts
     env = gym.make("semsearch/DoorSearch-v0", scenario=str(sc), **policy.env_kwargs)
     for _, row in rows.iterrows():
         play(policy, env, row)

@@ -147,7 +147,9 @@ def test_the_model_reads_the_environments_text_and_travels_what_its_agent_travel
 
 
 def test_an_object_estimator_reads_probabilities_by_place(tmp_path):
-    def likely(request, n):  # all weight on the places the log saw the mug at within the hour
+    def likely(request, n):  # all weight on the places the log saw the mug at within the hour (first, some prose)
+        if n == 0:
+            return Answer("The mug is probably in the kitchen.")
         text = request["messages"][1]["content"]
         near = {k: int(w) for k, w in re.findall(r"^\[(\d+)\] .*detections, (\d+) within the hour$", text, re.M)}
         total = sum(near.values()) or 1
@@ -157,9 +159,12 @@ def test_an_object_estimator_reads_probabilities_by_place(tmp_path):
         sc = object_scenario(tmp_path, [llm(srv, mode="estimator")])
         api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, seeds=1), plots=False)
         assert "JSON object" in srv.requests[0]["messages"][1]["content"]
+        again = srv.requests[1]["messages"][-1]["content"]  # the re-ask asks for what the mode answers
+        assert again == ("Your reply could not be used: the reply is not one JSON object. Answer with one JSON object "
+                         "mapping place numbers (0-9) to probabilities from 0 to 1.")
     got = rows(tmp_path / "out")
-    assert len(got) >= 2 and got["invalid_replies"].sum() == 0 and got["fallbacks"].sum() == 0
-    assert (got["llm_calls"] == got["decisions"]).all()
+    assert len(got) >= 2 and got["invalid_replies"].sum() == 1 and got["fallbacks"].sum() == 0
+    assert got["llm_calls"].sum() == got["decisions"].sum() + 1
 
 
 def test_an_indirect_estimator_and_a_prompt_of_another_kind_are_refused_naming_the_field(tmp_path):

@@ -159,7 +159,7 @@ class IndirectSearchEnv(SearchEnv):
 
     def _observe(self):
         st = self.state
-        t_s = st.steps / self.task.spec.camera.fps
+        t_s = st.steps * self.search.dt  # as the search's planners read it
         if self.observation_mode == "text":
             return self._text(t_s)
         return {"belief": self._belief(), "secondary": self._secondary(),

@@ -606,7 +606,8 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
             raise ScenarioError(file, f"planners[{i}].name", f"unknown planner {name!r}{did_you_mean(name, valid)}; valid: "
                                 f"{', '.join(valid)} (semsearch planners lists them with their parameters)")
         if task is not None and not PLANNERS[name].answers(task):
-            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} answers {PLANNERS[name].task} scenarios, not {task} "
+            raise ScenarioError(file, f"planners[{i}].name", f"{name!r} answers "
+                                f"{', '.join(PLANNERS[name].kinds or (PLANNERS[name].task,))} scenarios, not {task} "
                                 f"ones; valid: {', '.join(valid)}")
         keys = sorted(params)
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]

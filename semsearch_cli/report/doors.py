@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..planners.base import planner_named
 from ..runner import run_rows
 from . import stats as S
 from . import tables as T
@@ -149,11 +150,12 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
     --frames`` recorded, else re-simulated (see :func:`replay_frames`): ``choice``
     (planner, goal, episode, seed: the ``--replay`` value, checked against the rows before the
     report starts), or by default the median run (:func:`median_label`: the lower middle one for
-    an even number of runs) of the most semantic variant for the first goal."""
+    an even number of runs) of the most semantic variant for the first goal (not a language
+    model's: re-simulating it would call the model)."""
     w = loaded.world
     ep = S.episodes(runs)
     if choice is True:
-        label = order[-1]
+        label = next((lab for lab in reversed(order) if (c := planner_named(lab)) is None or not c.service), order[-1])
         goal = sorted(runs["goal"].unique(), key=goal_key)[0]
         sub = runs[(runs["planner"] == label) & (runs["goal"] == goal)]
         if sub.empty:

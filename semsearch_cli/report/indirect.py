@@ -247,7 +247,8 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
     """One search as a GIF of the probability map at its re-plans, from the frames ``semsearch run
     --frames`` recorded, else re-simulated (see :func:`replay_frames`):
     ``choice`` (the ``--replay`` run: planner, view scale, episode, seed), or by default the first
-    search of ISCG-PN-SM (the paper's best; else the last method) at the smallest view scale."""
+    search of ISCG-PN-SM (the paper's best; else the last method, not a language model's) at the
+    smallest view scale."""
     loaded = part.loaded(notes, "The replay")
     if loaded is None or runs.empty:
         return
@@ -255,6 +256,7 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
     scales = runs["goal"].astype(float)
     if choice is True:
         order = T.planner_order(runs["planner"])
+        order = [lab for lab in order if (c := planner_named(lab)) is None or not c.service] or order  # never a model, by default
         label = next((lab for lab in order if (c := planner_named(lab)) is not None and c.replay), order[-1])
         sub = runs[(runs["planner"] == label) & (scales == scales.min())]
     else:

@@ -112,13 +112,18 @@ def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rer
     ``frames/<run>.npz`` when ``semsearch run --frames`` recorded them, else by ``rerun(observer)``
     (re-simulating the run, which is deterministic, with a :class:`FrameRecorder` watching).
     Returns (frames, "recorded" or "re-simulated"); a run whose planner raised (``failed``: its row's
-    outcome is ``error``) is re-simulated up to the error, which ``how`` names."""
+    outcome is ``error``) is re-simulated up to the error, which ``how`` names. A run of a planner
+    that answers through a service (a language model: ``Planner.service``) is never re-simulated,
+    which would call the model: without recorded frames, no frames."""
     for stem in stems(planner, goal, seed, episode):
         f = Path(folder) / "frames" / f"{stem}.npz"
         if f.is_file():
             frames, how = read_frames(f), "recorded"
             break
     else:
+        cls = planner_named(planner)
+        if cls is not None and cls.service:
+            return [], "not re-simulated (it would call the planner's service; semsearch run --frames records the frames)"
         recorder = FrameRecorder()
         how = "re-simulated"
         try:

@@ -228,7 +228,7 @@ class Task:
     subclasses :class:`OnMapTask`, which does the world and the episodes."""
 
     kind: ClassVar[str] = ""
-    planner_kind: ClassVar[str] = ""  # the ``task`` of the registered planners that answer it
+    planner_kind: ClassVar[str] = ""  # the kind the registered planners that answer it answer (Planner.answers)
     noun: ClassVar[str] = ""  # what the kind searches for, in a sentence ("door signs")
     records: ClassVar[tuple[str, ...]] = ()  # the row columns this kind fills with a value on every row
     columns: ClassVar[tuple[str, ...]] = ()  # the kind's own row columns, beyond every kind's (metrics.SHARED)

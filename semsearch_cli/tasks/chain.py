@@ -97,6 +97,10 @@ class ChainTask(OnMapTask):
                 task._check_object_stages(ch, stages, field)
                 # a chain names its object planner alone, with its defaults: one that needs parameters to run (llm) cannot
                 answers = sorted(n for n, c in PLANNERS.items() if c.answers(ObjectTask.planner_kind) and not c.service)
+                if ch.object_planner in PLANNERS and PLANNERS[ch.object_planner].service:
+                    raise ScenarioError(task.file, f"{field}.object_planner", f"{ch.object_planner!r} needs parameters to "
+                                        f"run (a model to call), and a chain runs its object planner with its defaults; "
+                                        f"valid: {', '.join(answers)}")
                 if ch.object_planner not in answers:
                     raise ScenarioError(task.file, f"{field}.object_planner", f"unknown object-search planner "
                                         f"{ch.object_planner!r}; valid: {', '.join(answers)}")

@@ -112,7 +112,7 @@ class Seat:
     The seat keeps the planners it built for the run (``seated``), so that the run can read what
     they report of themselves: a cost (a language model's calls and tokens, :meth:`costs`), a
     transcript (:meth:`transcripts`), why a planner's own budget ended the run (:meth:`notes`).
-    ``run``: the run's identity (scenario, planner label, goal, episode, seed), which a planner
+    ``run``: the run's identity (scenario, kind, planner label, goal, episode, seed), which a planner
     that wants it (``start_run(identity)``, e.g. to find its transcript) is given when built,
     with ``stage`` its place among the run's planners (0, 1, ... in a chain)."""
 

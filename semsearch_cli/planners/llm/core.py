@@ -34,7 +34,7 @@ from ...errors import BudgetSpent, PlannerError, ScenarioError
 from ..base import COST_COLUMNS, Planner
 from .client import Chat, Reply, prompt_path, require_openai
 from .replies import parse_number, parse_probabilities
-from .transcript import folder_text, header, index, read, run_key
+from .transcript import folder_text, header, index, read, replan_on_signs, run_key
 
 FIELDS = {  # kind -> the fields a prompt template may use ($name), each documented in docs/llm.md
     "doors": {
@@ -151,6 +151,10 @@ class LlmCore(Planner):
             if fault:
                 raise PlannerError(f"llm: {fault[0]}: {fault[1]}")
             require_openai("<llm planner>")
+        else:  # the re-plan cadence the transcripts were made with, known before a run starts (a policy's env_kwargs)
+            made = replan_on_signs(Path(params.replay), params.replay_planner)
+            if len(made) == 1:
+                self.replan_on_signs = made.pop()
 
     @classmethod
     def fault(cls, params: LlmParams, kind: str | None = None) -> tuple[str, str] | None:

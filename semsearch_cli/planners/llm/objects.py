@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from ..objects import ObjectPlanner
-from ..text import object_fields, place_history
+from ..text import object_fields, place_history, spell
 from .core import LlmCore
 
 
@@ -44,6 +44,11 @@ class ObjectLlm(LlmCore, ObjectPlanner):
                 return
             fields = object_fields(ctx.cls, ctx.hour, (ctx.x, ctx.y, ctx.heading), ctx.distance, names, ctx.places,
                                    ctx.seen_places, history, here, mask)
+            if self._live.mode == "estimator":  # the answer is probabilities, not a number (the re-ask repeats it)
+                json_line = (f"Answer with one JSON object mapping place numbers ({spell(range(len(names)))}) to "
+                             "probabilities from 0 to 1.")
+                fields["observation"] = fields["observation"].removesuffix(fields["answer"]) + json_line
+                fields["answer"] = json_line
             dist = np.array([math.hypot(x - ctx.x, y - ctx.y) for x, y in (ctx.places[n] for n in names)])
             nearest = int(allowed[np.argmin(dist[allowed])])
             pick, info = self.ask(fields, allowed, dist, nearest)

@@ -65,8 +65,9 @@ def _fenced(text: str) -> str:
     return body[4:] if body[:4].lower() == "json" else body
 
 
-def parse_number(reply, allowed: range) -> tuple[int | None, str]:
-    """An actor's reply -> (the number it names, "") or (None, why not)."""
+def parse_number(reply, allowed) -> tuple[int | None, str]:
+    """An actor's reply -> (the number it names, "") or (None, why not); ``allowed``: the numbers
+    it may name (a range, a set)."""
     text, why = _text(reply)
     if text is None:
         return None, why

@@ -79,11 +79,21 @@ def index(folder: Path) -> dict[tuple, list[tuple[str, Path]]]:
     paths = files(Path(folder))
     key = (str(Path(folder).resolve()), len(paths), max((p.stat().st_mtime_ns for p in paths), default=0))
     if _INDEX.get("key") != key:  # read again when a transcript was added or rewritten
-        _INDEX["key"], _INDEX["index"] = key, _index(paths)
+        _INDEX["key"], _INDEX["params"] = key, {}
+        _INDEX["index"] = _index(paths, _INDEX["params"])
     return _INDEX["index"]
 
 
-def _index(paths: list[Path]) -> dict[tuple, list[tuple[str, Path]]]:
+def replan_on_signs(folder: Path, planner: str | None = None) -> set:
+    """The values of ``replan_on_signs`` the transcripts under ``folder`` were made with (of
+    ``planner``'s only, when given): what a replay's environment must re-plan by before its
+    first run starts (a :class:`~semsearch_cli.envs.PlannerPolicy`'s ``env_kwargs``)."""
+    runs = index(folder)
+    paths = {p for found in runs.values() for lab, p in found if planner is None or lab == planner}
+    return {bool(v.get("replan_on_signs", False)) for p, v in _INDEX["params"].items() if p in paths}
+
+
+def _index(paths: list[Path], params: dict) -> dict[tuple, list[tuple[str, Path]]]:
     out: dict[tuple, list[tuple[str, Path]]] = {}
     for path in paths:
         with open(path, encoding="utf-8") as fh:
@@ -94,6 +104,7 @@ def _index(paths: list[Path]) -> dict[tuple, list[tuple[str, Path]]]:
             continue
         if isinstance(head, dict) and head.get("format") == FORMAT and isinstance(head.get("run"), dict):
             out.setdefault(run_key(head["run"]), []).append((str(head["run"].get("planner", "")), path))
+            params[path] = head["params"] if isinstance(head.get("params"), dict) else {}
     return out
 
 
