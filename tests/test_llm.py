@@ -436,3 +436,16 @@ def test_a_gymnasium_policy_replays_the_batchs_transcripts_with_no_server(tmp_pa
     for _, row in rows.iterrows():
         play(policy, env, row)
         assert policy.planner.costs() == {c: (int(row[c]) if c != "llm_s" else row[c]) for c in COSTS}
+
+
+def test_a_report_never_calls_the_model(tmp_path):
+    with ChatServer(first_target) as srv:
+        sc = scenario(tmp_path, [{"name": "greedy"}, llm(srv)], seeds=1, goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+        made = len(srv.requests)
+        api.report([tmp_path / "out"], tmp_path / "report")  # no frames recorded: the default replay is greedy's
+        api.report([tmp_path / "out"], tmp_path / "again", replay="llm[base_url=" + srv.base_url + ",model=scripted],304,0,0")
+        assert len(srv.requests) == made
+    gifs = sorted(p.name for p in (tmp_path / "report").rglob("replay_*.gif"))
+    assert gifs and all("greedy" in g for g in gifs)
+    assert not list((tmp_path / "again").rglob("replay_*.gif"))

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import os
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -95,6 +96,15 @@ def _save(fig, out: Path, formats=("png",), dpi: int = PNG_DPI) -> list[Path]:
         written.append(f)
     plt.close(fig)
     return written
+
+
+def wrap_label(lab: str, width: int) -> str:
+    """A planner label over lines of at most ``width`` characters, broken after its parameters'
+    commas (a language model's label holds its endpoint and model), never inside a value."""
+    lab = str(lab)
+    if len(lab) <= width:
+        return lab
+    return "\n".join(textwrap.wrap(lab.replace(",", ", "), width, break_on_hyphens=False)).replace(", ", ",")
 
 
 def _grid(n: int, panel_h: float, cols: int = 2, maps: bool = False, **kw):

@@ -4,7 +4,6 @@ parameter sweeps (:func:`plot_alpha_sweep`, :func:`plot_sweep`)."""
 
 from __future__ import annotations
 
-import textwrap
 
 import inspect
 from pathlib import Path
@@ -16,7 +15,7 @@ from .. import stats
 from ...planners.base import baseline_of, planner_named, swept_value
 from ..tables import goal_key, planner_order
 from . import common as _common  # by another name: plot_boxes has a local named common
-from .common import (COLUMN_IN, _grid, _legend, _n_by_planner, _no_finite, _outer_y, _paper, episode_mean,
+from .common import (COLUMN_IN, wrap_label, _grid, _legend, _n_by_planner, _no_finite, _outer_y, _paper, episode_mean,
                      planner_colors)
 
 import matplotlib.pyplot as plt  # after .common, which chooses the Agg backend
@@ -149,8 +148,8 @@ def plot_budget(curve: pd.DataFrame, order: list, out: Path, formats=("png",), c
             if r == 0:
                 n = int(e["n"].iloc[0]) if len(e) else 0
                 # a long label (a language model's endpoint and model) broken at its parameters, to the panel's width
-                head = "\n".join(textwrap.wrap(lab.replace(",", ", "), 22, break_on_hyphens=False)).replace(", ", ",")
-                ax.set_title(f"{head}\n(n={n})" if len(lab) > 12 else f"{lab} (n={n})", fontsize=8, color=colors[lab])
+                ax.set_title(f"{wrap_label(lab, 22)}\n(n={n})" if len(lab) > 12 else f"{lab} (n={n})", fontsize=8,
+                             color=colors[lab])
             if j == 0:
                 ax.set_ylabel(f"goal {g}\nsuccess rate")
     for ax in axes[-1]:
@@ -172,7 +171,8 @@ def plot_boxes(runs, scenario: str, order: list, out: Path, formats=("png",), co
     goals = sorted(sub["goal"].unique(), key=goal_key)
     labels = [lab for lab in order if (sub["planner"] == lab).any()]
     common = _n_by_planner(sub)
-    fig, axes = _grid(len(goals), 0.32 * len(labels) + 0.75, sharey=True)
+    ticks = [wrap_label(lab, 30) + (f" (n={common[lab]})" if common else "") for lab in labels]  # a long label on lines
+    fig, axes = _grid(len(goals), sum(0.32 + 0.14 * t.count("\n") for t in ticks) + 0.75, sharey=True)
     y = np.arange(len(labels), dtype=float)
     for ax, g in zip(axes, goals):
         d = sub[sub["goal"] == g]
@@ -201,7 +201,7 @@ def plot_boxes(runs, scenario: str, order: list, out: Path, formats=("png",), co
         ax.set_title(f"goal {g}")
         ax.set_xlabel("distance travelled (m)")
         ax.set_xlim(left=0)
-    axes[0].set_yticks(y, [f"{lab} (n={common[lab]})" if common else lab for lab in labels])
+    axes[0].set_yticks(y, ticks)
     axes[0].set_ylim(len(labels) - 0.45, -0.55)
     for ax in axes:
         _outer_y(ax)
