@@ -114,3 +114,11 @@ def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "--version"],
                          capture_output=True, text=True, cwd=elsewhere, env=env)
     assert res.stdout.startswith(f"semsearch {__version__} (code ") and f"commit {head}" in res.stdout, res.stdout
+
+
+def test_the_package_data_holds_no_half_written_folder():
+    """A suite split is written as <split>.<pid>.tmp and renamed; one left behind is not data."""
+    data = ROOT / "semsearch_cli" / "data"
+    tracked = subprocess.run(["git", "ls-files", str(data)], cwd=ROOT, capture_output=True, text=True)
+    paths = tracked.stdout.splitlines() if tracked.returncode == 0 else [str(p) for p in data.rglob("*")]
+    assert not [p for p in paths if ".tmp/" in p or p.endswith(".tmp")]
