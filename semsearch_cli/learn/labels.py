@@ -1,0 +1,114 @@
+"""Labels from the known map, and the features the robot has, for every frontier target of every
+door decision: the data a learned planner is trained on.
+
+The label of target ``c`` at a decision is the true remaining travel through it, the oracle the
+robot does not have: ``oracle_m(c) = d(c) + G(c)``, with ``d(c)`` the metres the robot would drive
+to ``c`` on the map it has built (the skeleton path every door planner is given,
+:meth:`~semsearch_cli.belief.DoorBelief.search`) and ``G(c)`` the ground-truth geodesic metres
+from ``c`` to the nearest pose that reads the goal's sign
+(:meth:`~semsearch_cli.tasks.base.Task.goal_field`, with the robot's clearance). The target of
+least ``oracle_m`` is what a clairvoyant planner that still has to drive to a frontier target
+would choose (``best``). An unreachable target has no label (inf).
+
+The features are what the robot has at that decision (:data:`FEATURES`): the target's path
+length and its rank among the targets, how many targets there are, the metres travelled and the
+signs counted so far, and nsos's terms for the target (Eqs. 4.9-4.14 and paper Eq. 16: growing
+direction, parity, door and robot orientation, closeness; :mod:`~semsearch_cli.planners.doors.nsos`).
+
+:class:`LabelSeat` is the batch's seat that writes one row per target before the run's planner
+answers (the behaviour policy: the run is exactly the run that planner makes alone; a test checks
+it); :func:`collect` runs a scenario's episodes and repeats with it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..planners import Variant
+from ..planners.doors.nsos import NSOS, NSOSParams
+from ..runner import Loaded
+from ..tasks.decisions import Seat
+
+TERMS = ("phi_g", "zeta", "gamma", "phi_p", "phi_o", "phi_r", "phi_c", "SF", "GF", "phi")
+FEATURES = ("d_m", "d_rank", "n_targets", "travelled_m", "signs", *TERMS)
+ID = ("scenario", "goal", "episode", "seed", "decision", "target", "row", "col")
+
+
+def oracle_costs(field: np.ndarray, d_m: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """``d(c) + G(c)`` (m) per target: ``d_m`` the path to each target on the robot's map (inf when
+    unreachable), ``field`` the ground-truth distance field to the goal (m, inf where the goal
+    cannot be reached), ``rows``, ``cols`` the targets' cells."""
+    g = np.asarray(field, float)[np.asarray(rows, np.int64), np.asarray(cols, np.int64)]
+    return np.asarray(d_m, float) + g
+
+
+class LabelSeat(Seat):
+    """The batch's seat that, at each door decision, writes the features and labels of every
+    frontier target (:attr:`rows`), then lets the run's planner answer. The nsos terms come from
+    an nsos planner of its own (``nsos``: its parameters) run on a copy of the decision whose
+    random generator is not the run's, before the run's planner: the run is the planner's own."""
+
+    def __init__(self, task, nsos: NSOSParams = NSOSParams()):
+        super().__init__()
+        self.task, self.nsos_params = task, nsos
+        self.rows: list[dict] = []
+        self._nsos: NSOS | None = None
+        self._k = 0
+
+    def planner(self, variant):
+        self._nsos, self._k = NSOS(self.nsos_params), 0  # one per run, as the batch builds each planner
+        return super().planner(variant)
+
+    def decide(self, point):
+        if point.kind == "doors" and len(point.choices):
+            self._label(point.observation, point.choices)
+        return point.ask()
+
+    def _label(self, ctx, cands) -> None:
+        own = dataclasses.replace(ctx, rng=np.random.default_rng(0), explain=True)
+        dec = self._nsos._decide(own, cands)
+        terms = dec.info["candidates"] if dec is not None else [{} for _ in range(len(cands))]
+        b = ctx.belief
+        d = np.array([t.get("D_m") if t.get("D_m") is not None else math.inf for t in terms], float)
+        if dec is None:  # nothing reachable: the distances alone
+            gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, 0)
+            d = gs.lengths(cands.rows, cands.cols) * b.frame.res
+        label = oracle_costs(self.task.goal_field(ctx.goal), d, cands.rows, cands.cols)
+        finite = np.isfinite(label)
+        best = label == label[finite].min() if finite.any() else np.zeros(len(cands), bool)
+        rank = np.argsort(np.argsort(d, kind="stable"), kind="stable")
+        signs = sum(1 for n in b.reads.total.values() if n >= b.spec.min_reads)
+        run = self.run
+        for i in range(len(cands)):
+            row = {"scenario": run.get("scenario"), "goal": run.get("goal"), "episode": run.get("episode"),
+                   "seed": run.get("seed"), "decision": self._k, "target": i, "row": int(cands.rows[i]),
+                   "col": int(cands.cols[i]), "d_m": float(d[i]), "d_rank": int(rank[i]),
+                   "n_targets": len(cands), "travelled_m": float(ctx.distance), "signs": signs}
+            row.update({t: terms[i].get(t, math.nan) if terms[i].get(t) is not None else math.nan for t in TERMS})
+            row.update({"oracle_m": float(label[i]), "best": bool(best[i])})
+            self.rows.append(row)
+        self._k += 1
+
+
+def collect(scenario: str | Path, planner: str = "greedy", seeds: int = 1, goals=None) -> pd.DataFrame:
+    """The labelled targets of every decision of ``planner`` (the behaviour policy, with its
+    defaults) over a door scenario's episodes (of ``goals``, when given) and ``seeds`` repeats:
+    one row per target (:data:`ID`: the run, the decision, the target's number and cell;
+    :data:`FEATURES`; ``oracle_m``; ``best``; and the run's ``outcome``)."""
+    loaded = Loaded.load(Path(scenario))
+    task = loaded.task
+    keep = None if goals is None else {str(g) for g in goals}
+    out = []
+    for ep in task.episodes:
+        if keep is not None and str(ep.goal) not in keep:
+            continue
+        for seed in range(seeds):
+            seat = LabelSeat(task)
+            res = task.run(Variant(planner, ()), ep, seed, seat=seat)
+            out += [{**r, "outcome": res.outcome} for r in seat.rows]
+    return pd.DataFrame(out, columns=[*ID, *FEATURES, "oracle_m", "best", "outcome"])
