@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..planners import Variant
+from ..planners import DoorPlanner, Variant
 from ..planners.doors.nsos import NSOS, NSOSParams
 from ..runner import Loaded
 from ..tasks.decisions import Seat
@@ -65,7 +65,7 @@ class LabelSeat(Seat):
         return super().planner(variant)
 
     def decide(self, point):
-        if point.kind == "doors" and len(point.choices):
+        if point.kind == DoorPlanner.task and len(point.choices):  # a door decision (the kind door planners answer)
             self._label(point.observation, point.choices)
         return point.ask()
 
