@@ -10,10 +10,12 @@ from ``c`` to the nearest pose that reads the goal's sign
 least ``oracle_m`` is what a clairvoyant planner that still has to drive to a frontier target
 would choose (``best``). An unreachable target has no label (inf).
 
-The features are what the robot has at that decision (:data:`FEATURES`): the target's path
-length and its rank among the targets, how many targets there are, the metres travelled and the
-signs counted so far, and nsos's terms for the target (Eqs. 4.9-4.14 and paper Eq. 16: growing
-direction, parity, door and robot orientation, closeness; :mod:`~semsearch_cli.planners.doors.nsos`).
+The features are what the robot has at that decision, exactly as the ``learned`` planner computes
+them (:func:`~semsearch_cli.planners.doors.learned.decision_features`): the target's path length
+and its rank among the targets, how many targets there are, the metres travelled and the signs
+counted so far, nsos's terms for the target (Eqs. 4.9-4.14 and paper Eq. 16: growing direction,
+parity, door and robot orientation, closeness; :mod:`~semsearch_cli.planners.doors.nsos`), and the
+path and nsos's phi, SF and phi_g against the decision's best.
 
 :class:`LabelSeat` is the batch's seat that writes one row per target before the run's planner
 answers (the behaviour policy: the run is exactly the run that planner makes alone; a test checks
@@ -22,20 +24,17 @@ it); :func:`collect` runs a scenario's episodes and repeats with it.
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..planners import DoorPlanner, Variant
+from ..planners.doors.learned import FEATURES, decision_features
 from ..planners.doors.nsos import NSOS, NSOSParams
 from ..runner import Loaded
 from ..tasks.decisions import Seat
 
-TERMS = ("phi_g", "zeta", "gamma", "phi_p", "phi_o", "phi_r", "phi_c", "SF", "GF", "phi")
-FEATURES = ("d_m", "d_rank", "n_targets", "travelled_m", "signs", *TERMS)
 ID = ("scenario", "goal", "episode", "seed", "decision", "target", "row", "col")
 
 
@@ -70,26 +69,17 @@ class LabelSeat(Seat):
         return point.ask()
 
     def _label(self, ctx, cands) -> None:
-        own = dataclasses.replace(ctx, rng=np.random.default_rng(0), explain=True)
-        dec = self._nsos._decide(own, cands)
-        terms = dec.info["candidates"] if dec is not None else [{} for _ in range(len(cands))]
-        b = ctx.belief
-        d = np.array([t.get("D_m") if t.get("D_m") is not None else math.inf for t in terms], float)
-        if dec is None:  # nothing reachable: the distances alone
-            gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, 0)
-            d = gs.lengths(cands.rows, cands.cols) * b.frame.res
+        X, d = decision_features(ctx, cands, self._nsos)  # what the learned planner sees, exactly
         label = oracle_costs(self.task.goal_field(ctx.goal), d, cands.rows, cands.cols)
         finite = np.isfinite(label)
         best = label == label[finite].min() if finite.any() else np.zeros(len(cands), bool)
-        rank = np.argsort(np.argsort(d, kind="stable"), kind="stable")
-        signs = sum(1 for n in b.reads.total.values() if n >= b.spec.min_reads)
         run = self.run
         for i in range(len(cands)):
             row = {"scenario": run.get("scenario"), "goal": run.get("goal"), "episode": run.get("episode"),
                    "seed": run.get("seed"), "decision": self._k, "target": i, "row": int(cands.rows[i]),
-                   "col": int(cands.cols[i]), "d_m": float(d[i]), "d_rank": int(rank[i]),
-                   "n_targets": len(cands), "travelled_m": float(ctx.distance), "signs": signs}
-            row.update({t: terms[i].get(t, math.nan) if terms[i].get(t) is not None else math.nan for t in TERMS})
+                   "col": int(cands.cols[i])}
+            row.update(zip(FEATURES, X[i].tolist()))
+            row["d_m"] = float(d[i])  # inf when unreachable (the feature is NaN)
             row.update({"oracle_m": float(label[i]), "best": bool(best[i])})
             self.rows.append(row)
         self._k += 1
