@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import functools
 import os
-import textwrap
+import re
 from pathlib import Path
 
 import numpy as np
@@ -99,12 +99,18 @@ def _save(fig, out: Path, formats=("png",), dpi: int = PNG_DPI) -> list[Path]:
 
 
 def wrap_label(lab: str, width: int) -> str:
-    """A planner label over lines of at most ``width`` characters, broken after its parameters'
-    commas (a language model's label holds its endpoint and model), never inside a value."""
+    """A planner label over lines of about ``width`` characters (a language model's label holds
+    its endpoint and model), broken only after a ``,`` or a ``/``: a piece between two such
+    marks longer than ``width`` keeps its own line whole."""
     lab = str(lab)
     if len(lab) <= width:
         return lab
-    return "\n".join(textwrap.wrap(lab.replace(",", ", "), width, break_on_hyphens=False)).replace(", ", ",")
+    lines = [""]
+    for piece in re.findall(r"[^,/]*[,/]|[^,/]+$", lab):
+        if lines[-1] and len(lines[-1]) + len(piece) > width:
+            lines.append("")
+        lines[-1] += piece
+    return "\n".join(lines)
 
 
 def _grid(n: int, panel_h: float, cols: int = 2, maps: bool = False, **kw):

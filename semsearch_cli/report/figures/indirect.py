@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from . import common
-from .common import COLUMN_IN, GOAL_COLOR, PALETTE, _animate, _legend, _paper, planner_colors
+from .common import COLUMN_IN, GOAL_COLOR, PALETTE, _animate, _legend, _paper, planner_colors, wrap_label
 
 import matplotlib.pyplot as plt  # after .common, which chooses the Agg backend
 from matplotlib.lines import Line2D
@@ -37,7 +37,7 @@ def plot_success_by_scale(table, order: list, paper: dict, paper_scales, out: Pa
         ax.fill_between(d["view_scale"], 100 * lo, 100 * hi, color=c, alpha=0.2, lw=0, zorder=1)
         ax.plot(d["view_scale"], 100 * d["success"], "o-", c=c, ms=3, lw=1.2, zorder=3)
         n = sorted(set(d["n"].astype(int)))
-        ax.set_title(f"{m} (n={'/'.join(map(str, n))})", fontsize=8, color=c if c != "#000000" else "black")
+        ax.set_title(f"{wrap_label(m, 30)} (n={'/'.join(map(str, n))})", fontsize=8, color=c if c != "#000000" else "black")
         ax.set_ylim(-3, 104)  # room for the markers at 0 and 100%, which the frame would cut in half
         ax.set_yticks([0, 25, 50, 75, 100])
         ax.grid(alpha=0.3, lw=0.5)

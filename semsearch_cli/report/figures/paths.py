@@ -11,7 +11,7 @@ import numpy as np
 from . import common
 from .common import (COLUMN_IN, EVERY_RUN_LW, GOAL_COLOR, PALETTE, _axes_m_per_pt, _draw_map, _grid, _label_outer, _legend,
                      _map_axes, _number_signs, _paper, _places, _sign_labels, _starts, _stops, every_run_alpha,
-                     planner_colors)
+                     planner_colors, wrap_label)
 
 import matplotlib.pyplot as plt  # after .common, which chooses the Agg backend
 from matplotlib.lines import Line2D
@@ -69,7 +69,7 @@ def plot_path_panels(world, panels: dict, stops, title: str, out: Path, formats=
             _places(ax, places, truth)
         _starts(ax, starts)
         if lab:
-            ax.set_title(f"{lab}: {note}" if note else lab, color="black")
+            ax.set_title(f"{wrap_label(lab, 40)}: {note}" if note else wrap_label(lab, 40), color="black")
         _map_axes(ax)
     _label_outer(axes)
     handles = [Line2D([], [], c="0.35", lw=EVERY_RUN_LW, alpha=every_run_alpha(10), label="every run"),
