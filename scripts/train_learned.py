@@ -26,23 +26,18 @@ import numpy as np
 import pandas as pd
 from sklearn.ensemble import HistGradientBoostingClassifier, HistGradientBoostingRegressor
 
-from semsearch_cli.planners.doors.learned import FEATURES, MODELS, RELATIVE, Trees
+from semsearch_cli.planners.doors.learned import FEATURES, MODELS, Trees
 
 DECISION = ["scenario", "goal", "episode", "seed", "decision"]
 
 
 def prepare(df: pd.DataFrame) -> pd.DataFrame:
-    """The labelled rows with every feature (the relative ones derived per decision, as
-    :func:`~semsearch_cli.planners.doors.learned.add_relative` does) and the target."""
+    """The labelled rows of reachable targets in decisions with a choice, and the target."""
     df = df.replace([np.inf, -np.inf], np.nan)
     df = df[df["oracle_m"].notna() & df["d_m"].notna()].copy()
     g = df.groupby(DECISION, sort=False)
     df = df[g["target"].transform("size") >= 2].copy()
     g = df.groupby(DECISION, sort=False)
-    if not set(RELATIVE) <= set(df.columns):  # rows recorded before they were: derived alike
-        df["d_over_min"] = df["d_m"] - g["d_m"].transform("min")
-        for rel, base in (("phi_below_max", "phi"), ("SF_below_max", "SF"), ("phi_g_below_max", "phi_g")):
-            df[rel] = g[base].transform("max") - df[base]
     df["regret"] = df["oracle_m"] - g["oracle_m"].transform("min")
     df["y"] = np.log1p(df["regret"])
     return df

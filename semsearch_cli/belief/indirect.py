@@ -238,3 +238,10 @@ class IndirectBelief:
         """(p(a_ij), p(a_0)) after folding in everything observed so far."""
         self.flush()
         return self.p, self.p0
+
+    def inside(self) -> np.ndarray:
+        """(H, W) float32: p(a_ij) given that the target is in the room (the map scaled to sum to
+        1), after folding in everything observed so far: what the environment and the llm
+        planner show."""
+        self.flush()
+        return (self.p / max(float(self.p.sum()), 1e-300)).astype(np.float32)

@@ -74,10 +74,8 @@ class IndirectSearchEnv(SearchEnv):
         self.masks, self.negative = masks, negative and masks is not None
         self.lattice = lattice
         self.secondary = list(t.spec.secondary)
-        w, h = t.grids[0].room.size
-        self.lx = np.arange(lattice / 2, w, lattice)
-        self.ly = np.arange(lattice / 2, h, lattice)
-        self.N = len(self.lx) * len(self.ly)
+        g = t.grids[0]  # the action space: the first room's lattice of points
+        self.N = Lattice.over(g.frame, g.stand, g.room.size, lattice).n
         H, W = t.grids[0].stand.shape
         spaces = {"belief": gym.spaces.Box(0.0, 1.0, (H, W), np.float32),
                   "secondary": box([0, -BIG, -BIG], [1, BIG, BIG], (len(self.secondary), 3)),
@@ -144,9 +142,7 @@ class IndirectSearchEnv(SearchEnv):
         return {**super()._info(), "room": self.grid.room.name}
 
     def _belief(self) -> np.ndarray:
-        b = self.state.belief
-        b.flush()
-        return (b.p / max(float(b.p.sum()), 1e-300)).astype(np.float32)
+        return self.state.belief.inside()
 
     def _secondary(self) -> np.ndarray:
         st = self.state

@@ -37,8 +37,7 @@ class IndirectLlm(LlmCore, IndirectPlanner):
     def plan(self, ctx):
         self.begin("indirect")
         lat = Lattice.over(ctx.frame, ctx.stand, ctx.room_size, self._live.lattice)
-        b = ctx.belief
-        p = (b.p / max(float(b.p.sum()), 1e-300)).astype(np.float32)  # as the environment shows it
+        p = ctx.belief.inside()  # as the environment shows it
         mask = lat.mask()
         fields = indirect_fields(ctx.target, ctx.room, ctx.view_scale, ctx.t, ctx.time_limit, (ctx.x, ctx.y, ctx.heading),
                                  ctx.seen, p, ctx.frame, lattice_choices(len(lat.xs), len(lat.ys), lat.step, ctx.horizon),
