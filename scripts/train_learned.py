@@ -1,17 +1,23 @@
-"""Fit a learned door planner's model from labelled decisions (scripts/make_labels.py) and write
-it as arrays (semsearch_cli/data/models/<name>.json, the package data a learned planner will read;
-none is registered yet, docs/learning.md). Run from the checkout, with the ``train`` extra
-installed (``pip install -e '.[train]'``):
+"""Train the learned door planner (``learned``, docs/learning.md) from nothing, in one command, and
+write its model as arrays into the package (semsearch_cli/data/models/<name>.json). Run from the
+checkout, with the ``train`` extra installed (``pip install -e '.[train]'``):
 
-    python scripts/train_learned.py --labels results/labels/labels.csv [--name learned-doors-v1] [--objective regret|best]
+    python scripts/train_learned.py --out results/labels --floors 120 --dagger 60     # the shipped model
+    python scripts/train_learned.py --labels results/labels/greedy/labels.csv ...    # fit labels already made
+
+With ``--out``: label ``--floors`` training floors under greedy (scripts/make_labels.py; floors
+already labelled are skipped, so an interrupted run resumes), fit, and with ``--dagger N`` label N
+more floors under the fitted model's own planner and fit again on all of them (one round of
+DAgger: the planner learns from the states it visits itself).
 
 The model: scikit-learn's gradient-boosted trees (fixed seed) on the features of
 semsearch_cli/planners/doors/learned.py, either regressing ``log(1 + regret)`` of each reachable
 target, ``regret`` the metres its oracle (``d(c) + G(c)``) exceeds the decision's best (a planner
-takes the least), or classifying whether it is the best (the highest log-odds). Decisions with fewer than two labelled targets teach nothing and are left out.
-One floor in five (by the floor's name) is held out; the script prints, on those floors, the mean
-regret of the target the model picks against greedy's (the nearest) and nsos's (the highest phi),
-and checks that the exported arrays predict what scikit-learn predicts."""
+takes the least), or classifying whether it is the best (the highest log-odds). Decisions with
+fewer than two labelled targets teach nothing and are left out. One floor in five (by the floor's
+name) is held out; the script prints, on those floors, the mean regret of the target the model
+picks against greedy's (the nearest), nsos's (the highest phi) and the numbering model's (the
+least expected travel), and checks that the exported arrays predict what scikit-learn predicts."""
 
 from __future__ import annotations
 
@@ -26,7 +32,8 @@ import numpy as np
 import pandas as pd
 from sklearn.ensemble import HistGradientBoostingClassifier, HistGradientBoostingRegressor
 
-from semsearch_cli.planners.doors.learned import FEATURES, MODELS, Trees
+from make_labels import make  # scripts/, beside this one
+from semsearch_cli.planners.doors.learned import FEATURES, MODELS, Trees, load_model
 
 DECISION = ["scenario", "goal", "episode", "seed", "decision"]
 
@@ -69,17 +76,9 @@ def export(model: HistGradientBoostingRegressor) -> dict:
     return {"trees": out, "baseline": float(np.ravel(model._baseline_prediction)[0]), "max_depth": depth}
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--labels", type=Path, required=True)
-    ap.add_argument("--name", default="learned-doors-v1")
-    ap.add_argument("--iterations", type=int, default=200)
-    ap.add_argument("--leaves", type=int, default=15)
-    ap.add_argument("--objective", choices=("regret", "best"), default="regret",
-                    help="regret: regress log(1 + regret); best: classify the decision's best target")
-    a = ap.parse_args()
-    t0 = time.perf_counter()
-    raw = pd.read_csv(a.labels, dtype={"goal": str})
+def fit(raw: pd.DataFrame, a, sources: list[str]) -> dict:
+    """Fit the model to labelled rows, check its export and measure it on the held-out floors:
+    the model's document (its trees, and how it was trained)."""
     df = prepare(raw)
     held = df["scenario"].map(lambda s: int(hashlib.sha256(str(s).encode()).hexdigest(), 16) % 5 == 0)
     train, val = df[~held], df[held]
@@ -93,7 +92,7 @@ def main() -> int:
     fit_s = time.perf_counter() - t1
     doc = {"name": a.name, "features": list(FEATURES), "objective": a.objective, "sign": 1.0 if a.objective == "regret" else -1.0,
            **export(model),
-           "training": {"labels": str(a.labels.name), "floors": int(df["scenario"].nunique()),
+           "training": {"labels": sources, "floors": int(df["scenario"].nunique()),
                         "held_out_floors": int(val["scenario"].nunique()), "rows": int(len(train)),
                         "decisions": int(train.groupby(DECISION).ngroups), "fit_s": round(fit_s, 1),
                         "iterations": a.iterations, "leaves": a.leaves, "learning_rate": 0.1, "min_samples_leaf": 50,
@@ -107,15 +106,56 @@ def main() -> int:
         raise SystemExit(f"the exported trees predict {gap} away from scikit-learn's")
     res = {"model": picked_regret(val, doc["sign"] * ours), "greedy (nearest)": picked_regret(val, val["d_m"].to_numpy()),
            "nsos (highest phi)": picked_regret(val, -val["phi"].fillna(-np.inf).to_numpy()),
+           "numbering (least expected travel)": picked_regret(val, val["T_expected"].fillna(np.inf).to_numpy()),
            "oracle": 0.0}
     doc["training"]["held_out_regret_m"] = {k: round(v, 3) for k, v in res.items()}
-    MODELS.mkdir(parents=True, exist_ok=True)
-    path = MODELS / f"{a.name}.json"
-    path.write_text(json.dumps(doc, separators=(",", ":")) + "\n")
     print(f"{len(raw)} labelled targets -> {len(df)} in decisions with a choice; {df['scenario'].nunique()} floors "
-          f"({val['scenario'].nunique()} held out); fit {fit_s:.1f} s; all {time.perf_counter() - t0:.1f} s")
-    print("held-out mean regret of the target picked (m): " + ", ".join(f"{k} {v:.2f}" for k, v in res.items()))
-    print(f"exported == scikit-learn's predictions (max gap {gap:.1e}); {path} ({path.stat().st_size / 1e3:.0f} kB)")
+          f"({val['scenario'].nunique()} held out); fit {fit_s:.1f} s; exported == scikit-learn's predictions "
+          f"(max gap {gap:.1e})", flush=True)
+    print("held-out mean regret of the target picked (m): " + ", ".join(f"{k} {v:.2f}" for k, v in res.items()), flush=True)
+    return doc
+
+
+def write(doc: dict) -> Path:
+    MODELS.mkdir(parents=True, exist_ok=True)
+    path = MODELS / f"{doc['name']}.json"
+    tmp = path.with_suffix(".part")
+    tmp.write_text(json.dumps(doc, separators=(",", ":")) + "\n")
+    tmp.replace(path)
+    load_model.cache_clear()
+    print(f"wrote {path} ({path.stat().st_size / 1e3:.0f} kB)", flush=True)
+    return path
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--labels", type=Path, nargs="*", default=[], help="labelled CSVs to fit (instead of --out's)")
+    ap.add_argument("--out", type=Path, help="label training floors into OUT/greedy (and OUT/dagger) first, then fit")
+    ap.add_argument("--floors", type=int, default=120, help="with --out: training floors labelled under greedy")
+    ap.add_argument("--dagger", type=int, default=0,
+                    help="with --out: then this many more floors labelled under the first model's own planner, and fit again on all")
+    ap.add_argument("--name", default="learned-doors-v1")
+    ap.add_argument("--iterations", type=int, default=200)
+    ap.add_argument("--leaves", type=int, default=15)
+    ap.add_argument("--objective", choices=("regret", "best"), default="regret",
+                    help="regret: regress log(1 + regret); best: classify the decision's best target")
+    a = ap.parse_args()
+    t0 = time.perf_counter()
+    csvs = list(a.labels)
+    if a.out is not None:
+        if a.name != "learned-doors-v1" and a.dagger:
+            raise SystemExit("--dagger runs the registered planner, which reads learned-doors-v1: keep --name")
+        csvs = [make(a.floors, a.out / "greedy", "greedy")]
+        print(f"labels under greedy: {time.perf_counter() - t0:.0f} s", flush=True)
+        if a.dagger:
+            write(fit(pd.concat([pd.read_csv(c, dtype={"goal": str}) for c in csvs]), a, [str(c) for c in csvs]))
+            csvs.append(make(a.dagger, a.out / "dagger", "learned", first=a.floors))
+            print(f"labels under the first model: {time.perf_counter() - t0:.0f} s", flush=True)
+    if not csvs:
+        raise SystemExit("give --labels CSV... or --out DIR")
+    raw = pd.concat([pd.read_csv(c, dtype={"goal": str}) for c in csvs], ignore_index=True)
+    write(fit(raw, a, [str(c) for c in csvs]))
+    print(f"all {time.perf_counter() - t0:.0f} s")
     return 0
 
 

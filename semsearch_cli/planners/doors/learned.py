@@ -1,30 +1,43 @@
-"""What a learned door planner reads and how it evaluates its model (docs/learning.md): the
-features of each frontier target at a decision (:func:`decision_features`: its path length and
-rank, the targets, the metres travelled and signs counted, nsos's terms, and the path and nsos's
-phi, SF and phi_g against the decision's best), and gradient-boosted regression trees evaluated
-with NumPy (:class:`Trees`; ``scripts/train_learned.py`` fits them with scikit-learn and writes
-them as arrays). The labelled decisions (:mod:`semsearch_cli.learn`) are recorded with these very
-features.
+"""``learned``: the door planner whose choice a model makes, and what it reads (docs/learning.md).
 
-No learned planner is registered yet: the first models, trained on up to 57 training floors,
-picked targets no better than greedy's (docs/learning.md has the numbers); one will be, with its
-model shipped beside it, when it does better on floors it never saw.
+At a decision every frontier target gets the features the robot has (:func:`decision_features`:
+its path length and rank, the targets, the metres travelled and signs counted, nsos's terms, the
+numbering model's probability that the goal lies beyond the target, metres past it and expected
+travel, and the path, nsos's phi, SF and phi_g and the expected travel against the decision's
+best). Gradient-boosted regression trees predict ``log(1 + regret)`` of each, ``regret`` the
+metres the oracle ``d(c) + G(c)`` (the true remaining travel through the target, computed on the
+known map) exceeds the decision's best. The planner takes the least prediction (ties: the nearer
+target, then the run's generator) and keeps its last target while that target's prediction is
+within ``hysteresis`` of the best, as nsos keeps its own (:class:`KeepTarget`).
+
+The trees were fitted with scikit-learn on training floors that are none of the benchmark's
+(``scripts/train_learned.py``, one command) and ship as arrays
+(``semsearch_cli/data/models/learned-doors-v1.json``), which NumPy evaluates (:class:`Trees`): no
+learning library is needed to run the planner. The labelled decisions
+(:mod:`semsearch_cli.learn`) are recorded with these very features.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
+from functools import lru_cache
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
 
-from .nsos import NSOS
+from ..base import Decision, register_planner
+from .nsos import NSOS, KeepTarget, NSOSParams, pick
+from .numbering import NumberingParams, expected_travel, target_terms
 
 MODELS = Path(__file__).resolve().parents[2] / "data" / "models"
 TERMS = ("phi_g", "zeta", "gamma", "phi_p", "phi_o", "phi_r", "phi_c", "SF", "GF", "phi")
-BASE = ("d_m", "d_rank", "n_targets", "travelled_m", "signs", *TERMS)  # a target's own
-RELATIVE = ("d_over_min", "phi_below_max", "SF_below_max", "phi_g_below_max")  # against the decision's best
+NUMBERING = ("P_beyond", "E_beyond", "T_expected")  # the numbering model's (docs/numbering.md), at its defaults
+BASE = ("d_m", "d_rank", "n_targets", "travelled_m", "signs", *TERMS, *NUMBERING)  # a target's own
+RELATIVE = ("d_over_min", "phi_below_max", "SF_below_max", "phi_g_below_max", "T_over_min")  # against the decision's best
 FEATURES = (*BASE, *RELATIVE)
 
 
@@ -48,7 +61,16 @@ def decision_features(ctx, cands, nsos: NSOS) -> tuple[np.ndarray, np.ndarray]:
     X[:, 4] = signs
     for j, t in enumerate(TERMS):
         X[:, 5 + j] = [np.nan if c.get(t) is None else c[t] for c in terms]
+    reach = np.isfinite(d)
+    P, E = target_terms(ctx, cands, reach, _NUMBERING)
+    T = expected_travel(d, P, E, _NUMBERING.horizon)
+    j = 5 + len(TERMS)
+    X[:, j : j + 3] = np.column_stack([P, E, T])
+    X[~reach, j : j + 3] = np.nan
     return add_relative(X), d
+
+
+_NUMBERING = NumberingParams()
 
 
 def add_relative(X: np.ndarray) -> np.ndarray:
@@ -62,6 +84,8 @@ def add_relative(X: np.ndarray) -> np.ndarray:
         for rel, base in (("phi_below_max", "phi"), ("SF_below_max", "SF"), ("phi_g_below_max", "phi_g")):
             v = X[:, col[base]]
             X[:, col[rel]] = np.nanmax(v) - v if np.isfinite(v).any() else np.nan
+        T = X[:, col["T_expected"]]
+        X[:, col["T_over_min"]] = T - np.nanmin(T) if np.isfinite(T).any() else np.nan
     return X
 
 
@@ -100,3 +124,43 @@ class Trees:
             go_left = np.where(np.isnan(x), self.missing_left[node], x <= self.threshold[node])
             node = np.where(inner, np.where(go_left, self.left[node], self.right[node]), node)
         return self.baseline + self.value[node].sum(axis=0)
+
+
+@lru_cache(maxsize=4)
+def load_model(name: str) -> Trees:
+    """A shipped model, ``semsearch_cli/data/models/<name>.json``; its features must be this
+    module's :data:`FEATURES`, in order."""
+    doc = json.loads((MODELS / f"{name}.json").read_text())
+    if tuple(doc["features"]) != FEATURES:
+        raise ValueError(f"model {name}: its features {doc['features']} are not this planner's {list(FEATURES)}")
+    return Trees(doc)
+
+
+class LearnedParams(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    model: Literal["learned-doors-v1"] = Field("learned-doors-v1", description="the shipped model (semsearch_cli/data/models/<model>.json)")
+    hysteresis: float = Field(0.05, ge=0.0, description="keep the last target while its predicted log(1 + regret) is within this of the best")
+
+
+@register_planner("learned")
+class Learned(KeepTarget):
+    """The frontier target of least predicted regret, by gradient-boosted trees trained on labels
+    from the known map on floors none of the benchmark's (docs/learning.md). The trees are
+    evaluated with NumPy; no learning library is needed to run it."""
+
+    rank = 6
+    Params = LearnedParams
+
+    def __init__(self, params):
+        super().__init__(params)
+        self._nsos = NSOS(NSOSParams())
+        self._trees = load_model(self.params.model)
+
+    def _decide(self, ctx, cands, keep: int | None = None):
+        X, d = decision_features(ctx, cands, self._nsos)
+        reach = np.isfinite(d)
+        if not reach.any():
+            return None
+        pred = np.where(reach, self._trees.sign * self._trees.predict(X), np.inf)
+        j = pick(-pred, np.where(reach, d, np.inf), keep, self.params.hysteresis, ctx.rng)
+        return Decision(int(cands.rows[j]), int(cands.cols[j]), {"chosen": j, "predicted": round(float(pred[j]), 4)})
