@@ -116,6 +116,11 @@ def fit(raw: pd.DataFrame, a, sources: list[str]) -> dict:
     return doc
 
 
+def named(csvs) -> list[str]:
+    """The label files as the model records them: folder and name, not this machine's path."""
+    return [f"{Path(c).parent.name}/{Path(c).name}" for c in csvs]
+
+
 def write(doc: dict) -> Path:
     MODELS.mkdir(parents=True, exist_ok=True)
     path = MODELS / f"{doc['name']}.json"
@@ -148,13 +153,13 @@ def main() -> int:
         csvs = [make(a.floors, a.out / "greedy", "greedy")]
         print(f"labels under greedy: {time.perf_counter() - t0:.0f} s", flush=True)
         if a.dagger:
-            write(fit(pd.concat([pd.read_csv(c, dtype={"goal": str}) for c in csvs]), a, [str(c) for c in csvs]))
+            write(fit(pd.concat([pd.read_csv(c, dtype={"goal": str}) for c in csvs]), a, named(csvs)))
             csvs.append(make(a.dagger, a.out / "dagger", "learned", first=a.floors))
             print(f"labels under the first model: {time.perf_counter() - t0:.0f} s", flush=True)
     if not csvs:
         raise SystemExit("give --labels CSV... or --out DIR")
     raw = pd.concat([pd.read_csv(c, dtype={"goal": str}) for c in csvs], ignore_index=True)
-    write(fit(raw, a, [str(c) for c in csvs]))
+    write(fit(raw, a, named(csvs)))
     print(f"all {time.perf_counter() - t0:.0f} s")
     return 0
 
