@@ -3,7 +3,7 @@ doors-v1's mix from a salt of their own, no benchmark floor), run a behaviour pl
 episodes, and write one row per frontier target of every decision with the features the robot
 has and the oracle's label (semsearch_cli/learn/labels.py). Run from the checkout:
 
-    python scripts/make_labels.py --floors 200 --out results/labels [--planner greedy] [--seeds 1] [--first 0]
+    python scripts/make_labels.py --floors 120 --out results/labels/greedy [--planner greedy] [--seeds 1] [--first 0]
 
 Rows are appended to OUT/labels.csv floor by floor; a floor already in it is skipped, so an
 interrupted run resumes. OUT/floors/ keeps the floors (their scenarios run as they are)."""
