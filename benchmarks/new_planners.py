@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from bench_board import safe  # the same folder names as the val board's
 from output import emit
 
 from semsearch_cli import api
@@ -36,10 +37,6 @@ from semsearch_cli.runner import BatchOptions
 
 BASELINES = ("nsos[alpha=0.9]", "greedy")
 RUNS = (("doors-v1", "true"), ("doors-v1", "shuffled"), ("doors-classic-v1", "true"))
-
-
-def safe(label: str) -> str:
-    return label.replace("[", "_").replace("]", "").replace("=", "")
 
 
 def diff_cell(a: pd.DataFrame, b: pd.DataFrame) -> str:

@@ -42,7 +42,7 @@ def training_floor(i: int, out: Path, salt: str = SALT) -> tuple[Path, dict]:
         path = generate_building(r["layout"], r["numbering"], r["seed"], out / fid, spacing=r["spacing"],
                                  name=f"{SUITE}-{fid}", planners=DEFAULT_PLANNER, skip=r["skip"], letters=r["letters"],
                                  extension=r["extension"], style=r["style"], letter_case=r["letter_case"])
-        if sum(1 for _ in open(path.parent / "doors.csv")) - 1 >= MIN_SIGNS:
+        if len((path.parent / "doors.csv").read_text().splitlines()) - 1 >= MIN_SIGNS:
             doc = yaml.safe_load(path.read_text())
             doc["episodes"] = {"starts": 3, "seed": int(rng.integers(2**31)), "min_distance": 10.0}
             path.write_text(path.read_text().split("\n", 1)[0] + "\n" + yaml.safe_dump(doc, sort_keys=False))

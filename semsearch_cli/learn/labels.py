@@ -14,8 +14,10 @@ The features are what the robot has at that decision, exactly as the ``learned``
 them (:func:`~semsearch_cli.planners.doors.learned.decision_features`): the target's path length
 and its rank among the targets, how many targets there are, the metres travelled and the signs
 counted so far, nsos's terms for the target (Eqs. 4.9-4.14 and paper Eq. 16: growing direction,
-parity, door and robot orientation, closeness; :mod:`~semsearch_cli.planners.doors.nsos`), and the
-path and nsos's phi, SF and phi_g against the decision's best.
+parity, door and robot orientation, closeness; :mod:`~semsearch_cli.planners.doors.nsos`), the
+numbering model's probability that the goal lies beyond the target, metres past it and expected
+travel (:mod:`~semsearch_cli.planners.doors.numbering`), and the path, nsos's phi, SF and phi_g
+and the expected travel against the decision's best.
 
 :class:`LabelSeat` is the batch's seat that writes one row per target before the run's planner
 answers (the behaviour policy: the run is exactly the run that planner makes alone; a test checks

@@ -39,6 +39,7 @@ NUMBERING = ("P_beyond", "E_beyond", "T_expected")  # the numbering model's (doc
 BASE = ("d_m", "d_rank", "n_targets", "travelled_m", "signs", *TERMS, *NUMBERING)  # a target's own
 RELATIVE = ("d_over_min", "phi_below_max", "SF_below_max", "phi_g_below_max", "T_over_min")  # against the decision's best
 FEATURES = (*BASE, *RELATIVE)
+_NUMBERING = NumberingParams()  # the numbering model's terms are read at its defaults
 
 
 def decision_features(ctx, cands, nsos: NSOS) -> tuple[np.ndarray, np.ndarray]:
@@ -68,9 +69,6 @@ def decision_features(ctx, cands, nsos: NSOS) -> tuple[np.ndarray, np.ndarray]:
     X[:, j : j + 3] = np.column_stack([P, E, T])
     X[~reach, j : j + 3] = np.nan
     return add_relative(X), d
-
-
-_NUMBERING = NumberingParams()
 
 
 def add_relative(X: np.ndarray) -> np.ndarray:

@@ -17,8 +17,8 @@ the branch, ``t_i = p_i . e_f`` with ``e_f = (cos theta_f, sin theta_f)``.
   ``S = sum (r_i - mean r)^2``: ``p(n | H_{s,b}) = R^-1 (2 pi sigma^2)^(-(k-1)/2) k^(-1/2)
   exp(-S / 2 sigma^2)`` and ``p(n | H_0) = R^-k``. The posterior is proportional to prior times
   evidence.
-- **Where the goal is.** Under ``H_{s,b}`` the goal ``g`` sits at ``t_g = t_0 + (g - a*) / (s b)``
-  with ``a*`` the offset's posterior mean, ``mean(n_i - s b t_i)`` (``t_0 = 0``): beyond the target
+- **Where the goal is.** Under ``H_{s,b}`` the goal ``g`` sits at ``t_g = (g - a*) / (s b)``
+  with ``a*`` the offset's posterior mean, ``mean(n_i - s b t_i)``: beyond the target
   when ``t_g > t_c`` (``t_c = c . e_f``), at ``t_g - t_c`` metres past it.
 - **Prefix and parity.** A segment whose numbered signs carry other prefixes is likely another
   wing: ``(k_same + 1) / (k + 1)`` multiplies the probability that the goal is beyond the target;
@@ -53,6 +53,12 @@ from .nsos import KeepTarget, pick
 SPACINGS = (0.1, 0.15, 0.2, 0.3, 0.45, 0.7, 1.0, 1.5, 2.2, 3.3, 5.0)  # numbers per metre, a geometric grid
 
 
+def slopes(spacings=SPACINGS) -> np.ndarray:
+    """(2, B): ``s b`` of every linear numbering, rising (``s = +1``, row 0) then falling."""
+    b = np.asarray(spacings, float)
+    return np.stack([b, -b])
+
+
 class NumberingParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
     sigma: float = Field(1.5, gt=0.0, le=100.0, description="numbers: residual of a sign about the corridor's line")
@@ -70,8 +76,7 @@ def linear_posterior(numbers, t, sigma: float, R: float, p_none: float, spacings
     n = np.asarray(numbers, float)
     t = np.asarray(t, float)
     k = n.size
-    b = np.asarray(spacings, float)
-    slope = np.stack([b, -b])  # (2, B): s b
+    slope = slopes(spacings)
     log_prior_lin = math.log(max(1.0 - p_none, 1e-300)) - math.log(slope.size)
     log_prior_none = math.log(max(p_none, 1e-300))
     if k == 0:
@@ -97,9 +102,7 @@ def beyond(w0: float, w: np.ndarray, a: np.ndarray, goal: float, t_c: float, hor
            spacings=SPACINGS) -> tuple[float, float]:
     """(P, E): the probability that the goal lies beyond the target at ``t_c`` along the axis,
     and the expected metres past it when it does (see the module docstring)."""
-    b = np.asarray(spacings, float)
-    slope = np.stack([b, -b])
-    t_g = (goal - a) / slope
+    t_g = (goal - a) / slopes(spacings)
     past = t_g - t_c
     ahead = past > 0
     p_lin = float(w[ahead].sum())
