@@ -6,7 +6,7 @@ import pytest
 from semsearch_cli.belief import DoorBelief
 from semsearch_cli.config import BeliefSpec
 from semsearch_cli.geometry import GridFrame
-from semsearch_cli.kernels.grid import GridSearch, dijkstra, local_reach
+from semsearch_cli.kernels.grid import BUCKETS, GridSearch, _dijkstra, dijkstra, local_reach
 from semsearch_cli.kernels.memory import lazy_zeros
 from semsearch_cli.kernels.raycast import cast_rays
 
@@ -172,6 +172,43 @@ def test_search_heap_grows_without_changing_the_result():
     far = int(np.argmax(np.where(np.isfinite(big.costs(tr, tc)), big.costs(tr, tc), -1)))
     assert big.costs(tr, tc)[far] > 50
     assert np.array_equal(np.stack(small.path(int(tr[far]), int(tc[far]))), np.stack(big.path(int(tr[far]), int(tc[far]))))
+
+
+def _heap_only(gs, p, cost, tr, tc):
+    """A search with the heap alone (no Dial buckets), as GridSearch.run falls back to."""
+    H, W = p.shape
+    gs.gen += 1
+    gs.tmark[tr * W + tc] = gs.gen
+    hk, hi = np.empty(1 << 16), np.empty(1 << 16, np.int64)
+    return _dijkstra(p.ravel(), cost.ravel(), H, W, np.array([0], np.int64), gs.tmark, 0, np.inf, gs.state, gs.parent,
+                     gs.stamp, gs.gen, hk, hi, gs._bk, gs._bi, gs._bn, False, -1)
+
+
+@pytest.mark.parametrize("low", [1.0, 0.5])
+def test_dial_buckets_settle_as_the_heap_does(low):
+    """Dial's buckets give the heap's costs, lengths and parents bit for bit (ties included: costs
+    drawn from a few values); a step cheaper than one cell (low 0.5) falls back to the heap, and
+    buckets too small for a search grow."""
+    rng = np.random.default_rng(3)
+    p = rng.random((70, 90)) > 0.15
+    p[0, 0] = True
+    cost = rng.choice(np.array([low, 1.0, 1.5, 2.0, 3.5], np.float32), size=p.shape)
+    tr, tc = np.nonzero(p)
+    dial, heap = GridSearch(p.shape), GridSearch(p.shape)
+    dial._bk, dial._bi = np.empty((BUCKETS, 2)), np.empty((BUCKETS, 2), np.int64)
+    assert dial.run(p, cost, 0, 0, tr, tc) == _heap_only(heap, p, cost, tr, tc) > 5000
+    assert dial._bk.shape[1] > 2  # grown
+    H, W = p.shape
+    dial.gen += 1  # the buckets alone, as the first try: a step under one cell ends it
+    with_buckets = _dijkstra(p.ravel(), cost.ravel(), H, W, np.array([0], np.int64), dial.tmark, 0, np.inf, dial.state,
+                             dial.parent, dial.stamp, dial.gen, dial._hk, dial._hi, dial._bk, dial._bi, dial._bn, True, -1)
+    assert (with_buckets == -2) == (low < 1.0)
+    dial.run(p, cost, 0, 0, tr, tc)
+    for a in (dial, heap):
+        assert a.stamp.max() == 2 * a.gen + 1
+    done = dial.stamp == 2 * dial.gen + 1
+    assert np.array_equal(done, heap.stamp == 2 * heap.gen + 1)
+    assert np.array_equal(dial.state[done], heap.state[done]) and np.array_equal(dial.parent[done], heap.parent[done])
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")

@@ -177,10 +177,11 @@ def _before(k1, i1, k2, i2):
 
 @njit(cache=True, inline="always")
 def _heap_push(hk, hi, n, k, i):
-    """Put (k, i) into the binary heap of the first ``n`` entries of (hk, hi)."""
+    """Put (k, i) into the 4-ary heap of the first ``n`` entries of (hk, hi) (a 4-ary heap is half
+    as deep as a binary one, and its four children share a cache line)."""
     j = n
     while j > 0:
-        p = (j - 1) >> 1
+        p = (j - 1) >> 2
         if not _before(k, i, hk[p], hi[p]):
             break
         hk[j] = hk[p]
@@ -198,116 +199,174 @@ def _heap_drop_top(hk, hi, n):
     i = hi[n]
     j = 0
     while True:
-        ch = 2 * j + 1
+        ch = 4 * j + 1
         if ch >= n:
             break
-        if ch + 1 < n and _before(hk[ch + 1], hi[ch + 1], hk[ch], hi[ch]):
-            ch += 1
-        if not _before(hk[ch], hi[ch], k, i):
+        best = ch
+        for q in range(ch + 1, min(ch + 4, n)):
+            if _before(hk[q], hi[q], hk[best], hi[best]):
+                best = q
+        if not _before(hk[best], hi[best], k, i):
             break
-        hk[j] = hk[ch]
-        hi[j] = hi[ch]
-        j = ch
+        hk[j] = hk[best]
+        hi[j] = hi[best]
+        j = best
     hk[j] = k
     hi[j] = i
 
 
+BUCKETS = 8  # future buckets of unit width: a step may cost up to 7 (sqrt(2) x 4.9)
+
+
 @njit(cache=True)
-def _dijkstra(passable, cost, src_r, src_c, tmark, n_stop, max_cost, dist, length, parent, touched, closed, gen, hk, hi,
+def _dijkstra(passable, cost, H, W, src, tmark, n_stop, max_cost, state, parent, stamp, gen, hk, hi, bk, bi, bn, dial,
               stop_idx):
     """Multi-source Dijkstra on an 8-connected grid with per-cell cost multipliers.
 
-    Moving into cell q costs ``step * cost[q]`` with step 1 or sqrt(2); ``cost`` of shape (1, 1)
-    means a uniform cost of 1. Cells with ``tmark == gen`` are targets; the search stops once
-    ``n_stop`` of them are settled (0: never), once the cell of index ``stop_idx`` is settled (-1:
-    no such cell), or when the cost exceeds ``max_cost``. A settled cell's parent is final, so a
-    search stopped at a cell holds the same path to it as the search run on. The state arrays
-    are reused across searches: a value is valid only where its stamp (``touched`` / ``closed``)
-    equals ``gen``, so a search costs what it explores, not the grid size.
+    Every grid is flat (index ``r * W + c``). Moving into cell q costs ``step * cost[q]`` with
+    step 1 or sqrt(2); ``cost`` of size 1 means a uniform cost of 1. Cells with ``tmark == gen``
+    are targets; the search stops once ``n_stop`` of them are settled (0: never), once the cell
+    ``stop_idx`` is settled (-1: no such cell), or when the cost exceeds ``max_cost``. A settled
+    cell's parent is final, so a search stopped at a cell holds the same path to it as the search
+    run on.
 
-    The queue is a binary heap in (hk, hi) (cost, cell index), ordered by cost and then by cell
-    index, so ties settle in one fixed order. Returns the number of targets settled, or -1 when
-    the heap is full (the caller grows it and searches again).
+    The state is reused across searches and never cleared: ``state[q]`` holds (cost, length) and
+    ``parent[q]`` the previous cell, valid only where ``stamp[q]`` says this search reached q
+    (``2 gen``, queued) or settled it (``2 gen + 1``), so a search costs what it explores, not the
+    grid size; one cell's numbers share a cache line.
+
+    Cells settle in the order of (cost, cell index): the order of any correct priority queue over
+    these keys (they are distinct), so ties resolve alike whatever the queue. The queue is a 4-ary
+    heap in (hk, hi); with ``dial``, Dial's buckets in front of it: a cell queued at cost d waits
+    in bucket floor(d) (``bk``, ``bi``, ``bn``: :data:`BUCKETS` rows used in turn) and the heap
+    holds only the bucket being settled. When every step costs at least 1, a cell settled from
+    bucket k queues its neighbours in bucket k + 1 or later, so a bucket is complete before its
+    turn and the heap settles it in key order: the same order as the heap alone, at a fraction of
+    its cost. A step cheaper than 1, or so dear that it skips every bucket, ends the search with
+    -2 (the caller runs it again without ``dial``). Returns the number of targets settled, -1 when
+    the heap or a bucket is full (the caller grows them and searches again), -2 as said.
     """
-    H, W = passable.shape
     uniform = cost.shape[0] == 1
-    cap = hk.shape[0]
-    n = 0
-    for s in range(src_r.shape[0]):
-        r = src_r[s]
-        c = src_c[s]
-        if 0 <= r < H and 0 <= c < W and passable[r, c]:
-            if n == cap:
+    hcap = hk.shape[0]
+    bcap = bk.shape[1]
+    reached = 2 * gen
+    done = reached + 1
+    off = np.array([-W, W, -1, 1, -W - 1, -W + 1, W - 1, W + 1], np.int64)
+    bn[:] = 0
+    n = 0  # entries in the heap
+    for s in range(src.shape[0]):
+        q = src[s]
+        if q >= 0 and passable[q]:
+            if n == hcap:
                 return -1
-            dist[r, c] = 0.0
-            length[r, c] = 0.0
-            parent[r, c] = -1
-            touched[r, c] = gen
-            _heap_push(hk, hi, n, 0.0, r * W + c)
+            state[q, 0] = 0.0
+            state[q, 1] = 0.0
+            parent[q] = -1
+            stamp[q] = reached
+            _heap_push(hk, hi, n, 0.0, q)
             n += 1
+    cur = 0  # with dial: the bucket the heap holds (costs in [cur, cur + 1))
+    waiting = 0  # with dial: entries in the buckets after it
     settled_targets = 0
-    while n > 0:
+    while True:
+        if n == 0:
+            if waiting == 0:
+                break
+            cur += 1  # the next bucket into the heap
+            b = cur % BUCKETS
+            m = bn[b]
+            if m > hcap:
+                return -1
+            for j in range(m):
+                _heap_push(hk, hi, n, bk[b, j], bi[b, j])
+                n += 1
+            waiting -= m
+            bn[b] = 0
+            continue
         d = hk[0]
         idx = hi[0]
         _heap_drop_top(hk, hi, n)
         n -= 1
-        r = idx // W
-        c = idx - r * W
-        if closed[r, c] == gen:
+        if stamp[idx] == done:
             continue
         if d > max_cost:
             break
-        closed[r, c] = gen
-        if tmark[r, c] == gen:
+        stamp[idx] = done
+        if tmark[idx] == gen:
             settled_targets += 1
             if n_stop > 0 and settled_targets >= n_stop:
                 break
         if idx == stop_idx:
             break
+        r = idx // W
+        c = idx - r * W
+        inner = 0 < r < H - 1 and 0 < c < W - 1
+        length = state[idx, 1]
         for k in range(8):
-            nr = r + _DR8[k]
-            nc = c + _DC8[k]
-            if nr < 0 or nr >= H or nc < 0 or nc >= W or closed[nr, nc] == gen or not passable[nr, nc]:
+            if not inner:
+                nr = r + _DR8[k]
+                nc = c + _DC8[k]
+                if nr < 0 or nr >= H or nc < 0 or nc >= W:
+                    continue
+            q = idx + off[k]
+            if stamp[q] == done or not passable[q]:
                 continue
-            if k >= 4:
-                if not passable[r, nc] or not passable[nr, c]:
+            if k >= 4:  # no corner cutting: both orthogonal cells, (r, nc) and (nr, c), passable
+                if not passable[idx + _DC8[k]] or not passable[idx + _DR8[k] * W]:
                     continue
                 step = SQRT2
             else:
                 step = 1.0
-            nd = d + (step if uniform else step * cost[nr, nc])
-            if touched[nr, nc] != gen or nd < dist[nr, nc]:
-                if n == cap:
-                    return -1
-                touched[nr, nc] = gen
-                dist[nr, nc] = nd
-                length[nr, nc] = length[r, c] + step
-                parent[nr, nc] = idx
-                _heap_push(hk, hi, n, nd, nr * W + nc)
-                n += 1
+            inc = step if uniform else step * cost[q]
+            nd = d + inc
+            if stamp[q] != reached or nd < state[q, 0]:
+                if dial:
+                    kb = int(math.floor(nd))
+                    if not inc >= 1.0 or kb - cur >= BUCKETS:
+                        return -2
+                    b = kb % BUCKETS
+                    if bn[b] == bcap:
+                        return -1
+                    bk[b, bn[b]] = nd
+                    bi[b, bn[b]] = q
+                    bn[b] += 1
+                    waiting += 1
+                else:
+                    if n == hcap:
+                        return -1
+                    _heap_push(hk, hi, n, nd, q)
+                    n += 1
+                stamp[q] = reached
+                state[q, 0] = nd
+                state[q, 1] = length + step
+                parent[q] = idx
     return settled_targets
 
 
 class GridSearch:
     """Reusable Dijkstra state for one grid shape (see :func:`_dijkstra`).
 
-    After :meth:`run`, :meth:`lengths` and :meth:`path` read the settled cells of that search.
+    After :meth:`run`, :meth:`settled`, :meth:`lengths`, :meth:`costs` and :meth:`path` read the
+    cells that search settled; :meth:`length_grid` gives its lengths over the whole grid.
     """
 
     def __init__(self, shape):
         # never filled: a value counts only where its stamp says so, and pages never written are
         # never resident (a search touches a band, not the map); int32 cell indices (maps are at
         # most 25 M cells)
-        self.dist = lazy_zeros(shape)
-        self.length_ = lazy_zeros(shape)
-        self.parent = lazy_zeros(shape, np.int32)
-        self.touched = lazy_zeros(shape, np.int32)
-        self.closed = lazy_zeros(shape, np.int32)
-        self.tmark = lazy_zeros(shape, np.int32)
+        self.shape = tuple(shape)
+        n = int(np.prod(self.shape))
+        self.state = lazy_zeros((n, 2))  # (cost, length) per cell
+        self.parent = lazy_zeros(n, np.int32)
+        self.stamp = lazy_zeros(n, np.int32)
+        self.tmark = lazy_zeros(n, np.int32)
         self.gen = 0
         self.source = None
         self._hk = np.empty(4096)  # the search's heap (cost, cell), grown when a search fills it
         self._hi = np.empty(4096, np.int64)
+        self._bk = np.empty((BUCKETS, 1024))  # Dial's buckets (cost, cell), grown alike
+        self._bi = np.empty((BUCKETS, 1024), np.int64)
+        self._bn = np.zeros(BUCKETS, np.int64)
 
     def run(self, passable, cost, src_r, src_c, t_rows, t_cols, n_stop=0, max_cost=np.inf, stop=None) -> int:
         """Search from the source cells; returns the number of targets settled. ``stop``: a cell
@@ -316,31 +375,52 @@ class GridSearch:
         src_r = np.atleast_1d(np.asarray(src_r, np.int64))
         src_c = np.atleast_1d(np.asarray(src_c, np.int64))
         self.source = (tuple(src_r), tuple(src_c))
-        while True:  # a search that fills the heap runs again, from scratch, with a larger one
+        H, W = passable.shape
+        inside = (src_r >= 0) & (src_r < H) & (src_c >= 0) & (src_c < W)
+        src = np.where(inside, src_r * W + src_c, -1)
+        stop_idx = -1 if stop is None else int(stop[0]) * W + int(stop[1])
+        t_idx = np.asarray(t_rows, np.int64) * W + np.asarray(t_cols, np.int64)
+        passable, cost = passable.ravel(), cost.ravel()
+        dial = True
+        while True:  # a search that fills the heap or a bucket runs again, from scratch, with larger ones
             self.gen += 1
-            self.tmark[t_rows, t_cols] = self.gen
-            stop_idx = -1 if stop is None else int(stop[0]) * passable.shape[1] + int(stop[1])
-            settled = _dijkstra(passable, cost, src_r, src_c, self.tmark, n_stop, max_cost, self.dist, self.length_,
-                                self.parent, self.touched, self.closed, self.gen, self._hk, self._hi, stop_idx)
+            self.tmark[t_idx] = self.gen
+            settled = _dijkstra(passable, cost, H, W, src, self.tmark, n_stop, max_cost, self.state, self.parent,
+                                self.stamp, self.gen, self._hk, self._hi, self._bk, self._bi, self._bn, dial, stop_idx)
             if settled >= 0:
                 return settled
-            self._hk, self._hi = np.empty(2 * self._hk.size), np.empty(2 * self._hi.size, np.int64)
+            if settled == -2:  # a step outside what Dial's buckets hold: the heap alone
+                dial = False
+            elif self._bn.max() == self._bk.shape[1]:
+                self._bk, self._bi = np.empty((BUCKETS, 2 * self._bk.shape[1])), np.empty((BUCKETS, 2 * self._bi.shape[1]), np.int64)
+            else:
+                self._hk, self._hi = np.empty(2 * self._hk.size), np.empty(2 * self._hi.size, np.int64)
+
+    def _flat(self, rows, cols):
+        return np.asarray(rows, np.int64) * self.shape[1] + np.asarray(cols, np.int64)
 
     def settled(self, rows, cols) -> np.ndarray:
-        return self.closed[rows, cols] == self.gen
+        return self.stamp[self._flat(rows, cols)] == 2 * self.gen + 1
 
     def lengths(self, rows, cols) -> np.ndarray:
         """Path length (cells) to each given cell, inf where it was not settled."""
-        return np.where(self.settled(rows, cols), self.length_[rows, cols], np.inf)
+        q = self._flat(rows, cols)
+        return np.where(self.stamp[q] == 2 * self.gen + 1, self.state[q, 1], np.inf)
 
     def costs(self, rows, cols) -> np.ndarray:
-        return np.where(self.settled(rows, cols), self.dist[rows, cols], np.inf)
+        q = self._flat(rows, cols)
+        return np.where(self.stamp[q] == 2 * self.gen + 1, self.state[q, 0], np.inf)
+
+    def length_grid(self) -> np.ndarray:
+        """(H, W) path length (cells) to every cell, inf where the last search did not settle it."""
+        done = self.stamp == 2 * self.gen + 1
+        return np.where(done, self.state[:, 1], np.inf).reshape(self.shape)
 
     def path(self, r, c):
         """Cells (rows, cols) from the source to (r, c), or None if (r, c) was not settled."""
-        if self.closed[r, c] != self.gen:
+        if not self.settled(r, c):
             return None
-        return backtrack(self.parent, r, c)
+        return backtrack(self.parent, self.shape[1], int(r), int(c))
 
 
 def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
@@ -351,19 +431,19 @@ def dijkstra(passable, cost, src_r, src_c, target, n_stop, max_cost):
     gs = GridSearch(passable.shape)
     tr, tc = np.nonzero(target)
     gs.run(passable, cost, src_r, src_c, tr, tc, n_stop, max_cost)
-    done = gs.closed == gs.gen
-    return np.where(done, gs.dist, np.inf), np.where(done, gs.length_, np.inf), np.where(done, gs.parent, -1)
+    done = (gs.stamp == 2 * gs.gen + 1).reshape(gs.shape)
+    return (np.where(done, gs.state[:, 0].reshape(gs.shape), np.inf), gs.length_grid(),
+            np.where(done, gs.parent.reshape(gs.shape), -1))
 
 
 @njit(cache=True)
-def backtrack(parent, r, c):
-    """Cells (rows, cols) from the Dijkstra source to (r, c), following ``parent``."""
-    W = parent.shape[1]
+def backtrack(parent, W, r, c):
+    """Cells (rows, cols) from the Dijkstra source to (r, c), following the flat ``parent``."""
     n = 0
     idx = r * W + c
     while idx >= 0:
         n += 1
-        idx = parent[idx // W, idx % W]
+        idx = parent[idx]
     rows = np.empty(n, np.int64)
     cols = np.empty(n, np.int64)
     idx = r * W + c
@@ -372,7 +452,7 @@ def backtrack(parent, r, c):
         rows[k] = idx // W
         cols[k] = idx % W
         k -= 1
-        idx = parent[idx // W, idx % W]
+        idx = parent[idx]
     return rows, cols
 
 

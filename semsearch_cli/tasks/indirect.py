@@ -97,8 +97,7 @@ class RoomGrid:
         r, c = min(max(r, 0), self.frame.height - 1), min(max(c, 0), self.frame.width - 1)
         self.search.run(self.stand, self.cost, r, c, np.zeros(0, np.int64), np.zeros(0, np.int64), 0)
         self.full_from = (r, c, self.search.gen)  # a whole-room search: path() can backtrack in it
-        done = self.search.closed == self.search.gen
-        return np.where(done, self.search.length_ * self.frame.res, np.inf)
+        return self.search.length_grid() * self.frame.res
 
     def path(self, x: float, y: float, tx: float, ty: float):
         """Waypoints (xs, ys) m from (x, y) to (tx, ty) over the standing cells, pulled taut by
@@ -541,8 +540,7 @@ class IndirectTask(Task):
                 self._views[key] = np.full(g.stand.shape, np.inf)
             else:
                 g.search.run(g.stand, g.cost, rr, cc, np.zeros(0, np.int64), np.zeros(0, np.int64), 0)
-                done = g.search.closed == g.search.gen
-                self._views[key] = np.where(done, g.search.length_ * fr.res, np.inf)
+                self._views[key] = g.search.length_grid() * fr.res
         return self._views[key]
 
     def shortest_of(self, k: int, scale: float, x: float | None = None, y: float | None = None) -> float:
