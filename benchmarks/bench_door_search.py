@@ -4,7 +4,9 @@ Measures (medians of repeated runs, with ratios against baselines timed in the s
   1. one run each of greedy and nsos (alpha 0.9), Hotel goal 148, seed 0, under each re-planning
      policy (``--replan periodic,events``, navigation.replan): wall time and seconds
      per 300 m travelled; the baseline is the sensing-only loop (laser + HIMM + door cameras +
-     visited kernel) over the same poses, i.e. the floor any planner pays;
+     visited kernel) over the same poses, i.e. the floor any planner pays, and what a decision
+     costs beyond it (the run's median less the baseline's, over the decisions: belief upkeep,
+     candidates, the planner, the path and the loop between two decisions);
   2. whole Hotel tables with 2 workers: 4 goals x greedy and bvp x 10 seeds, and 4 goals x
      greedy and nsos at alpha 0.8, 0.9, 1.0 x 10 seeds;
   3. navigators: path lengths of the geodesic and the harmonic navigator between random pairs of
@@ -147,6 +149,7 @@ def main() -> int:
             say(f"distance {res.distance_m:.1f} m, {res.steps} steps, {res.decisions} decisions, outcome {res.outcome}")
             say(f"median wall {med:.3f} s (min {min(walls):.3f}, max {max(walls):.3f}) = {med / res.distance_m * 300:.2f} s per 300 m (target <= 1.5)")
             say(f"sensing-only baseline over the same poses: median {bmed:.3f} s; run / baseline = {med / bmed:.2f} (target <= 1.5)")
+            say(f"a decision beyond sensing, (run - baseline) / decisions: {(med - bmed) / res.decisions * 1000:.2f} ms")
             say()
     # 2. navigators
     b = known_belief(L)
