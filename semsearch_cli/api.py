@@ -36,7 +36,7 @@ from .tasks.decisions import Seat
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import check_outputs, inside, output_file, output_folder, temp_path
-from . import bench, shipped
+from . import bench, ros2, shipped
 from .shipped import scenario_file
 
 
@@ -151,6 +151,43 @@ class VerifyOutput:
     verdict: Verdict
 
 
+def _rows_scenario(folder: Path, scenario: str | Path | None) -> tuple[Path, Loaded]:
+    """The scenario a results folder's rows were made with, loaded without planners: ``scenario``
+    when given, else the one meta.json names, with the parameter a sweep set in that folder."""
+    if not (folder / "runs.csv").is_file():
+        raise ScenarioError(str(folder), "", "no runs.csv here: give a folder written by `semsearch run`")
+    meta = report_build.read_meta(folder)
+    if scenario is None:
+        path = report_build.scenario_of(folder, meta)
+        path = path.resolve() if path is not None else None
+        if path is None:
+            raise ScenarioError(str(folder / "meta.json"), "scenario", "names no scenario file that exists; give the "
+                                "scenario the rows were made with, --scenario FILE")
+    else:
+        path = scenario_file(scenario)
+    varied = meta.get("varied")  # a sweep's value: its parameter set as the sweep set it
+    if isinstance(varied, dict) and isinstance(varied.get("param"), str):
+        return path, Loaded.load(path, with_param(read_yaml(path), varied["param"], varied.get("value"), path), planners=False)
+    return path, Loaded.load(path, planners=False)
+
+
+def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | None = None,
+           scenario: str | Path | None = None) -> list:
+    """Every door-search run of a results folder recorded with ``--decisions`` (or the one named
+    ``run``, its record's file stem) as a ROS 2 bag folder ``out/<run>`` (``fmt``: ``mcap`` or
+    ``rosbag2``, SQLite 3), replayed from its decisions (:mod:`semsearch_cli.ros2`; the ``ros``
+    extra). Runs whose bag exists already are kept. Returns the
+    :class:`~semsearch_cli.ros2.Exported` runs."""
+    if fmt not in ros2.FORMATS:
+        raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
+    if not ros2.available():
+        raise ScenarioError("<command line>", "export", "needs the ros extra (rosbags, mcap): pip install 'semsearch[ros]'")
+    folder = Path(folder)
+    _, loaded = _rows_scenario(folder, scenario)
+    with folder_lock(Path(out)):
+        return ros2.export_folder(loaded, folder, Path(out), fmt, run)
+
+
 def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None,
            salt_file: str | Path | None = None) -> VerifyOutput:
     """Replay every run of a results folder that has a decisions record (``run --decisions``)
@@ -172,22 +209,7 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
         return _verify_bench(folder, salt_file, progress, workers)
     if salt_file is not None:
         raise ScenarioError("<command line>", "--salt-file", f"{folder} is not a bench folder (no bench.json)")
-    if not (folder / "runs.csv").is_file():
-        raise ScenarioError(str(folder), "", "no runs.csv here: give a folder written by `semsearch run`")
-    meta = report_build.read_meta(folder)
-    if scenario is None:
-        path = report_build.scenario_of(folder, meta)
-        path = path.resolve() if path is not None else None
-        if path is None:
-            raise ScenarioError(str(folder / "meta.json"), "scenario", "names no scenario file that exists; give the "
-                                "scenario the rows were made with, --scenario FILE")
-    else:
-        path = scenario_file(scenario)
-    varied = meta.get("varied")  # a sweep's value: its parameter set as the sweep set it
-    if isinstance(varied, dict) and isinstance(varied.get("param"), str):
-        loaded = Loaded.load(path, with_param(read_yaml(path), varied["param"], varied.get("value"), path), planners=False)
-    else:
-        loaded = Loaded.load(path, planners=False)
+    path, loaded = _rows_scenario(folder, scenario)
     verdict = verify_folder(folder, loaded, progress, workers_for(workers))
     if not verdict.verified and not verdict.failed:
         raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "

@@ -391,6 +391,30 @@ def verify(
 
 
 @app.command()
+def export(
+    folder: Path = typer.Argument(..., help="A results folder with decisions/ (`semsearch run --decisions`)."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="Folder for the bags: one ROS 2 bag folder per run."),
+    fmt: str = typer.Option("mcap", "--format", help="mcap (one .mcap file, opens in Foxglove) or rosbag2 (SQLite 3)."),
+    run_id: Optional[str] = typer.Option(None, "--run", help="Only this run: its decisions file's name without .json "
+                                         "(e.g. greedy__goal304__ep0__seed0)."),
+    scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the rows were made with (default: the one "
+                                            "meta.json names)."),
+):
+    """Write recorded door-search runs as ROS 2 bags (the ros extra): the belief map, pose and /tf,
+    laser, path, signs read, frontier candidates and each decision's target, on the topics of
+    docs/robot.md. Each run is replayed from its decisions; a bag already written is kept."""
+
+    try:
+        done = api.export(folder, out_dir, fmt, run_id, scenario)
+    except ScenarioError as exc:
+        _fail(exc)
+    for d in done:
+        out.print(f"{d.folder}: {d.outcome}, {d.distance_m:.1f} m, {d.decisions} decisions, {d.messages} messages, "
+                  f"{d.size / 1e6:.2f} MB")
+    out.print(f"{len(done)} bag(s) written to {out_dir} ({fmt})")
+
+
+@app.command()
 def validate(scenario: Path = SCENARIO):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""
 

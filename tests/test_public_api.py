@@ -39,6 +39,7 @@ API = {
     "default_out": ["loaded", "out"],
     "init": ["name", "folder", "force"],
     "verify": ["folder", "scenario", "progress", "workers", "salt_file"],
+    "export": ["folder", "out", "fmt", "run", "scenario"],
     "bench_run": ["suite", "planners", "out", "split", "numbering", "options", "limit", "salt_file", "planner_file", "progress"],
     "bench_list": [],
     "bench_hash": ["suite", "split", "salt_file"],

@@ -56,22 +56,31 @@ DOOR_CODEC = Codec(_encode, _decode)
 
 
 class DoorSensing:
-    """Laser into HIMM and door cameras into reads, shared by the searches of this task."""
+    """Laser into HIMM and door cameras into reads, shared by the searches of this task. An
+    observer that asks for steps (``Observer.steps``) sees a :class:`DoorStep` after each step's
+    belief update."""
+
+    observer: Observer | None = None
 
     def __init__(self, task: "DoorTask", goal, rng: np.random.Generator):
         self.task, self.goal, self.rng = task, goal, rng
         self.goal_idx = set(task.world.signs.indices_of(goal))  # more than one under duplicates: any
+        self._frame_reads: list = []  # (sign index, label) read since the last step shown to a stepping observer
+        self._scan = None  # the last laser scan (beam angles rad, ranges cells, hit flags)
 
     def sense(self, st: RobotState) -> tuple[bool, bool]:
         """(goal read, a sign reached min_reads)."""
         t, b, fr = self.task, st.belief, self.task.world.frame
         v, u, r, c = fr.point_to_cell(st.x, st.y)
-        b.fold_scan(v, u, *t.laser.scan(v, u, st.heading, self.rng))
+        scan = t.laser.scan(v, u, st.heading, self.rng)
+        b.fold_scan(v, u, *scan)
+        self._scan = scan
         min_reads = b.spec.min_reads
         b.views.append((v, u, st.heading))
         found = event = False
         for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
             st.read_signs[i] = label
+            self._frame_reads.append((i, label))
             if i in self.goal_idx and label == self.goal:
                 found = True
             if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:
@@ -82,6 +91,35 @@ class DoorSensing:
         _, _, r, c = self.task.world.frame.point_to_cell(st.x, st.y)
         st.belief.visit(r, c)
         st.headings.append(st.heading)
+        if self.observer is not None and self.observer.steps:
+            self.observer.see(DoorStep(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=st.belief,
+                                       reads=tuple(self._frame_reads), scan=self._scan))
+        self._frame_reads.clear()
+
+
+@dataclass(frozen=True, kw_only=True)
+class DoorStep(Event):
+    """One step of a door search, shown to observers that ask for steps: the pose (``x``, ``y``
+    m, ``heading`` rad) after ``step`` steps, the belief as it is now (``belief``: copy what you
+    keep) and the signs read since the last step, [(sign index, label)] (turning on the spot
+    senses several frames in one step: their reads are all here); ``scan``: the step's laser
+    scan, (beam angles rad in the world, ranges in cells, hit flags). Not traced."""
+
+    step: int
+    x: float
+    y: float
+    heading: float
+    belief: DoorBelief
+    reads: tuple = ()
+    scan: tuple | None = None
+
+    @property
+    def traced(self) -> bool:
+        return False
+
+    def row(self) -> dict:
+        return {"step": self.step, "x": round(float(self.x), 3), "y": round(float(self.y), 3),
+                "heading_deg": round(float(np.degrees(self.heading)), 1), "reads": [[int(i), str(v)] for i, v in self.reads]}
 
 
 @dataclass(frozen=True, kw_only=True)

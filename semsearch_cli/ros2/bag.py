@@ -1,0 +1,171 @@
+"""ROS 2 messages of a door search, and the bag they are written to (`rosbags`, pure Python: no
+ROS install). Topics, types and frames are :data:`TOPICS` (docs/robot.md lists them).
+
+Frames: ``map`` (the world's metres: x right, y up) and ``base_link`` (the robot, x ahead);
+``/tf`` carries map -> base_link at every step. Stamps are simulated time: step k at
+``1 + k * step / SPEED`` seconds (a run has no clock of its own; ``SPEED`` is a Pioneer's cruise).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..optional import lazy_module
+
+typesys = lazy_module("rosbags.typesys")  # optional: pip install 'semsearch[ros]'
+rosbag2 = lazy_module("rosbags.rosbag2")
+
+SPEED = 0.5  # m/s: the simulated clock's robot speed (stamps only)
+START_NS = 1_000_000_000  # the first step's stamp (1 s: some tools read 0 as "no stamp")
+
+# topic -> (message type, when it is published, what it holds)
+TOPICS = {
+    "/map": ("nav_msgs/msg/OccupancyGrid", "at the start, at each decision and at the end",
+             "the belief: -1 never seen, 0 free, 100 occupied, over the bounding box of what was seen"),
+    "/scan": ("sensor_msgs/msg/LaserScan", "every step", "the laser scan folded into the belief (m; +inf: no return)"),
+    "/tf": ("tf2_msgs/msg/TFMessage", "every step", "map -> base_link"),
+    "/semsearch/pose": ("geometry_msgs/msg/PoseStamped", "every step", "the robot's pose in map"),
+    "/semsearch/path": ("nav_msgs/msg/Path", "at the first decision after each 5 m travelled, and at the end",
+                        "the path travelled so far, a pose every 0.5 m"),
+    "/semsearch/detections": ("std_msgs/msg/String", "each sign read",
+                              'JSON {"label", "x", "y", "facing"}: the sign read (m, rad) and its label as read'),
+    "/semsearch/signs": ("visualization_msgs/msg/MarkerArray", "when a sign is read for the first time, and at the start",
+                         "every sign read so far as a text marker (its label), the goal's number at the top left"),
+    "/explore/frontiers": ("visualization_msgs/msg/MarkerArray", "at each decision",
+                           "the frontier candidates (spheres, as explore_lite publishes its frontiers)"),
+    "/semsearch/goal": ("geometry_msgs/msg/PoseStamped", "at each decision", "the chosen target, facing along its branch"),
+    "/semsearch/decision": ("std_msgs/msg/String", "at each decision", "JSON: the decision's row (as --trace writes it)"),
+}
+FORMATS = {"mcap": "MCAP", "rosbag2": "SQLITE3"}  # --format -> rosbags' storage plugin
+
+
+def stamp_ns(step: int, step_m: float) -> int:
+    """The stamp (ns) of step ``step`` of a run whose steps are ``step_m`` metres."""
+    return START_NS + int(round(step * step_m / SPEED * 1e9))
+
+
+class Messages:
+    """Builds the messages of :data:`TOPICS` (rosbags' ROS 2 Humble types)."""
+
+    def __init__(self):
+        self.ts = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
+        self.T = self.ts.types
+
+    def serialize(self, msg) -> bytes:
+        return self.ts.serialize_cdr(msg, msg.__msgtype__)
+
+    # -- parts -------------------------------------------------------------------------
+    def header(self, t_ns: int, frame: str = "map"):
+        return self.T["std_msgs/msg/Header"](stamp=self._time(t_ns), frame_id=frame)
+
+    def _time(self, t_ns: int):
+        return self.T["builtin_interfaces/msg/Time"](sec=int(t_ns // 1_000_000_000), nanosec=int(t_ns % 1_000_000_000))
+
+    def pose(self, x: float, y: float, yaw: float):
+        P = self.T
+        return P["geometry_msgs/msg/Pose"](position=P["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=0.0),
+                                           orientation=self._quat(yaw))
+
+    def _quat(self, yaw: float):
+        return self.T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+
+    # -- messages ----------------------------------------------------------------------
+    def pose_stamped(self, t_ns: int, x: float, y: float, yaw: float):
+        return self.T["geometry_msgs/msg/PoseStamped"](header=self.header(t_ns), pose=self.pose(x, y, yaw))
+
+    def tf(self, t_ns: int, x: float, y: float, yaw: float):
+        P = self.T
+        tr = P["geometry_msgs/msg/Transform"](translation=P["geometry_msgs/msg/Vector3"](x=float(x), y=float(y), z=0.0),
+                                              rotation=self._quat(yaw))
+        ts = P["geometry_msgs/msg/TransformStamped"](header=self.header(t_ns), child_frame_id="base_link", transform=tr)
+        return P["tf2_msgs/msg/TFMessage"](transforms=[ts])
+
+    def grid(self, t_ns: int, seen: np.ndarray, free: np.ndarray, frame) -> object:
+        """The belief over the bounding box of the seen cells (the whole grid's first cell when
+        none is), rows flipped to ROS's order (row 0 at the lowest y)."""
+        rr, cc = np.nonzero(seen)
+        r0, r1, c0, c1 = (int(rr.min()), int(rr.max()) + 1, int(cc.min()), int(cc.max()) + 1) if rr.size else (0, 1, 0, 1)
+        s, f = seen[r0:r1, c0:c1], free[r0:r1, c0:c1]
+        data = np.where(s, np.where(f, 0, 100), -1).astype(np.int8)[::-1]
+        x0 = frame.origin_x + c0 * frame.res
+        y0 = frame.origin_y + (frame.height - r1) * frame.res
+        P = self.T
+        info = P["nav_msgs/msg/MapMetaData"](map_load_time=self._time(t_ns), resolution=float(frame.res),
+                                             width=int(c1 - c0), height=int(r1 - r0), origin=self.pose(x0, y0, 0.0))
+        return P["nav_msgs/msg/OccupancyGrid"](header=self.header(t_ns), info=info, data=np.ascontiguousarray(data).ravel())
+
+    def scan(self, t_ns: int, thetas: np.ndarray, dist_cells: np.ndarray, hit: np.ndarray, heading: float, res: float,
+             max_range: float):
+        """The scan in base_link: beams evenly spaced from ``thetas[0]`` (world) relative to the
+        heading, ranges in m, +inf where a beam returned nothing."""
+        rel = np.asarray(thetas, float) - heading
+        inc = float(rel[1] - rel[0]) if rel.size > 1 else 0.0
+        ranges = np.where(np.asarray(hit, bool), np.asarray(dist_cells, float) * res, np.inf).astype(np.float32)
+        return self.T["sensor_msgs/msg/LaserScan"](header=self.header(t_ns, "base_link"), angle_min=float(rel[0]),
+                                                   angle_max=float(rel[-1]), angle_increment=inc, time_increment=0.0,
+                                                   scan_time=0.0, range_min=0.0, range_max=float(max_range), ranges=ranges,
+                                                   intensities=np.zeros(0, np.float32))
+
+    def path(self, t_ns: int, trail) -> object:
+        xy = np.asarray(trail, float).reshape(-1, 2)
+        poses = []
+        for k in range(len(xy)):
+            yaw = math.atan2(xy[k, 1] - xy[k - 1, 1], xy[k, 0] - xy[k - 1, 0]) if k else 0.0
+            poses.append(self.pose_stamped(t_ns, xy[k, 0], xy[k, 1], yaw))
+        return self.T["nav_msgs/msg/Path"](header=self.header(t_ns), poses=poses)
+
+    def string(self, obj) -> object:
+        return self.T["std_msgs/msg/String"](data=json.dumps(obj, separators=(",", ":")))
+
+    def marker(self, t_ns: int, ns: str, mid: int, kind: str, x: float, y: float, rgba, scale: float, text: str = ""):
+        P = self.T
+        M = P["visualization_msgs/msg/Marker"]
+        return M(header=self.header(t_ns), ns=ns, id=int(mid), type=getattr(M, kind), action=M.ADD, pose=self.pose(x, y, 0.0),
+                 scale=P["geometry_msgs/msg/Vector3"](x=scale, y=scale, z=scale),
+                 color=P["std_msgs/msg/ColorRGBA"](r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3]),
+                 lifetime=P["builtin_interfaces/msg/Duration"](sec=0, nanosec=0), frame_locked=False, points=[], colors=[],
+                 texture_resource="", texture=P["sensor_msgs/msg/CompressedImage"](header=self.header(t_ns), format="",
+                                                                                     data=np.zeros(0, np.uint8)),
+                 uv_coordinates=[], text=text, mesh_resource="",
+                 mesh_file=P["visualization_msgs/msg/MeshFile"](filename="", data=np.zeros(0, np.uint8)),
+                 mesh_use_embedded_materials=False)
+
+    def delete_all(self, t_ns: int, ns: str):
+        M = self.T["visualization_msgs/msg/Marker"]
+        m = self.marker(t_ns, ns, 0, "SPHERE", 0.0, 0.0, (0.0, 0.0, 0.0, 0.0), 0.1)
+        m.action = M.DELETEALL
+        return m
+
+    def markers(self, items) -> object:
+        return self.T["visualization_msgs/msg/MarkerArray"](markers=list(items))
+
+
+class BagWriter:
+    """A ROS 2 bag folder (``metadata.yaml`` and one storage file: MCAP or SQLite 3) written with
+    rosbags, zstd-compressed (MCAP's chunks, or each SQLite message), one connection per topic of
+    :data:`TOPICS` as it is first written."""
+
+    def __init__(self, out: Path, fmt: str, messages: Messages):
+        self.msgs = messages
+        plugin = getattr(rosbag2.StoragePlugin, FORMATS[fmt])
+        self.writer = rosbag2.Writer(Path(out), version=rosbag2.Writer.VERSION_LATEST if hasattr(rosbag2.Writer, "VERSION_LATEST") else 9,
+                                     storage_plugin=plugin)
+        mode = rosbag2.CompressionMode.STORAGE if fmt == "mcap" else rosbag2.CompressionMode.MESSAGE
+        self.writer.set_compression(mode, rosbag2.CompressionFormat.ZSTD)
+        self.writer.open()
+        self.conns: dict = {}
+        self.count = 0
+
+    def write(self, topic: str, t_ns: int, msg) -> None:
+        conn = self.conns.get(topic)
+        if conn is None:
+            conn = self.conns[topic] = self.writer.add_connection(topic, TOPICS[topic][0], typestore=self.msgs.ts)
+        self.writer.write(conn, int(t_ns), self.msgs.serialize(msg))
+        self.count += 1
+
+    def close(self) -> None:
+        self.writer.close()

@@ -1,0 +1,230 @@
+"""A recorded door-search run as a ROS 2 bag (``semsearch export``).
+
+The run is replayed from its decisions record (``semsearch run --decisions``; no planner is built,
+as ``semsearch verify`` does) with an observer that sees every step (:class:`BagRecorder`), so the
+bag holds the whole run at the simulator's resolution whatever the frames file kept; the replay
+must give the row's outcome, distance and steps, or nothing is written.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import PlannerError, ScenarioError, did_you_mean
+from ..planners import Variant
+from ..runner.specs import Loaded, file_stem
+from ..runner.store import read_decisions, read_runs
+from ..tasks.base import Observer
+from ..tasks.decisions import Replay, ReplayError
+from ..tasks.doors import DoorDecision, DoorStep
+from .bag import BagWriter, Messages, stamp_ns
+
+SIGN_RGBA = (0.1, 0.3, 0.9, 1.0)
+GOAL_RGBA = (0.9, 0.1, 0.1, 1.0)
+CAND_RGBA = (1.0, 0.6, 0.0, 0.9)
+PATH_EVERY_M = 5.0  # /semsearch/path at the first decision after each 5 m of travel (and at the end)
+PATH_STEP_M = 0.5  # its poses, one every 0.5 m
+
+
+class BagRecorder(Observer):
+    """Writes a door search's steps and decisions to a :class:`BagWriter` as they happen (topics
+    :data:`~semsearch_cli.ros2.bag.TOPICS`)."""
+
+    steps = True
+
+    def __init__(self, bag: BagWriter, world, goal, step_m: float, max_range: float):
+        self.bag, self.m = bag, bag.msgs
+        self.world, self.frame, self.goal = world, world.frame, goal
+        self.step_m, self.max_range = step_m, max_range
+        self.t = stamp_ns(0, step_m)
+        self.read: dict[int, str] = {}  # sign index -> label as first read
+        self.belief = None
+        self.trail: list = []
+        self.decisions = 0
+        self.path_at = -PATH_EVERY_M  # distance (m) at the last /semsearch/path
+
+    def see(self, event) -> None:
+        if isinstance(event, DoorStep):
+            self._step(event)
+        elif isinstance(event, DoorDecision):
+            self._decision(event)
+
+    def _step(self, e: DoorStep) -> None:
+        t = self.t = stamp_ns(e.step, self.step_m)
+        first = self.belief is None
+        self.belief = e.belief
+        self.trail.append((float(e.x), float(e.y)))
+        self.bag.write("/tf", t, self.m.tf(t, e.x, e.y, e.heading))
+        self.bag.write("/semsearch/pose", t, self.m.pose_stamped(t, e.x, e.y, e.heading))
+        if e.scan is not None:
+            self.bag.write("/scan", t, self.m.scan(t, *e.scan, e.heading, self.frame.res, self.max_range))
+        signs = self.world.signs
+        new = False
+        for i, label in e.reads:
+            i = int(i)
+            self.bag.write("/semsearch/detections", t, self.m.string({"label": str(label), "x": float(signs.x[i]),
+                                                                      "y": float(signs.y[i]), "facing": float(signs.facing[i])}))
+            if i not in self.read:
+                self.read[i] = str(label)
+                new = True
+        if first:
+            self.bag.write("/map", t, self.m.grid(t, e.belief.seen, e.belief.free, self.frame))
+        if new or first:
+            self._signs(t)
+
+    def _signs(self, t: int) -> None:
+        s = self.world.signs
+        items = [self.m.marker(t, "signs", i, "TEXT_VIEW_FACING", s.x[i], s.y[i], SIGN_RGBA, 0.4, label)
+                 for i, label in sorted(self.read.items())]
+        x0 = self.frame.origin_x
+        y1 = self.frame.origin_y + self.frame.height * self.frame.res
+        items.append(self.m.marker(t, "goal", 0, "TEXT_VIEW_FACING", x0 + 1.0, y1 - 1.0, GOAL_RGBA, 0.8, f"goal {self.goal}"))
+        self.bag.write("/semsearch/signs", t, self.m.markers(items))
+
+    def _decision(self, e: DoorDecision) -> None:
+        t = self.t
+        self.decisions += 1
+        b, c = e.belief, e.candidates
+        self.bag.write("/map", t, self.m.grid(t, b.seen, b.free, self.frame))
+        if e.distance - self.path_at >= PATH_EVERY_M:
+            self.path_at = e.distance
+            self.bag.write("/semsearch/path", t, self.m.path(t, self._thinned()))
+        cx, cy = self.frame.to_world(c.rows, c.cols)
+        chosen = np.flatnonzero((c.rows == e.decision.row) & (c.cols == e.decision.col))
+        items = [self.m.delete_all(t, "frontiers")]
+        items += [self.m.marker(t, "frontiers", k, "SPHERE", cx[k], cy[k], GOAL_RGBA if k in chosen else CAND_RGBA,
+                                0.5 if k in chosen else 0.35) for k in range(len(c))]
+        self.bag.write("/explore/frontiers", t, self.m.markers(items))
+        yaw = float(c.theta[chosen[0]]) if chosen.size else 0.0
+        self.bag.write("/semsearch/goal", t, self.m.pose_stamped(t, *e.target_xy, yaw))
+        self.bag.write("/semsearch/decision", t, self.m.string(_jsonable(e.row())))
+
+    def _thinned(self) -> list:
+        """The path so far, one pose every ``PATH_STEP_M`` of travel (its last pose kept): a
+        whole path at every decision would grow with the square of the run's length."""
+        k = max(1, int(round(PATH_STEP_M / self.step_m)))
+        return self.trail[::k] + ([self.trail[-1]] if (len(self.trail) - 1) % k else [])
+
+    def finish(self) -> None:
+        """The map and the path as the run ended."""
+        if self.belief is not None:
+            self.bag.write("/map", self.t, self.m.grid(self.t, self.belief.seen, self.belief.free, self.frame))
+            self.bag.write("/semsearch/path", self.t, self.m.path(self.t, self._thinned()))
+
+
+def _jsonable(v):
+    if isinstance(v, dict):
+        return {str(k): _jsonable(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, (np.floating, float)):
+        return None if not math.isfinite(float(v)) else float(v)
+    if isinstance(v, (np.integer, np.bool_)):
+        return v.item()
+    return v
+
+
+@dataclass
+class Exported:
+    """One run written as a bag: its name (the record's file stem), the bag folder, its size in
+    bytes, messages, decisions, and the row it replayed to."""
+
+    name: str
+    folder: Path
+    size: int
+    messages: int
+    decisions: int
+    outcome: str
+    distance_m: float
+
+
+def recorded_runs(folder: Path) -> list[tuple[str, dict, Path]]:
+    """(name, the run's row, its decisions record) of every door-search run of a results folder
+    that has a record (``semsearch run --decisions``); chain stages are left out (a chain's
+    run is exported as its first stage's search is not: one search per bag)."""
+    rows = read_runs(folder / "runs.csv", as_written=True)
+    out = []
+    for row in rows[rows["stage"] == ""].to_dict("records"):
+        name = file_stem(str(row["planner"]), row["goal"], int(row["seed"]), int(row["episode"]))
+        f = folder / "decisions" / f"{name}.json"
+        if f.is_file():
+            out.append((name, row, f))
+    return out
+
+
+def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Path, fmt: str) -> Exported:
+    """Replay one recorded run into a bag folder ``out`` (which must not exist); a
+    :class:`ScenarioError` when the run is not a door search's or does not replay to its row."""
+    task = loaded.task
+    if task.kind != "doors":
+        raise ScenarioError(str(loaded.path), "kind", f"is {task.kind}: only door-search runs export as bags so far")
+    record = read_decisions(record_file)
+    episodes = {(str(e.goal), e.index): e for e in task.episodes}
+    ep = episodes.get((str(row["goal"]), int(row["episode"])))
+    if ep is None:
+        raise ScenarioError(str(record_file), "episode", f"the scenario has no episode {row['episode']} of goal {row['goal']}")
+    work = out.with_name(f".{out.name}.partial")  # the bag is written here, then moved into place whole
+    if work.exists():
+        shutil.rmtree(work)
+    work.mkdir(parents=True)
+    tmp = work / out.name  # rosbags names the storage file after its folder
+    bag = BagWriter(tmp, fmt, Messages())
+    rec = BagRecorder(bag, loaded.world, ep.goal, loaded.sc.robot.step, loaded.sc.laser.range)
+    try:
+        replay = Replay(record)
+        res = task.run(Variant(str(row["planner"]), ()), ep, int(row["seed"]), observer=rec, seat=replay)
+        replay.finish()
+        rec.finish()
+    except (ReplayError, PlannerError, ScenarioError) as exc:
+        _drop(bag, work)
+        raise ScenarioError(str(record_file), "decisions", f"does not replay: {exc}") from None
+    except Exception as exc:  # noqa: BLE001  a recorded choice the run could not take: named, never a traceback
+        _drop(bag, work)
+        raise ScenarioError(str(record_file), "decisions", f"does not replay: {type(exc).__name__}: {str(exc)[:120]}") from None
+    bag.close()
+    got = (res.outcome, res.distance_m, res.steps)
+    want = (str(row["outcome"]), float(row["distance_m"]), int(row["steps"]))
+    if got[0] != want[0] or round(got[1], 3) != round(want[1], 3) or got[2] != want[2]:
+        shutil.rmtree(work, ignore_errors=True)
+        raise ScenarioError(str(record_file), "decisions", f"replays to {got[0]}, {got[1]:.3f} m, {got[2]} steps, not the row's "
+                            f"{want[0]}, {want[1]:.3f} m, {want[2]} steps (another scenario than the one it was run with?)")
+    tmp.rename(out)
+    work.rmdir()
+    size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    return Exported(name, out, size, bag.count, rec.decisions, res.outcome, float(res.distance_m))
+
+
+def _drop(bag: BagWriter, work: Path) -> None:
+    """Close and remove a bag that will not be kept."""
+    try:
+        bag.close()
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def export_folder(loaded: Loaded, folder: Path, out: Path, fmt: str, run: str | None = None) -> list[Exported]:
+    """Every recorded run of ``folder`` (or the one named ``run``: its decisions file's stem) as a
+    bag folder ``out/<run>``; runs whose bag exists already are left as they are."""
+    runs = recorded_runs(folder)
+    if not runs:
+        raise ScenarioError(str(folder / "decisions"), "", "no run of this folder has a decisions record: run it with "
+                            "--decisions (`semsearch run SCENARIO --decisions --out DIR`)")
+    if run is not None:
+        named = [r for r in runs if r[0] == run]
+        if not named:
+            raise ScenarioError("<command line>", "--run", f"no recorded run {run!r} in {folder}{did_you_mean(run, [r[0] for r in runs])} "
+                                f"({len(runs)} recorded: the names of {folder / 'decisions'}'s files without .json)")
+        runs = named
+    out.mkdir(parents=True, exist_ok=True)
+    done = []
+    for name, row, f in runs:
+        target = out / name
+        if target.exists():
+            continue
+        done.append(export_run(loaded, name, row, f, target, fmt))
+    return done
