@@ -188,6 +188,34 @@ def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | No
         return ros2.export_folder(loaded, folder, Path(out), fmt, run)
 
 
+def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | Path | None = None, fmt: str = "mcap",
+               planner_file: str | Path | None = None):
+    """Run a door planner (``NAME`` or ``NAME[key=value,...]``) over a bag ``semsearch export``
+    wrote, asked at each of the bag's re-plans, and write its decisions as a new bag folder ``out``
+    (:func:`~semsearch_cli.ros2.replay_bag`; the ``ros`` extra). ``scenario``: the scenario the bag
+    was recorded on (default: the shipped scenario the bag names). Returns the
+    :class:`~semsearch_cli.ros2.Replayed`."""
+    if fmt not in ros2.FORMATS:
+        raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
+    if not ros2.available():
+        raise ScenarioError("<command line>", "ros replay", "needs the ros extra (rosbags, mcap): pip install 'semsearch[ros]'")
+    bag = Path(bag)
+    if not bag.is_dir():
+        raise ScenarioError(str(bag), "", "no such bag folder (a ROS 2 bag is a folder with metadata.yaml)")
+    if scenario is None:
+        name = ros2.recorded_scenario(bag)
+        if name is None or name not in shipped.names():
+            raise ScenarioError(str(bag), "/semsearch/setup", f"names the scenario {name!r}, which is not a shipped one: give "
+                                "the scenario the bag was recorded on, --scenario FILE")
+        scenario = name
+    loaded = Loaded.load(scenario_file(scenario), planners=False)
+    variants = expand_variants([planner_spec(planner, planner_file)], "<command line>", loaded.task.planner_kind)
+    if len(variants) != 1:
+        raise ScenarioError("<command line>", "--planner", f"{planner!r} names {len(variants)} variants: give one value per "
+                            "parameter")
+    return ros2.replay_bag(loaded, bag, variants[0], Path(out), fmt)
+
+
 def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None,
            salt_file: str | Path | None = None) -> VerifyOutput:
     """Replay every run of a results folder that has a decisions record (``run --decisions``)

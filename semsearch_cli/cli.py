@@ -414,6 +414,32 @@ def export(
     out.print(f"{len(done)} bag(s) written to {out_dir} ({fmt})")
 
 
+ros_app = typer.Typer(no_args_is_help=True, help="Door planners over ROS 2 bags (the ros extra; docs/robot.md).")
+app.add_typer(ros_app, name="ros")
+
+
+@ros_app.command("replay")
+def ros_replay(
+    bag: Path = typer.Argument(..., help="A bag folder `semsearch export` wrote."),
+    planner: str = typer.Option(..., "--planner", help="The door planner to ask: NAME or NAME[key=value,...], e.g. nsos[alpha=0.9]."),
+    out_dir: str = typer.Option(..., "--out", callback=_path, help="The new bag folder for its decisions (must not exist)."),
+    scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the bag was recorded on (default: the "
+                                            "shipped scenario the bag names)."),
+    fmt: str = typer.Option("mcap", "--format", help="mcap or rosbag2 (SQLite 3), for the new bag."),
+    planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner."),
+):
+    """Ask a door planner where it would go at each re-plan of a recorded bag, the robot moving as it
+    moved, and write its answers (/semsearch/goal, /explore/frontiers, /semsearch/decision) to a new
+    bag. The run's own planner makes the run's decisions, decision for decision."""
+
+    try:
+        res = api.ros_replay(bag, planner, out_dir, scenario, fmt, planner_file)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"{res.folder}: {len(res.decisions)} decisions of {planner} over {bag}"
+              f"{' (the goal was read in the bag)' if res.found else ''}")
+
+
 @app.command()
 def validate(scenario: Path = SCENARIO):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""

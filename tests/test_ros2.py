@@ -11,14 +11,16 @@ from typer.testing import CliRunner
 pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed")
 mcap_reader = pytest.importorskip("mcap.reader", reason="the ros extra (mcap) is not installed")
 from rosbags.rosbag2 import Reader  # noqa: E402
-from rosbags.typesys import Stores, get_typestore  # noqa: E402
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore  # noqa: E402
 
 from semsearch_cli.cli import app  # noqa: E402
 from semsearch_cli.planners import Variant  # noqa: E402
 from semsearch_cli.ros2 import TOPICS  # noqa: E402
+from semsearch_cli.ros2.bag import BagWriter, Messages  # noqa: E402
 from semsearch_cli.runner import BatchOptions, Loaded, RunSpec, run_batch  # noqa: E402
 from semsearch_cli.tasks import TASKS  # noqa: E402
 from semsearch_cli.tasks.base import Observer  # noqa: E402
+from semsearch_cli.tasks.doors import DoorFrame  # noqa: E402
 from semsearch_cli.tasks.decisions import Replay  # noqa: E402
 from semsearch_cli.runner.store import read_decisions  # noqa: E402
 
@@ -38,26 +40,30 @@ def recorded(tmp_path_factory):
 
 
 def messages(bag):
-    """{topic: [(stamp ns, message)]} of a bag folder."""
+    """{topic: [(stamp ns, message)]} of a bag folder, decoded with the definitions the bag
+    carries (a type outside rosbags' Humble store, map_msgs's, from the bag alone)."""
     out = {}
     with Reader(bag) as r:
+        for c in r.connections:
+            if c.msgtype not in TS.types:
+                TS.register(get_types_from_msg(c.msgdef.data, c.msgtype))
         for c, t, raw in r.messages():
             out.setdefault(c.topic, []).append((t, TS.deserialize_cdr(raw, c.msgtype)))
     return out
 
 
 class Final(Observer):
-    """The belief and reads as a run ends (the last step it shows)."""
+    """The frames of a run (the last one's belief is the run's last) and its reads."""
 
     steps = True
 
     def __init__(self):
-        self.last = None
+        self.frames = []
         self.reads = []
 
     def see(self, event):
-        if hasattr(event, "reads") and hasattr(event, "scan"):
-            self.last = event
+        if isinstance(event, DoorFrame):
+            self.frames.append(event)
             self.reads += list(event.reads)
 
 
@@ -73,46 +79,56 @@ def test_a_run_exports_as_a_bag_that_reads_back_step_for_step(recorded, fmt):
     got = messages(bag)
     assert set(got) == set(TOPICS)
     steps, decisions = int(row["steps"]), int(row["decisions"])
-    # every step (the start's frame too) has its pose, /tf and scan; every decision its target and frontiers
+    events = [json.loads(m.data) for _, m in got["/semsearch/events"]]
+    frames = [e for e in events if e["event"] == "frame"]
+    assert len([e for e in events if e["event"] == "step"]) == steps + 1  # the start's step too
+    plans = [e for e in events if e["event"] == "plan"]
+    assert [p["plan"] for p in plans] == ["start", "end"] * (len(plans) // 2) and len(plans) >= 2 * decisions
+    # every frame (one a step, more when turning on the spot) has its pose, /tf and scan; every decision its target and frontiers
     for topic in ("/semsearch/pose", "/tf", "/scan"):
-        assert len(got[topic]) == steps + 1
+        assert len(got[topic]) == len(frames) >= steps + 1
+    stamps = [t for topic in got for t, _ in got[topic] if topic != "/semsearch/setup"]
+    assert len(set(stamps)) == len(stamps)  # strictly ordered: reading by time gives the order of writing
     for topic in ("/semsearch/goal", "/explore/frontiers", "/semsearch/decision"):
         assert len(got[topic]) == decisions
     assert len(got["/map"]) == decisions + 2 and 2 <= len(got["/semsearch/path"]) <= decisions + 1
-    # stamps: simulated time, 0.2 s a step (0.1 m at 0.5 m/s), in order
-    stamps = [t for t, _ in got["/semsearch/pose"]]
-    assert stamps[0] == 1_000_000_000 and np.all(np.diff(stamps) == 200_000_000)
+    # stamps: simulated time, 0.2 s a step (0.1 m at 0.5 m/s), then a microsecond a message
+    stamps = [t for t, _ in got["/tf"]]
+    assert stamps[0] == 1_000_000_000 and np.all(np.diff(stamps) > 0) and stamps[-1] - 200_000_000 * steps < 1_000_100_000
     # the same run, replayed here with an observer: its poses, reads and final map are the bag's
     fin = Final()
     ep = L.task.episodes[0]
     record = read_decisions(out / "results" / "decisions" / f"{RUN}.json")
     rerun = L.task.run(Variant("greedy", ()), ep, 0, observer=fin, seat=Replay(record))
-    trail = np.asarray(rerun.path, float)
+    trail = [(e["x"], e["y"]) for e in events if e["event"] == "step"]
     poses = np.array([[m.pose.position.x, m.pose.position.y] for _, m in got["/semsearch/pose"]])
-    assert np.allclose(poses[1:], trail[1:], atol=1e-5) and np.allclose(poses[0], trail[0], atol=1e-5)
+    assert np.array_equal(poses, [[f.x, f.y] for f in fin.frames])  # exact: float64 both ways
+    assert np.array_equal(np.float32([[e["x"], e["y"]] for e in events if e["event"] == "step"]), rerun.path)  # rows keep float32
     path = np.array([[p.pose.position.x, p.pose.position.y] for p in got["/semsearch/path"][-1][1].poses])
     assert np.allclose(path, np.vstack([trail[::5], trail[-1:]]) if (len(trail) - 1) % 5 else trail[::5], atol=1e-5)  # every 0.5 m
     last = got["/semsearch/pose"][-1][1].pose.orientation
-    assert math.isclose(2 * math.atan2(last.z, last.w), fin.last.heading, abs_tol=1e-9)
+    assert math.isclose(2 * math.atan2(last.z, last.w), fin.frames[-1].heading, abs_tol=1e-9)
     grid = got["/map"][-1][1]
-    b, fr = fin.last.belief, L.world.frame
-    rr, cc = np.nonzero(b.seen)
-    H, W = int(rr.max() - rr.min() + 1), int(cc.max() - cc.min() + 1)
+    b, fr = fin.frames[-1].belief, L.world.frame
+    H, W = fr.height, fr.width
     assert (grid.info.height, grid.info.width) == (H, W) and math.isclose(grid.info.resolution, fr.res, rel_tol=1e-6)
     data = grid.data.reshape(H, W)[::-1]  # back to the simulator's rows (row 0 at the top)
-    sub = (slice(rr.min(), rr.max() + 1), slice(cc.min(), cc.max() + 1))
-    want = np.where(b.seen[sub], np.where(b.free[sub], 0, 100), -1)
+    want = np.where(b.seen, np.where(b.free, 0, 100), -1)
     assert np.array_equal(data, want)
-    x0, y0 = fr.to_world(rr.max(), cc.min())  # the centre of the grid's first cell (lowest row, first column)
-    assert math.isclose(grid.info.origin.position.x + fr.res / 2, x0, abs_tol=1e-6)
-    assert math.isclose(grid.info.origin.position.y + fr.res / 2, y0, abs_tol=1e-6)
+    assert (grid.info.origin.position.x, grid.info.origin.position.y) == (fr.origin_x, fr.origin_y)
+    # the map updates, folded in order over an unknown grid, give the same map
+    state = np.full((H, W), -1, np.int8)
+    for _, u in got["/semsearch/map_updates"]:
+        r0 = H - u.y - u.height
+        state[r0:r0 + u.height, u.x:u.x + u.width] = u.data.reshape(u.height, u.width)[::-1]
+    assert np.array_equal(state, want)
     # a detection per read, at the sign's position, with its label; the goal was read last
     det = [json.loads(m.data) for _, m in got["/semsearch/detections"]]
     assert len(det) == len(fin.reads) > 0
     s = L.world.signs
     for d, (i, label) in zip(det, fin.reads):
-        assert d["label"] == str(label) and (d["x"], d["y"], d["facing"]) == (float(s.x[i]), float(s.y[i]), float(s.facing[i]))
-    assert det[-1]["label"] == "452"
+        assert d["label"] == label and (d["x"], d["y"], d["facing"]) == (float(s.x[i]), float(s.y[i]), float(s.facing[i]))
+    assert det[-1]["label"] == 452
     # scans in m, +inf where a beam returned nothing, within the laser's range
     scan = got["/scan"][0][1]
     finite = scan.ranges[np.isfinite(scan.ranges)]
@@ -168,3 +184,49 @@ def test_export_errors_name_the_flag_and_leave_no_bag(recorded, tmp_path):
     said = " ".join(res.output.split())
     assert res.exit_code == 2 and ("does not replay" in said or "not the row's" in said), res.output
     assert not [p for p in (tmp_path / "z").rglob("*") if p.name != ".semsearch.lock"]
+
+
+def decisions_of(bag):
+    """[(step, target x, y)] of a bag's /semsearch/decision messages."""
+    return [(d["step"], tuple(d["target"])) for d in (json.loads(m.data) for _, m in messages(bag).get("/semsearch/decision", []))]
+
+
+def test_a_run_replayed_from_its_bag_makes_its_decisions_decision_for_decision(recorded):
+    """The round trip: a run exported and replayed through `ros replay` with its own planner gives
+    the run's decisions, step and target; another planner is asked at the same re-plans."""
+    out, _, _, scenario = recorded
+    res = CliRunner().invoke(app, ["export", str(out / "results"), "--out", str(out / "trip"), "--scenario", str(scenario)])
+    assert res.exit_code == 0, res.output
+    for name, label in ((RUN, "greedy"), ("nsos_alpha0.9__goal452__ep0__seed0", "nsos[alpha=0.9]")):
+        bag = out / "trip" / name
+        res = CliRunner().invoke(app, ["ros", "replay", str(bag), "--planner", label, "--out", str(out / "replayed" / name),
+                                       "--scenario", str(scenario)])
+        assert res.exit_code == 0, res.output
+        want = decisions_of(bag)
+        got = [(s, tuple(round(v, 2) for v in t)) for s, t in decisions_of(out / "replayed" / name)]
+        assert len(want) > 5 and got == want
+        assert "(the goal was read in the bag)" in " ".join(res.output.split())
+    other = CliRunner().invoke(app, ["ros", "replay", str(out / "trip" / RUN), "--planner", "numbering", "--out",
+                                     str(out / "replayed" / "numbering"), "--scenario", str(scenario)])
+    assert other.exit_code == 0, other.output
+    asked = decisions_of(out / "replayed" / "numbering")
+    assert asked and all(0 <= s <= max(s for s, _ in decisions_of(out / "trip" / RUN)) + 1 for s, _ in asked)
+
+
+def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay(recorded, tmp_path):
+    out, _, _, scenario = recorded
+    CliRunner().invoke(app, ["export", str(out / "results"), "--out", str(out / "trip2"), "--scenario", str(scenario), "--run", RUN])
+    other = scenario.with_name("other2.yaml")
+    other.write_text(scenario.read_text() + "laser: {range: 4.0}\n")
+    res = CliRunner().invoke(app, ["ros", "replay", str(out / "trip2" / RUN), "--planner", "greedy", "--out", str(tmp_path / "a"),
+                                   "--scenario", str(other)])
+    assert res.exit_code == 2 and "recorded on another scenario" in " ".join(res.output.split()), res.output
+    # a robot's own bag: a pose and a map, no /semsearch/events
+    m = Messages()
+    w = BagWriter(tmp_path / "robot", "mcap", m)
+    w.write("/semsearch/pose", 1_000_000_000, m.pose_stamped(1_000_000_000, 1.0, 2.0, 0.0))
+    w.close()
+    res = CliRunner().invoke(app, ["ros", "replay", str(tmp_path / "robot"), "--planner", "greedy", "--out", str(tmp_path / "b"),
+                                   "--scenario", str(scenario)])
+    assert res.exit_code == 2 and "is not built yet" in " ".join(res.output.split()), res.output
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()

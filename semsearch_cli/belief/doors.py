@@ -205,6 +205,23 @@ class DoorBelief:
         rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
         _grow(self.dirty, (r0 + int(rows[0]), r0 + int(rows[-1]), c0 + int(cols[0]), c0 + int(cols[-1])))
 
+    def fold_grid(self, r0: int, c0: int, seen: np.ndarray, free: np.ndarray) -> None:
+        """Take another mapper's word for a window of the map (a bag's map update, a robot's SLAM
+        map): ``seen`` and ``free`` (h, w) bool from cell (r0, c0); as :meth:`fold_scan` does, count
+        the cells that stopped being free and grow the dirty box by those whose free state
+        changed."""
+        h, w = seen.shape
+        win = (slice(r0, r0 + h), slice(c0, c0 + w))
+        new = seen & free
+        changed = new != self.free[win]
+        self.seen[win] = seen
+        if not changed.any():
+            return
+        self.lost += int((changed & ~new).sum())
+        self.free[win] = new
+        rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
+        _grow(self.dirty, (r0 + int(rows[0]), r0 + int(rows[-1]), c0 + int(cols[0]), c0 + int(cols[-1])))
+
     def visit(self, r: int, c: int) -> None:
         """Mark the visited kernel around the robot and give its newly visited cells the local
         density class.

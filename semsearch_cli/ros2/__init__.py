@@ -1,10 +1,12 @@
-"""From the simulator to ROS 2: runs exported as bags (``semsearch export``), readable without a
-ROS install (the ``ros`` extra: rosbags, mcap). See docs/robot.md."""
+"""From the simulator to ROS 2: runs exported as bags (``semsearch export``) and door planners
+replayed over them (``semsearch ros replay``), without a ROS install (the ``ros`` extra: rosbags,
+mcap). See docs/robot.md."""
 
 import importlib.util
 
 from .bag import FORMATS, TOPICS
 from .export import BagRecorder, Exported, export_folder, export_run, recorded_runs
+from .replay import Replayed, recorded_scenario, replay_bag
 
 
 def available() -> bool:
@@ -12,4 +14,5 @@ def available() -> bool:
     return importlib.util.find_spec("rosbags") is not None
 
 
-__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "available", "export_folder", "export_run", "recorded_runs"]
+__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Replayed", "available", "export_folder", "export_run",
+           "recorded_runs", "recorded_scenario", "replay_bag"]

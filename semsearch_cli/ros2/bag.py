@@ -24,11 +24,16 @@ START_NS = 1_000_000_000  # the first step's stamp (1 s: some tools read 0 as "n
 
 # topic -> (message type, when it is published, what it holds)
 TOPICS = {
+    "/semsearch/setup": ("std_msgs/msg/String", "once, first",
+                         'JSON {"scenario", "file", "fingerprint", "goal", "planner", "episode", "seed"}: the run this bag '
+                         'records (its scenario\'s name, file name and fingerprint)'),
     "/map": ("nav_msgs/msg/OccupancyGrid", "at the start, at each decision and at the end",
-             "the belief: -1 never seen, 0 free, 100 occupied, over the bounding box of what was seen"),
-    "/scan": ("sensor_msgs/msg/LaserScan", "every step", "the laser scan folded into the belief (m; +inf: no return)"),
-    "/tf": ("tf2_msgs/msg/TFMessage", "every step", "map -> base_link"),
-    "/semsearch/pose": ("geometry_msgs/msg/PoseStamped", "every step", "the robot's pose in map"),
+             "the belief over the whole grid: -1 never seen, 0 free, 100 occupied"),
+    "/semsearch/map_updates": ("map_msgs/msg/OccupancyGridUpdate", "each frame that changed the map",
+                               "the cells it changed (their bounding box), as RViz's map update topic"),
+    "/scan": ("sensor_msgs/msg/LaserScan", "every frame", "the laser scan folded into the belief (m; +inf: no return)"),
+    "/tf": ("tf2_msgs/msg/TFMessage", "every frame", "map -> base_link"),
+    "/semsearch/pose": ("geometry_msgs/msg/PoseStamped", "every frame", "the robot's pose in map"),
     "/semsearch/path": ("nav_msgs/msg/Path", "at the first decision after each 5 m travelled, and at the end",
                         "the path travelled so far, a pose every 0.5 m"),
     "/semsearch/detections": ("std_msgs/msg/String", "each sign read",
@@ -39,8 +44,13 @@ TOPICS = {
                            "the frontier candidates (spheres, as explore_lite publishes its frontiers)"),
     "/semsearch/goal": ("geometry_msgs/msg/PoseStamped", "at each decision", "the chosen target, facing along its branch"),
     "/semsearch/decision": ("std_msgs/msg/String", "at each decision", "JSON: the decision's row (as --trace writes it)"),
+    "/semsearch/events": ("std_msgs/msg/String", "each frame, step and re-plan",
+                          'JSON {"event": "frame" (x, y, heading, the labels read), "step" (the visited kernel), '
+                          '"plan" (start with the generator\'s state, or end)}: what `semsearch ros replay` replays'),
 }
 FORMATS = {"mcap": "MCAP", "rosbag2": "SQLITE3"}  # --format -> rosbags' storage plugin
+UPDATE = "map_msgs/msg/OccupancyGridUpdate"
+UPDATE_MSG = "std_msgs/Header header\nint32 x\nint32 y\nuint32 width\nuint32 height\nint8[] data\n"
 
 
 def stamp_ns(step: int, step_m: float) -> int:
@@ -53,6 +63,8 @@ class Messages:
 
     def __init__(self):
         self.ts = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
+        if UPDATE not in self.ts.types:  # not among rosbags' Humble types: its definition, from map_msgs
+            self.ts.register(typesys.get_types_from_msg(UPDATE_MSG, UPDATE))
         self.T = self.ts.types
 
     def serialize(self, msg) -> bytes:
@@ -85,18 +97,23 @@ class Messages:
         return P["tf2_msgs/msg/TFMessage"](transforms=[ts])
 
     def grid(self, t_ns: int, seen: np.ndarray, free: np.ndarray, frame) -> object:
-        """The belief over the bounding box of the seen cells (the whole grid's first cell when
-        none is), rows flipped to ROS's order (row 0 at the lowest y)."""
-        rr, cc = np.nonzero(seen)
-        r0, r1, c0, c1 = (int(rr.min()), int(rr.max()) + 1, int(cc.min()), int(cc.max()) + 1) if rr.size else (0, 1, 0, 1)
-        s, f = seen[r0:r1, c0:c1], free[r0:r1, c0:c1]
-        data = np.where(s, np.where(f, 0, 100), -1).astype(np.int8)[::-1]
-        x0 = frame.origin_x + c0 * frame.res
-        y0 = frame.origin_y + (frame.height - r1) * frame.res
+        """The belief over the whole grid (-1 never seen, 0 free, 100 occupied; a few kilobytes
+        once compressed, unknown cells being most), rows flipped to ROS's order (row 0 at the
+        lowest y), its origin the grid's lower-left corner."""
+        data = np.where(seen, np.where(free, 0, 100), -1).astype(np.int8)[::-1]
         P = self.T
         info = P["nav_msgs/msg/MapMetaData"](map_load_time=self._time(t_ns), resolution=float(frame.res),
-                                             width=int(c1 - c0), height=int(r1 - r0), origin=self.pose(x0, y0, 0.0))
+                                             width=int(frame.width), height=int(frame.height),
+                                             origin=self.pose(frame.origin_x, frame.origin_y, 0.0))
         return P["nav_msgs/msg/OccupancyGrid"](header=self.header(t_ns), info=info, data=np.ascontiguousarray(data).ravel())
+
+    def grid_update(self, t_ns: int, states: np.ndarray, r0: int, c0: int, height: int) -> object:
+        """``states`` (h, w) int8 of the grid's cells from row ``r0``, column ``c0`` (the
+        simulator's rows, row 0 at the top of a grid of ``height`` rows) as a
+        map_msgs/OccupancyGridUpdate of /map (x, y: the window's first cell in ROS's order)."""
+        h, w = states.shape
+        return self.T[UPDATE](header=self.header(t_ns), x=int(c0), y=int(height - r0 - h), width=int(w), height=int(h),
+                              data=np.ascontiguousarray(states[::-1]).ravel())
 
     def scan(self, t_ns: int, thetas: np.ndarray, dist_cells: np.ndarray, hit: np.ndarray, heading: float, res: float,
              max_range: float):

@@ -21,8 +21,8 @@ from ..runner.specs import Loaded, file_stem
 from ..runner.store import read_decisions, read_runs
 from ..tasks.base import Observer
 from ..tasks.decisions import Replay, ReplayError
-from ..tasks.doors import DoorDecision, DoorStep
-from .bag import BagWriter, Messages, stamp_ns
+from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep
+from .bag import START_NS, BagWriter, Messages, stamp_ns
 
 SIGN_RGBA = (0.1, 0.3, 0.9, 1.0)
 GOAL_RGBA = (0.9, 0.1, 0.1, 1.0)
@@ -32,8 +32,10 @@ PATH_STEP_M = 0.5  # its poses, one every 0.5 m
 
 
 class BagRecorder(Observer):
-    """Writes a door search's steps and decisions to a :class:`BagWriter` as they happen (topics
-    :data:`~semsearch_cli.ros2.bag.TOPICS`)."""
+    """Writes a door search's frames, steps, re-plans and decisions to a :class:`BagWriter` as
+    they happen (topics :data:`~semsearch_cli.ros2.bag.TOPICS`). Stamps strictly increase (a
+    step's stamp, then a microsecond per message after it), so that reading by time gives the
+    order of writing: the order ``semsearch ros replay`` needs."""
 
     steps = True
 
@@ -41,41 +43,74 @@ class BagRecorder(Observer):
         self.bag, self.m = bag, bag.msgs
         self.world, self.frame, self.goal = world, world.frame, goal
         self.step_m, self.max_range = step_m, max_range
-        self.t = stamp_ns(0, step_m)
+        self.t = stamp_ns(0, step_m) - 1000  # the first message is stamped at the first step
         self.read: dict[int, str] = {}  # sign index -> label as first read
         self.belief = None
+        self.state = np.full((world.frame.height, world.frame.width), -1, np.int8)  # the map as the bag has it so far
+        self.reach = int(np.ceil(max_range / world.frame.res)) + 2  # cells a frame may change around the robot
         self.trail: list = []
         self.decisions = 0
         self.path_at = -PATH_EVERY_M  # distance (m) at the last /semsearch/path
 
     def see(self, event) -> None:
-        if isinstance(event, DoorStep):
-            self._step(event)
+        if isinstance(event, DoorFrame):
+            self._frame(event)
+        elif isinstance(event, DoorStep):
+            self._write("/semsearch/events", event.step, self.m.string({"event": "step", **event.row()}))
+            self.trail.append((float(event.x), float(event.y)))
+        elif isinstance(event, DoorPlan):
+            self._write("/semsearch/events", event.step, self.m.string({"event": "plan", **event.row()}))
         elif isinstance(event, DoorDecision):
             self._decision(event)
 
-    def _step(self, e: DoorStep) -> None:
-        t = self.t = stamp_ns(e.step, self.step_m)
+    def _stamp(self, step: int) -> int:
+        self.t = max(stamp_ns(step, self.step_m), self.t + 1000)
+        return self.t
+
+    def _write(self, topic: str, step: int, msg) -> None:
+        self.bag.write(topic, self._stamp(step), msg)
+
+    def _frame(self, e: DoorFrame) -> None:
         first = self.belief is None
-        self.belief = e.belief
-        self.trail.append((float(e.x), float(e.y)))
+        self.belief = b = e.belief
+        t = self._stamp(e.step)
         self.bag.write("/tf", t, self.m.tf(t, e.x, e.y, e.heading))
-        self.bag.write("/semsearch/pose", t, self.m.pose_stamped(t, e.x, e.y, e.heading))
+        self.bag.write("/semsearch/pose", self._stamp(e.step), self.m.pose_stamped(t, e.x, e.y, e.heading))
         if e.scan is not None:
-            self.bag.write("/scan", t, self.m.scan(t, *e.scan, e.heading, self.frame.res, self.max_range))
+            self._write("/scan", e.step, self.m.scan(t, *e.scan, e.heading, self.frame.res, self.max_range))
+        self._map_update(e)
         signs = self.world.signs
         new = False
         for i, label in e.reads:
             i = int(i)
-            self.bag.write("/semsearch/detections", t, self.m.string({"label": str(label), "x": float(signs.x[i]),
-                                                                      "y": float(signs.y[i]), "facing": float(signs.facing[i])}))
+            self._write("/semsearch/detections", e.step, self.m.string({"label": _label(label), "x": float(signs.x[i]),
+                                                                        "y": float(signs.y[i]), "facing": float(signs.facing[i])}))
             if i not in self.read:
                 self.read[i] = str(label)
                 new = True
+        row = e.row()
+        row["reads"] = [_label(v) for _, v in e.reads]  # labels as read, as the robot has them (no sign index)
+        self._write("/semsearch/events", e.step, self.m.string({"event": "frame", **row}))
         if first:
-            self.bag.write("/map", t, self.m.grid(t, e.belief.seen, e.belief.free, self.frame))
+            self._write("/map", e.step, self.m.grid(self.t, b.seen, b.free, self.frame))
         if new or first:
-            self._signs(t)
+            self._signs(self.t)
+
+    def _map_update(self, e: DoorFrame) -> None:
+        """The cells this frame changed, as one map_msgs/OccupancyGridUpdate over their bounding box."""
+        H, W = self.state.shape
+        r, c = (int(v) for v in self.frame.to_index(e.x, e.y))
+        k = self.reach
+        r0, r1, c0, c1 = max(0, r - k), min(H, r + k + 1), max(0, c - k), min(W, c + k + 1)
+        b = e.belief
+        now = np.where(b.seen[r0:r1, c0:c1], np.where(b.free[r0:r1, c0:c1], 0, 100), -1).astype(np.int8)
+        changed = now != self.state[r0:r1, c0:c1]
+        if not changed.any():
+            return
+        rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
+        a0, a1, b0, b1 = r0 + int(rows[0]), r0 + int(rows[-1]) + 1, c0 + int(cols[0]), c0 + int(cols[-1]) + 1
+        self.state[r0:r1, c0:c1] = now
+        self._write("/semsearch/map_updates", e.step, self.m.grid_update(self.t, self.state[a0:a1, b0:b1], a0, b0, H))
 
     def _signs(self, t: int) -> None:
         s = self.world.signs
@@ -84,25 +119,25 @@ class BagRecorder(Observer):
         x0 = self.frame.origin_x
         y1 = self.frame.origin_y + self.frame.height * self.frame.res
         items.append(self.m.marker(t, "goal", 0, "TEXT_VIEW_FACING", x0 + 1.0, y1 - 1.0, GOAL_RGBA, 0.8, f"goal {self.goal}"))
-        self.bag.write("/semsearch/signs", t, self.m.markers(items))
+        self.bag.write("/semsearch/signs", self._stamp(0), self.m.markers(items))  # after the last message
 
     def _decision(self, e: DoorDecision) -> None:
-        t = self.t
         self.decisions += 1
-        b, c = e.belief, e.candidates
-        self.bag.write("/map", t, self.m.grid(t, b.seen, b.free, self.frame))
+        b, c, k = e.belief, e.candidates, e.step
+        self._write("/map", k, self.m.grid(self.t, b.seen, b.free, self.frame))
         if e.distance - self.path_at >= PATH_EVERY_M:
             self.path_at = e.distance
-            self.bag.write("/semsearch/path", t, self.m.path(t, self._thinned()))
+            self._write("/semsearch/path", k, self.m.path(self.t, self._thinned()))
+        t = self.t
         cx, cy = self.frame.to_world(c.rows, c.cols)
         chosen = np.flatnonzero((c.rows == e.decision.row) & (c.cols == e.decision.col))
         items = [self.m.delete_all(t, "frontiers")]
-        items += [self.m.marker(t, "frontiers", k, "SPHERE", cx[k], cy[k], GOAL_RGBA if k in chosen else CAND_RGBA,
-                                0.5 if k in chosen else 0.35) for k in range(len(c))]
-        self.bag.write("/explore/frontiers", t, self.m.markers(items))
+        items += [self.m.marker(t, "frontiers", j, "SPHERE", cx[j], cy[j], GOAL_RGBA if j in chosen else CAND_RGBA,
+                                0.5 if j in chosen else 0.35) for j in range(len(c))]
+        self._write("/explore/frontiers", k, self.m.markers(items))
         yaw = float(c.theta[chosen[0]]) if chosen.size else 0.0
-        self.bag.write("/semsearch/goal", t, self.m.pose_stamped(t, *e.target_xy, yaw))
-        self.bag.write("/semsearch/decision", t, self.m.string(_jsonable(e.row())))
+        self._write("/semsearch/goal", k, self.m.pose_stamped(t, *e.target_xy, yaw))
+        self._write("/semsearch/decision", k, self.m.string(_jsonable(e.row())))
 
     def _thinned(self) -> list:
         """The path so far, one pose every ``PATH_STEP_M`` of travel (its last pose kept): a
@@ -113,8 +148,14 @@ class BagRecorder(Observer):
     def finish(self) -> None:
         """The map and the path as the run ended."""
         if self.belief is not None:
-            self.bag.write("/map", self.t, self.m.grid(self.t, self.belief.seen, self.belief.free, self.frame))
-            self.bag.write("/semsearch/path", self.t, self.m.path(self.t, self._thinned()))
+            self.bag.write("/map", self.t + 1000, self.m.grid(self.t, self.belief.seen, self.belief.free, self.frame))
+            self.bag.write("/semsearch/path", self.t + 2000, self.m.path(self.t, self._thinned()))
+            self.t += 2000
+
+
+def _label(v):
+    """A label as JSON writes it: a whole number as a number, anything else as text."""
+    return int(v) if isinstance(v, (int, np.integer)) and not isinstance(v, bool) else str(v)
 
 
 def _jsonable(v):
@@ -175,6 +216,9 @@ def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Pat
     tmp = work / out.name  # rosbags names the storage file after its folder
     bag = BagWriter(tmp, fmt, Messages())
     rec = BagRecorder(bag, loaded.world, ep.goal, loaded.sc.robot.step, loaded.sc.laser.range)
+    setup = {"scenario": loaded.sc.name, "file": loaded.path.stem, "fingerprint": loaded.fingerprint, "goal": _label(ep.goal), "planner": str(row["planner"]),
+             "episode": int(row["episode"]), "seed": int(row["seed"])}
+    bag.write("/semsearch/setup", START_NS - 1000, bag.msgs.string(setup))
     try:
         replay = Replay(record)
         res = task.run(Variant(str(row["planner"]), ()), ep, int(row["seed"]), observer=rec, seat=replay)

@@ -65,8 +65,6 @@ class DoorSensing:
     def __init__(self, task: "DoorTask", goal, rng: np.random.Generator):
         self.task, self.goal, self.rng = task, goal, rng
         self.goal_idx = set(task.world.signs.indices_of(goal))  # more than one under duplicates: any
-        self._frame_reads: list = []  # (sign index, label) read since the last step shown to a stepping observer
-        self._scan = None  # the last laser scan (beam angles rad, ranges cells, hit flags)
 
     def sense(self, st: RobotState) -> tuple[bool, bool]:
         """(goal read, a sign reached min_reads)."""
@@ -74,17 +72,19 @@ class DoorSensing:
         v, u, r, c = fr.point_to_cell(st.x, st.y)
         scan = t.laser.scan(v, u, st.heading, self.rng)
         b.fold_scan(v, u, *scan)
-        self._scan = scan
         min_reads = b.spec.min_reads
         b.views.append((v, u, st.heading))
         found = event = False
-        for i, label in t.camera.read(st.x, st.y, st.heading, self.rng):
+        reads = t.camera.read(st.x, st.y, st.heading, self.rng)
+        for i, label in reads:
             st.read_signs[i] = label
-            self._frame_reads.append((i, label))
             if i in self.goal_idx and label == self.goal:
                 found = True
             if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:
                 event = True
+        if self.observer is not None and self.observer.steps:
+            self.observer.see(DoorFrame(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=b, reads=tuple(reads),
+                                        scan=scan))
         return found, event
 
     def update(self, st: RobotState) -> None:
@@ -92,18 +92,18 @@ class DoorSensing:
         st.belief.visit(r, c)
         st.headings.append(st.heading)
         if self.observer is not None and self.observer.steps:
-            self.observer.see(DoorStep(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=st.belief,
-                                       reads=tuple(self._frame_reads), scan=self._scan))
-        self._frame_reads.clear()
+            self.observer.see(DoorStep(step=st.steps, x=st.x, y=st.y, heading=st.heading, distance=st.distance,
+                                       belief=st.belief))
 
 
 @dataclass(frozen=True, kw_only=True)
-class DoorStep(Event):
-    """One step of a door search, shown to observers that ask for steps: the pose (``x``, ``y``
-    m, ``heading`` rad) after ``step`` steps, the belief as it is now (``belief``: copy what you
-    keep) and the signs read since the last step, [(sign index, label)] (turning on the spot
-    senses several frames in one step: their reads are all here); ``scan``: the step's laser
-    scan, (beam angles rad in the world, ranges in cells, hit flags). Not traced."""
+class DoorFrame(Event):
+    """One sensing frame of a door search, shown to observers that ask for steps
+    (``Observer.steps``): the pose (``x``, ``y`` m, ``heading`` rad) it sensed from during step
+    ``step``, the belief after folding it in (``belief``: copy what you keep), the signs it read
+    [(sign index, label as read)] and its laser scan (beam angles rad in the world, ranges in
+    cells, hit flags). A step senses one frame; turning on the spot senses several within one
+    step. Not traced."""
 
     step: int
     x: float
@@ -118,8 +118,50 @@ class DoorStep(Event):
         return False
 
     def row(self) -> dict:
-        return {"step": self.step, "x": round(float(self.x), 3), "y": round(float(self.y), 3),
-                "heading_deg": round(float(np.degrees(self.heading)), 1), "reads": [[int(i), str(v)] for i, v in self.reads]}
+        return {"step": self.step, "x": float(self.x), "y": float(self.y), "heading": float(self.heading),
+                "reads": [[int(i), str(v)] for i, v in self.reads]}
+
+
+@dataclass(frozen=True, kw_only=True)
+class DoorStep(Event):
+    """The belief update that ends a step of a door search (the visited kernel at the robot's
+    cell), shown to observers that ask for steps: the pose (``x``, ``y`` m, ``heading`` rad) after
+    ``step`` steps, ``distance`` m into the run, and the belief (``belief``: copy what you keep).
+    Not traced."""
+
+    step: int
+    x: float
+    y: float
+    heading: float
+    distance: float
+    belief: DoorBelief
+
+    @property
+    def traced(self) -> bool:
+        return False
+
+    def row(self) -> dict:
+        return {"step": self.step, "x": float(self.x), "y": float(self.y), "heading": float(self.heading),
+                "distance": float(self.distance)}
+
+
+@dataclass(frozen=True, kw_only=True)
+class DoorPlan(Event):
+    """A re-plan of a door search starts (``start``) or ends, shown to observers that ask for
+    steps, with the run's generator's state as it starts (``rng``: NumPy's bit-generator state,
+    None at the end): the frames sensed between the two were sensed by the re-plan (turning on
+    the spot). Not traced."""
+
+    step: int
+    start: bool
+    rng: dict | None = None
+
+    @property
+    def traced(self) -> bool:
+        return False
+
+    def row(self) -> dict:
+        return {"step": self.step, "plan": "start" if self.start else "end", **({"rng": self.rng} if self.rng else {})}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -155,6 +197,11 @@ class DoorDecision(Event):
                 "y": round(float(self.y), 3), "heading_deg": round(float(np.degrees(self.heading)), 1),
                 "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(self.candidates),
                 **self.decision.info}
+
+
+def _jsonable_state(state: dict) -> dict:
+    """A bit generator's state with NumPy integers as Python ones (JSON writes it as it is)."""
+    return {k: _jsonable_state(v) if isinstance(v, dict) else (v.item() if hasattr(v, "item") else v) for k, v in state.items()}
 
 
 def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
@@ -229,6 +276,15 @@ class DoorSearch(DoorSensing):
         path is taken out and the question asked again, at most ``MAX_RETRIES`` times; no target
         (None), or none reachable, sends the robot to the nearest wall face not read yet
         (:meth:`sweep`). The retry-and-sweep policy is here alone, for every driver."""
+        stepping = self.observer is not None and self.observer.steps
+        if stepping:
+            self.observer.see(DoorPlan(step=st.steps, start=True, rng=_jsonable_state(self.rng.bit_generator.state)))
+        out = yield from self._plan(st)
+        if stepping:
+            self.observer.see(DoorPlan(step=st.steps, start=False))
+        return out
+
+    def _plan(self, st):
         prep = self.prepare(st)
         if isinstance(prep, str):
             return prep
