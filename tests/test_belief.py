@@ -1,3 +1,5 @@
+import heapq
+import math
 import os
 
 import numpy as np
@@ -211,6 +213,74 @@ def test_dial_buckets_settle_as_the_heap_does(low):
     assert np.array_equal(dial.state[done], heap.state[done]) and np.array_equal(dial.parent[done], heap.parent[done])
 
 
+def _reference_dijkstra(p, cost, sources, targets, n_stop, max_cost, stop):
+    """Dijkstra as a textbook writes it: heapq over (cost, cell index), a cell's cost and parent
+    changed only by a strictly cheaper offer, the same 8 moves without corner cutting."""
+    H, W = p.shape
+    moves = ((-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1))
+    dist, length, parent, done, heap = {}, {}, {}, set(), []
+    for r, c in sources:
+        if p[r, c]:
+            q = r * W + c
+            dist[q], length[q], parent[q] = 0.0, 0.0, -1
+            heapq.heappush(heap, (0.0, q))
+    wanted, hit = {r * W + c for r, c in targets}, 0
+    while heap:
+        d, q = heapq.heappop(heap)
+        if q in done:
+            continue
+        if d > max_cost:
+            break
+        done.add(q)
+        if q in wanted:
+            hit += 1
+            if n_stop and hit >= n_stop:
+                break
+        if stop is not None and q == stop[0] * W + stop[1]:
+            break
+        r, c = divmod(q, W)
+        for k, (dr, dc) in enumerate(moves):
+            nr, nc = r + dr, c + dc
+            if not (0 <= nr < H and 0 <= nc < W) or nr * W + nc in done or not p[nr, nc]:
+                continue
+            if k >= 4 and (not p[r, nc] or not p[nr, c]):
+                continue
+            step = math.sqrt(2.0) if k >= 4 else 1.0
+            nd, n = d + step * float(cost[nr, nc]), nr * W + nc
+            if n not in dist or nd < dist[n]:
+                dist[n], length[n], parent[n] = nd, length[q] + step, q
+                heapq.heappush(heap, (nd, n))
+    return hit, done, dist, length, parent
+
+
+@pytest.mark.parametrize("low, n_stop, max_cost, stop", [(1.0, 0, np.inf, None), (1.0, 6, np.inf, None), (1.0, 0, 25.0, None),
+                                                         (1.0, 0, np.inf, (30, 40)), (0.5, 0, 30.0, None)])
+def test_the_search_settles_as_a_textbook_heap_does(low, n_stop, max_cost, stop):
+    """Several sources, a stop after n targets, at a cost, or at a cell; costs from a few values
+    (ties everywhere): the same cells settled, with the same costs, lengths and parents bit for
+    bit, as heapq's Dijkstra over (cost, cell index) (low 0.5: steps under one cell, the heap alone)."""
+    rng = np.random.default_rng(11)
+    p = rng.random((45, 60)) > 0.2
+    cost = rng.choice(np.array([low, 1.0, 1.5, 2.0, 3.5], np.float32), size=p.shape)
+    sources = [(2, 3), (40, 55), (20, 30)]
+    for r, c in sources + [stop or (0, 0)]:
+        p[r, c] = True
+    tr, tc = np.nonzero(p & (rng.random(p.shape) < 0.05))
+    gs = GridSearch(p.shape)
+    got = gs.run(p, cost, [r for r, _ in sources], [c for _, c in sources], tr, tc, n_stop, max_cost, stop)
+    hit, done, dist, length, parent = _reference_dijkstra(p, cost, sources, list(zip(tr, tc)), n_stop, max_cost, stop)
+    assert got == hit and len(done) > 50
+    W = p.shape[1]
+    settled = np.flatnonzero(gs.stamp == 2 * gs.gen + 1)
+    assert set(settled.tolist()) == done
+    q = np.array(sorted(done))
+    assert np.array_equal(gs.state[q, 0], [dist[i] for i in q]) and np.array_equal(gs.state[q, 1], [length[i] for i in q])
+    assert np.array_equal(gs.parent[q], [parent[i] for i in q])
+    far = int(q[np.argmax(gs.state[q, 0])])
+    rows, cols = gs.path(far // W, far % W)
+    assert rows[0] * W + cols[0] in {r * W + c for r, c in sources} and (rows[-1], cols[-1]) == (far // W, far % W)
+
+
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
 def test_lazy_grids_are_zero_and_private_to_each_process():
     a = lazy_zeros((300, 400), np.int32)
@@ -262,3 +332,21 @@ def test_lost_counts_the_free_cells_a_scan_turns_to_walls(buffer):
         b.fold_scan(40.5, 30.5, thetas, *cast_rays(occ, 40.5, 30.5, thetas, 50.0))
     lost = int((~b.free[:, 60] & b.seen[:, 60]).sum())
     assert not b.free[40, 60] and lost > 10 and b.lost == lost
+
+
+def test_fold_grid_takes_a_window_of_another_mapper_and_marks_what_changed():
+    H, W = 12, 16
+    b = DoorBelief(GridFrame(0.1, 0.0, 0.0, H, W), BeliefSpec(), robot_radius=0.05)
+    seen = np.ones((3, 4), bool)
+    free = np.array([[1, 1, 0, 1], [1, 1, 1, 1], [0, 0, 1, 1]], bool)
+    b.fold_grid(5, 6, seen, free)
+    assert b.seen.sum() == 12 and np.array_equal(b.free[5:8, 6:10], free) and b.free.sum() == 9
+    assert b.lost == 0 and b.dirty.tolist() == [5, 7, 6, 9]  # the free cells' rows 5-7, columns 6-9
+    b.dirty[:] = (H, -1, W, -1)
+    gone = free.copy()
+    gone[1, 2] = False  # a wall seen where the map had free space
+    b.fold_grid(5, 6, seen, gone)
+    assert b.lost == 1 and b.dirty.tolist() == [6, 6, 8, 8] and not b.free[6, 8]
+    b.dirty[:] = (H, -1, W, -1)
+    b.fold_grid(5, 6, seen, gone)  # nothing new: nothing dirty
+    assert b.lost == 1 and b.dirty.tolist() == [H, -1, W, -1]

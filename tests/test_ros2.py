@@ -3,6 +3,8 @@ messages, the mcap library for the file (its chunks' checksums)."""
 
 import json
 import math
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -181,9 +183,17 @@ def test_export_errors_name_the_flag_and_leave_no_bag(recorded, tmp_path):
     other.write_text(scenario.read_text() + "laser: {range: 4.0}\n")
     res = CliRunner().invoke(app, ["export", str(out / "results"), "--out", str(tmp_path / "z"), "--scenario", str(other),
                                    "--run", RUN])
+    assert res.exit_code == 2 and "made with another scenario" in " ".join(res.output.split()), res.output
+    # a record edited after the run: checked as verify checks it, no bag (nor a partial one) left
+    edited = tmp_path / "edited"
+    shutil.copytree(out / "results", edited)
+    f = edited / "decisions" / f"{RUN}.json"
+    f.write_text(f.read_text().replace('"decisions":[[', '"decisions":[[1, 1], [', 1))  # a first choice the run never made
+    res = CliRunner().invoke(app, ["export", str(edited), "--out", str(tmp_path / "z"), "--scenario", str(scenario)])
     said = " ".join(res.output.split())
-    assert res.exit_code == 2 and ("does not replay" in said or "not the row's" in said), res.output
-    assert not [p for p in (tmp_path / "z").rglob("*") if p.name != ".semsearch.lock"]
+    assert res.exit_code == 2 and "1 run(s) do not replay (1 other bag(s) written)" in said and RUN in said, res.output
+    assert sorted(p.name for p in (tmp_path / "z").iterdir() if not p.name.startswith(".semsearch")) == [
+        "nsos_alpha0.9__goal452__ep0__seed0"]
 
 
 def decisions_of(bag):
@@ -230,3 +240,9 @@ def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay
                                    "--scenario", str(scenario)])
     assert res.exit_code == 2 and "is not built yet" in " ".join(res.output.split()), res.output
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_the_topics_page_lists_every_topic_as_the_code_writes_it():
+    page = (Path(__file__).resolve().parents[1] / "docs" / "robot.md").read_text()
+    rows = [line for line in page.splitlines() if line.startswith("| `/")]
+    assert rows == [f"| `{t}` | `{ty}` | {when} | {what} |" for t, (ty, when, what) in TOPICS.items()]

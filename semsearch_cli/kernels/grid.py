@@ -215,7 +215,7 @@ def _heap_drop_top(hk, hi, n):
     hi[j] = i
 
 
-BUCKETS = 8  # future buckets of unit width: a step may cost up to 7 (sqrt(2) x 4.9)
+BUCKETS = 8  # Dial's buckets of unit width, used in turn: a step may cost up to 7 cells (the maps' costs reach sqrt(2) x 3.5)
 
 
 @njit(cache=True)
@@ -244,7 +244,7 @@ def _dijkstra(passable, cost, H, W, src, tmark, n_stop, max_cost, state, parent,
     turn and the heap settles it in key order: the same order as the heap alone, at a fraction of
     its cost. A step cheaper than 1, or so dear that it skips every bucket, ends the search with
     -2 (the caller runs it again without ``dial``). Returns the number of targets settled, -1 when
-    the heap or a bucket is full (the caller grows them and searches again), -2 as said.
+    the heap is full and -3 when a bucket is (the caller grows it and searches again), -2 as said.
     """
     uniform = cost.shape[0] == 1
     hcap = hk.shape[0]
@@ -321,12 +321,11 @@ def _dijkstra(passable, cost, H, W, src, tmark, n_stop, max_cost, state, parent,
             nd = d + inc
             if stamp[q] != reached or nd < state[q, 0]:
                 if dial:
-                    kb = int(math.floor(nd))
-                    if not inc >= 1.0 or kb - cur >= BUCKETS:
+                    if not inc >= 1.0 or not nd < cur + BUCKETS:  # NaN and inf too: the heap alone
                         return -2
-                    b = kb % BUCKETS
+                    b = int(math.floor(nd)) % BUCKETS
                     if bn[b] == bcap:
-                        return -1
+                        return -3
                     bk[b, bn[b]] = nd
                     bi[b, bn[b]] = q
                     bn[b] += 1
@@ -391,7 +390,7 @@ class GridSearch:
                 return settled
             if settled == -2:  # a step outside what Dial's buckets hold: the heap alone
                 dial = False
-            elif self._bn.max() == self._bk.shape[1]:
+            elif settled == -3:
                 self._bk, self._bi = np.empty((BUCKETS, 2 * self._bk.shape[1])), np.empty((BUCKETS, 2 * self._bi.shape[1]), np.int64)
             else:
                 self._hk, self._hi = np.empty(2 * self._hk.size), np.empty(2 * self._hi.size, np.int64)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ TOPICS = {
     "/scan": ("sensor_msgs/msg/LaserScan", "every frame", "the laser scan folded into the belief (m; +inf: no return)"),
     "/tf": ("tf2_msgs/msg/TFMessage", "every frame", "map -> base_link"),
     "/semsearch/pose": ("geometry_msgs/msg/PoseStamped", "every frame", "the robot's pose in map"),
-    "/semsearch/path": ("nav_msgs/msg/Path", "at the first decision after each 5 m travelled, and at the end",
+    "/semsearch/path": ("nav_msgs/msg/Path", "at the first decision, the first after each further 5 m, and at the end",
                         "the path travelled so far, a pose every 0.5 m"),
     "/semsearch/detections": ("std_msgs/msg/String", "each sign read",
                               'JSON {"label", "x", "y", "facing"}: the sign read (m, rad) and its label as read'),
@@ -169,8 +170,7 @@ class BagWriter:
     def __init__(self, out: Path, fmt: str, messages: Messages):
         self.msgs = messages
         plugin = getattr(rosbag2.StoragePlugin, FORMATS[fmt])
-        self.writer = rosbag2.Writer(Path(out), version=rosbag2.Writer.VERSION_LATEST if hasattr(rosbag2.Writer, "VERSION_LATEST") else 9,
-                                     storage_plugin=plugin)
+        self.writer = rosbag2.Writer(Path(out), version=rosbag2.Writer.VERSION_LATEST, storage_plugin=plugin)
         mode = rosbag2.CompressionMode.STORAGE if fmt == "mcap" else rosbag2.CompressionMode.MESSAGE
         self.writer.set_compression(mode, rosbag2.CompressionFormat.ZSTD)
         self.writer.open()
@@ -186,3 +186,14 @@ class BagWriter:
 
     def close(self) -> None:
         self.writer.close()
+
+
+def drop_bag(writer: BagWriter | None, work: Path) -> None:
+    """Close and remove a bag that will not be kept (``work``: the hidden folder it was written in)."""
+    try:
+        if writer is not None:
+            writer.close()
+    except Exception:  # noqa: BLE001  a bag half written is removed whatever closing it says
+        pass
+    finally:
+        shutil.rmtree(work, ignore_errors=True)

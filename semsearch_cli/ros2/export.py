@@ -15,14 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import PlannerError, ScenarioError, did_you_mean
-from ..planners import Variant
+from ..errors import ScenarioError, did_you_mean
 from ..runner.specs import Loaded, file_stem
-from ..runner.store import read_decisions, read_runs
+from ..runner.store import read_runs
+from ..runner.verify import replay_run
 from ..tasks.base import Observer
-from ..tasks.decisions import Replay, ReplayError
 from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep
-from .bag import START_NS, BagWriter, Messages, stamp_ns
+from .bag import START_NS, BagWriter, Messages, drop_bag, stamp_ns
 
 SIGN_RGBA = (0.1, 0.3, 0.9, 1.0)
 GOAL_RGBA = (0.9, 0.1, 0.1, 1.0)
@@ -88,11 +87,10 @@ class BagRecorder(Observer):
             if i not in self.read:
                 self.read[i] = str(label)
                 new = True
-        row = e.row()
-        row["reads"] = [_label(v) for _, v in e.reads]  # labels as read, as the robot has them (no sign index)
-        self._write("/semsearch/events", e.step, self.m.string({"event": "frame", **row}))
+        self._write("/semsearch/events", e.step, self.m.string({"event": "frame", **e.row()}))
         if first:
-            self._write("/map", e.step, self.m.grid(self.t, b.seen, b.free, self.frame))
+            t = self._stamp(e.step)
+            self.bag.write("/map", t, self.m.grid(t, b.seen, b.free, self.frame))
         if new or first:
             self._signs(self.t)
 
@@ -124,10 +122,11 @@ class BagRecorder(Observer):
     def _decision(self, e: DoorDecision) -> None:
         self.decisions += 1
         b, c, k = e.belief, e.candidates, e.step
-        self._write("/map", k, self.m.grid(self.t, b.seen, b.free, self.frame))
+        t = self._stamp(k)
+        self.bag.write("/map", t, self.m.grid(t, b.seen, b.free, self.frame))
         if e.distance - self.path_at >= PATH_EVERY_M:
             self.path_at = e.distance
-            self._write("/semsearch/path", k, self.m.path(self.t, self._thinned()))
+            self.bag.write("/semsearch/path", self._stamp(k), self.m.path(self.t, self._thinned()))
         t = self.t
         cx, cy = self.frame.to_world(c.rows, c.cols)
         chosen = np.flatnonzero((c.rows == e.decision.row) & (c.cols == e.decision.col))
@@ -199,12 +198,13 @@ def recorded_runs(folder: Path) -> list[tuple[str, dict, Path]]:
 
 
 def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Path, fmt: str) -> Exported:
-    """Replay one recorded run into a bag folder ``out`` (which must not exist); a
-    :class:`ScenarioError` when the run is not a door search's or does not replay to its row."""
+    """Replay one recorded run into a bag folder ``out`` (which must not exist), checked as
+    ``semsearch verify`` checks it (the record the row names, the run it records, the row's
+    outcome, distance, steps and decisions); a :class:`ScenarioError` when it does not replay, and
+    then nothing is left behind."""
     task = loaded.task
     if task.kind != "doors":
         raise ScenarioError(str(loaded.path), "kind", f"is {task.kind}: only door-search runs export as bags so far")
-    record = read_decisions(record_file)
     episodes = {(str(e.goal), e.index): e for e in task.episodes}
     ep = episodes.get((str(row["goal"]), int(row["episode"])))
     if ep is None:
@@ -214,46 +214,32 @@ def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Pat
         shutil.rmtree(work)
     work.mkdir(parents=True)
     tmp = work / out.name  # rosbags names the storage file after its folder
-    bag = BagWriter(tmp, fmt, Messages())
-    rec = BagRecorder(bag, loaded.world, ep.goal, loaded.sc.robot.step, loaded.sc.laser.range)
-    setup = {"scenario": loaded.sc.name, "file": loaded.path.stem, "fingerprint": loaded.fingerprint, "goal": _label(ep.goal), "planner": str(row["planner"]),
-             "episode": int(row["episode"]), "seed": int(row["seed"])}
-    bag.write("/semsearch/setup", START_NS - 1000, bag.msgs.string(setup))
+    bag = None
     try:
-        replay = Replay(record)
-        res = task.run(Variant(str(row["planner"]), ()), ep, int(row["seed"]), observer=rec, seat=replay)
-        replay.finish()
+        bag = BagWriter(tmp, fmt, Messages())
+        rec = BagRecorder(bag, loaded.world, ep.goal, loaded.sc.robot.step, loaded.sc.laser.range)
+        setup = {"scenario": loaded.sc.name, "file": loaded.path.stem, "fingerprint": loaded.fingerprint,
+                 "goal": _label(ep.goal), "planner": str(row["planner"]), "episode": int(row["episode"]), "seed": int(row["seed"])}
+        bag.write("/semsearch/setup", START_NS - 1000, bag.msgs.string(setup))
+        why = replay_run(task, record_file, str(row["planner"]), str(row["goal"]), int(row["episode"]), int(row["seed"]), [row],
+                         episodes, observer=rec)
+        if why:
+            raise ScenarioError(str(record_file), "decisions", f"does not replay: {why}")
         rec.finish()
-    except (ReplayError, PlannerError, ScenarioError) as exc:
-        _drop(bag, work)
-        raise ScenarioError(str(record_file), "decisions", f"does not replay: {exc}") from None
-    except Exception as exc:  # noqa: BLE001  a recorded choice the run could not take: named, never a traceback
-        _drop(bag, work)
-        raise ScenarioError(str(record_file), "decisions", f"does not replay: {type(exc).__name__}: {str(exc)[:120]}") from None
-    bag.close()
-    got = (res.outcome, res.distance_m, res.steps)
-    want = (str(row["outcome"]), float(row["distance_m"]), int(row["steps"]))
-    if got[0] != want[0] or round(got[1], 3) != round(want[1], 3) or got[2] != want[2]:
-        shutil.rmtree(work, ignore_errors=True)
-        raise ScenarioError(str(record_file), "decisions", f"replays to {got[0]}, {got[1]:.3f} m, {got[2]} steps, not the row's "
-                            f"{want[0]}, {want[1]:.3f} m, {want[2]} steps (another scenario than the one it was run with?)")
+        bag.close()
+    except BaseException:
+        drop_bag(bag, work)
+        raise
     tmp.rename(out)
     work.rmdir()
     size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
-    return Exported(name, out, size, bag.count, rec.decisions, res.outcome, float(res.distance_m))
-
-
-def _drop(bag: BagWriter, work: Path) -> None:
-    """Close and remove a bag that will not be kept."""
-    try:
-        bag.close()
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
+    return Exported(name, out, size, bag.count, rec.decisions, str(row["outcome"]), float(row["distance_m"]))
 
 
 def export_folder(loaded: Loaded, folder: Path, out: Path, fmt: str, run: str | None = None) -> list[Exported]:
     """Every recorded run of ``folder`` (or the one named ``run``: its decisions file's stem) as a
-    bag folder ``out/<run>``; runs whose bag exists already are left as they are."""
+    bag folder ``out/<run>``; runs whose bag exists already are left as they are. A run that does
+    not replay is named in a :class:`ScenarioError` raised once the others are written."""
     runs = recorded_runs(folder)
     if not runs:
         raise ScenarioError(str(folder / "decisions"), "", "no run of this folder has a decisions record: run it with "
@@ -264,11 +250,23 @@ def export_folder(loaded: Loaded, folder: Path, out: Path, fmt: str, run: str | 
             raise ScenarioError("<command line>", "--run", f"no recorded run {run!r} in {folder}{did_you_mean(run, [r[0] for r in runs])} "
                                 f"({len(runs)} recorded: the names of {folder / 'decisions'}'s files without .json)")
         runs = named
+    other = [r for r in runs if str(r[1].get("fingerprint", "")) != loaded.fingerprint]
+    if other:
+        raise ScenarioError(str(loaded.path), "fingerprint", f"{len(other)} of the {len(runs)} runs were made with another scenario "
+                            f"(fingerprint {other[0][1].get('fingerprint')}, this one's {loaded.fingerprint}): give the scenario "
+                            "they were made with (--scenario)")
     out.mkdir(parents=True, exist_ok=True)
-    done = []
+    done, failed = [], []
     for name, row, f in runs:
         target = out / name
         if target.exists():
             continue
-        done.append(export_run(loaded, name, row, f, target, fmt))
+        try:
+            done.append(export_run(loaded, name, row, f, target, fmt))
+        except ScenarioError as exc:
+            failed.append(f"{name}: {exc.message}")
+    if failed:
+        kept = f" ({len(done)} other bag(s) written)" if done else ""
+        raise ScenarioError(str(folder / "decisions"), "", f"{len(failed)} run(s) do not replay{kept}: " + "; ".join(failed[:3])
+                            + ("; ..." if len(failed) > 3 else ""))
     return done

@@ -16,6 +16,7 @@ where it would go, and its answers are written to a new bag (``/semsearch/goal``
 from __future__ import annotations
 
 import json
+import shutil
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,13 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from ..config.base import sign_label
-from ..errors import ScenarioError
+from ..errors import BudgetSpent, PlannerError, ScenarioError
 from ..planners import Variant
 from ..runner.specs import Loaded
 from ..tasks.base import Observer, RobotState
 from ..tasks.decisions import DecisionPoint
 from ..tasks.doors import DoorDecision, DoorSearch
-from .bag import BagWriter, Messages, rosbag2
+from .bag import BagWriter, Messages, drop_bag, rosbag2
 
 CAND_RGBA, GOAL_RGBA = (1.0, 0.6, 0.0, 0.9), (0.9, 0.1, 0.1, 1.0)
 
@@ -71,11 +72,15 @@ class BagStream:
 
 
 def apply_update(belief, msg) -> None:
-    """Fold a map_msgs/OccupancyGridUpdate of /map into the belief (ROS rows to the simulator's)."""
+    """Fold a map_msgs/OccupancyGridUpdate of /map into the belief (ROS rows to the simulator's);
+    a ValueError when it does not lie inside the grid."""
     h, w = int(msg.height), int(msg.width)
+    H, W = belief.frame.height, belief.frame.width
+    x, y = int(msg.x), int(msg.y)
+    if h < 1 or w < 1 or x < 0 or y < 0 or x + w > W or y + h > H or len(msg.data) != h * w:
+        raise ValueError(f"a map update of {w} x {h} cells at ({x}, {y}) does not fit the {W} x {H} grid")
     states = np.asarray(msg.data, np.int8).reshape(h, w)[::-1]
-    r0 = belief.frame.height - int(msg.y) - h
-    belief.fold_grid(r0, int(msg.x), states >= 0, states == 0)
+    belief.fold_grid(H - y - h, x, states >= 0, states == 0)
 
 
 class ReplaySearch(DoorSearch):
@@ -94,12 +99,13 @@ class ReplaySearch(DoorSearch):
         st.x, st.y, st.heading, st.steps = float(ev["x"]), float(ev["y"]), float(ev["heading"]), int(ev["step"])
         v, u, r, c = fr.point_to_cell(st.x, st.y)
         b.views.append((v, u, st.heading))
-        found = event = False
+        event = False
         for label in ev.get("reads", []):
-            label = sign_label(label)
-            found = found or label == self.goal
-            if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == b.spec.min_reads:
+            if b.reads.add(sign_label(label), r * fr.width + c, st.x, st.y, st.heading) == b.spec.min_reads:
                 event = True
+        found = bool(ev.get("found", False))  # the goal's own sign read (a misread of another as the goal is not)
+        if "rng" in ev:  # sensed inside a re-plan: the generator as the sensing left it
+            self.rng.bit_generator.state = ev["rng"]
         self.found = self.found or found
         return found, event
 
@@ -127,7 +133,8 @@ class GoalWriter(Observer):
 
     def __init__(self, bag: BagWriter, frame):
         self.bag, self.m, self.frame = bag, bag.msgs, frame
-        self.t = 0
+        self.t = 0  # the input's stamp at the re-plan
+        self.last = -1  # the last stamp written
         self.rows: list[dict] = []
 
     def see(self, event) -> None:
@@ -143,9 +150,10 @@ class GoalWriter(Observer):
         row = {"step": int(event.step), "target_cell": [int(event.decision.row), int(event.decision.col)],
                "target": [float(v) for v in event.target_xy]}
         self.rows.append(row)
-        self.bag.write("/explore/frontiers", t + 1, self.m.markers(items))
-        self.bag.write("/semsearch/goal", t + 2, self.m.pose_stamped(t, *event.target_xy, yaw))
-        self.bag.write("/semsearch/decision", t + 3, self.m.string(row))
+        for topic, msg in (("/explore/frontiers", self.m.markers(items)), ("/semsearch/goal", self.m.pose_stamped(t, *event.target_xy, yaw)),
+                           ("/semsearch/decision", self.m.string(row))):
+            self.last = max(t, self.last + 1)  # after the input's moment, and after every message before
+            self.bag.write(topic, self.last, msg)
 
 
 @dataclass
@@ -178,11 +186,24 @@ def replay_bag(loaded: Loaded, bag: Path, variant: Variant, out: Path, fmt: str 
                                 "recorded on, --scenario")
         if out.exists():
             raise ScenarioError(str(out), "", "exists already: give a new folder for the replay's bag")
-        writer = BagWriter(out, fmt, msgs)
+        work = out.with_name(f".{out.name}.partial")  # written here, then moved into place whole
+        shutil.rmtree(work, ignore_errors=True)
+        work.mkdir(parents=True)
+        writer = None
         try:
+            writer = BagWriter(work / out.name, fmt, msgs)
             found, rows = _run(task, variant, sign_label(setup["goal"]), stream, writer, loaded.world.frame)
-        finally:
             writer.close()
+        except BaseException as exc:
+            drop_bag(writer, work)
+            if isinstance(exc, ScenarioError):
+                raise
+            if isinstance(exc, (PlannerError, BudgetSpent, KeyError, ValueError, TypeError)):
+                raise ScenarioError(str(bag), "", f"the replay of {variant.label} stopped: {type(exc).__name__}: "
+                                    f"{str(exc)[:160]}") from None
+            raise
+        (work / out.name).rename(out)
+        work.rmdir()
     finally:
         stream.close()
     return Replayed(out, rows, found)
@@ -193,10 +214,14 @@ def recorded_scenario(bag: Path) -> str | None:
     None when the bag does not say."""
     stream = BagStream(bag, Messages())
     try:
+        if "/semsearch/setup" not in stream.topics:
+            return None
         item = stream.peek()
         if item is None or item[0] != "/semsearch/setup":
             return None
         return json.loads(item[2].data).get("file")
+    except (ValueError, KeyError, AttributeError):  # a setup that is not ours to read
+        return None
     finally:
         stream.close()
 

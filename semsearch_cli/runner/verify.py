@@ -117,11 +117,13 @@ def _pool(loaded: Loaded, workers: int):
 def _job(job) -> str:
     name, f, planner, goal, episode, seed, rows = job
     task, episodes = _TASK[0]
-    return _replay(task, f, planner, goal, episode, seed, rows, episodes)
+    return replay_run(task, f, planner, goal, episode, seed, rows, episodes)
 
 
-def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, want: list[dict], episodes: dict) -> str:
-    """Why the run's replay does not give its rows, or "" when it does."""
+def replay_run(task, f: Path, planner: str, goal: str, episode: int, seed: int, want: list[dict], episodes: dict,
+               observer=None) -> str:
+    """Why the run's replay does not give its rows, or "" when it does; ``observer`` sees the
+    replay's events (``semsearch export`` writes them to a bag)."""
     named = str(want[0].get("decisions_sha256") or "")
     if named and hashlib.sha256(f.read_bytes()).hexdigest() != named:
         return f"{f.name} is not the record the row names (its SHA-256 differs from the row's decisions_sha256)"
@@ -138,7 +140,7 @@ def _replay(task, f: Path, planner: str, goal: str, episode: int, seed: int, wan
     variant = Variant(planner, ())  # the label alone: the replay builds no planner
     try:
         replay = Replay(record)
-        res = task.run(variant, ep, seed, seat=replay)
+        res = task.run(variant, ep, seed, observer=observer, seat=replay)
         replay.finish()
     except (ReplayError, PlannerError) as exc:
         return f"the replay stopped: {exc}"

@@ -102,8 +102,8 @@ class Observer:
     """Sees every :class:`Event` of a run (``Task.run(..., observer)``): the trace of
     ``semsearch run --trace`` (:class:`TraceObserver`), a report's replay, a notebook's plot.
     Observing changes nothing in the run; a planner may tabulate more for an observed run
-    (``DoorContext.explain``). An observer with ``steps`` true also sees every step of a door
-    search (``DoorStep``: the pose, the belief and the signs read in that frame), for an export
+    (``DoorContext.explain``). An observer with ``steps`` true also sees every sensing frame,
+    step and re-plan of a door search (``DoorFrame``, ``DoorStep``, ``DoorPlan``), for an export
     that needs the whole run (``semsearch export``)."""
 
     steps = False

@@ -57,10 +57,11 @@ DOOR_CODEC = Codec(_encode, _decode)
 
 class DoorSensing:
     """Laser into HIMM and door cameras into reads, shared by the searches of this task. An
-    observer that asks for steps (``Observer.steps``) sees a :class:`DoorStep` after each step's
-    belief update."""
+    observer that asks for steps (``Observer.steps``) sees a :class:`DoorFrame` after each
+    sensing and a :class:`DoorStep` after each step's belief update."""
 
     observer: Observer | None = None
+    _planning = False  # inside a re-plan (DoorSearch.plan): frames sensed now tell the generator's state after them
 
     def __init__(self, task: "DoorTask", goal, rng: np.random.Generator):
         self.task, self.goal, self.rng = task, goal, rng
@@ -83,8 +84,9 @@ class DoorSensing:
             if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:
                 event = True
         if self.observer is not None and self.observer.steps:
+            rng = _jsonable_state(self.rng.bit_generator.state) if self._planning else None
             self.observer.see(DoorFrame(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=b, reads=tuple(reads),
-                                        scan=scan))
+                                        scan=scan, found=found, rng=rng))
         return found, event
 
     def update(self, st: RobotState) -> None:
@@ -102,8 +104,10 @@ class DoorFrame(Event):
     (``Observer.steps``): the pose (``x``, ``y`` m, ``heading`` rad) it sensed from during step
     ``step``, the belief after folding it in (``belief``: copy what you keep), the signs it read
     [(sign index, label as read)] and its laser scan (beam angles rad in the world, ranges in
-    cells, hit flags). A step senses one frame; turning on the spot senses several within one
-    step. Not traced."""
+    cells, hit flags); ``found``: whether it read the goal's sign; ``rng``: inside a re-plan (a
+    turn on the spot), the run's generator state after it (NumPy's bit-generator state), else
+    None. A step senses one frame; turning on the spot senses several within one step. Not
+    traced."""
 
     step: int
     x: float
@@ -112,14 +116,19 @@ class DoorFrame(Event):
     belief: DoorBelief
     reads: tuple = ()
     scan: tuple | None = None
+    found: bool = False
+    rng: dict | None = None
 
     @property
     def traced(self) -> bool:
         return False
 
     def row(self) -> dict:
-        return {"step": self.step, "x": float(self.x), "y": float(self.y), "heading": float(self.heading),
-                "reads": [[int(i), str(v)] for i, v in self.reads]}
+        """The frame as the robot has it: its pose, the labels read (a whole number as a number),
+        whether the goal's sign was among them, the generator's state inside a re-plan."""
+        labels = [int(v) if isinstance(v, (int, np.integer)) and not isinstance(v, bool) else str(v) for _, v in self.reads]
+        return {"step": self.step, "x": float(self.x), "y": float(self.y), "heading": float(self.heading), "reads": labels,
+                "found": bool(self.found), **({"rng": self.rng} if self.rng is not None else {})}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -200,8 +209,13 @@ class DoorDecision(Event):
 
 
 def _jsonable_state(state: dict) -> dict:
-    """A bit generator's state with NumPy integers as Python ones (JSON writes it as it is)."""
-    return {k: _jsonable_state(v) if isinstance(v, dict) else (v.item() if hasattr(v, "item") else v) for k, v in state.items()}
+    """A bit generator's state with NumPy numbers as Python ones and arrays as lists (JSON writes
+    it as it is; NumPy takes it back)."""
+    def plain(v):
+        if isinstance(v, dict):
+            return _jsonable_state(v)
+        return v.tolist() if hasattr(v, "tolist") else v
+    return {k: plain(v) for k, v in state.items()}
 
 
 def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
@@ -279,7 +293,11 @@ class DoorSearch(DoorSensing):
         stepping = self.observer is not None and self.observer.steps
         if stepping:
             self.observer.see(DoorPlan(step=st.steps, start=True, rng=_jsonable_state(self.rng.bit_generator.state)))
-        out = yield from self._plan(st)
+        self._planning = True
+        try:
+            out = yield from self._plan(st)
+        finally:
+            self._planning = False
         if stepping:
             self.observer.see(DoorPlan(step=st.steps, start=False))
         return out
