@@ -189,12 +189,13 @@ def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | No
 
 
 def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | Path | None = None, fmt: str = "mcap",
-               planner_file: str | Path | None = None):
-    """Run a door planner (``NAME`` or ``NAME[key=value,...]``) over a bag ``semsearch export``
-    wrote, asked at each of the bag's re-plans, and write its decisions as a new bag folder ``out``
-    (:func:`~semsearch_cli.ros2.replay_bag`; the ``ros`` extra). ``scenario``: the scenario the bag
-    was recorded on (default: the shipped scenario the bag names). Returns the
-    :class:`~semsearch_cli.ros2.Replayed`."""
+               planner_file: str | Path | None = None, goal: str | None = None):
+    """Run a door planner (``NAME`` or ``NAME[key=value,...]``) over a bag, asked at each of its
+    re-plans, and write its decisions as a new bag folder ``out``
+    (:func:`~semsearch_cli.ros2.replay_bag`; the ``ros`` extra). A bag ``semsearch export`` wrote
+    replays on ``scenario``, the one it was recorded on (default: the shipped scenario the bag
+    names); a robot's own bag (a map, a pose, the detections) needs ``goal``, the label to find, and
+    takes its settings from ``scenario`` when given. Returns the :class:`~semsearch_cli.ros2.Replayed`."""
     if fmt not in ros2.FORMATS:
         raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
     if not ros2.available():
@@ -202,18 +203,18 @@ def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | P
     bag = Path(bag)
     if not bag.is_dir():
         raise ScenarioError(str(bag), "", "no such bag folder (a ROS 2 bag is a folder with metadata.yaml)")
-    if scenario is None:
-        name = ros2.recorded_scenario(bag)
-        if name is None or name not in shipped.names():
+    name = ros2.recorded_scenario(bag)  # None: a robot's own bag
+    if scenario is None and name is not None:
+        if name not in shipped.names():
             raise ScenarioError(str(bag), "/semsearch/setup", f"names the scenario {name!r}, which is not a shipped one: give "
                                 "the scenario the bag was recorded on, --scenario FILE")
         scenario = name
-    loaded = Loaded.load(scenario_file(scenario), planners=False)
-    variants = expand_variants([planner_spec(planner, planner_file)], "<command line>", loaded.task.planner_kind)
+    loaded = Loaded.load(scenario_file(scenario), planners=False) if scenario is not None else None
+    variants = expand_variants([planner_spec(planner, planner_file)], "<command line>", TASKS["doors"].planner_kind)
     if len(variants) != 1:
         raise ScenarioError("<command line>", "--planner", f"{planner!r} names {len(variants)} variants: give one value per "
                             "parameter")
-    return ros2.replay_bag(loaded, bag, variants[0], Path(out), fmt)
+    return ros2.replay_bag(loaded, bag, variants[0], Path(out), fmt, goal)
 
 
 def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None,

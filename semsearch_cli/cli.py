@@ -424,16 +424,19 @@ def ros_replay(
     planner: str = typer.Option(..., "--planner", help="The door planner to ask: NAME or NAME[key=value,...], e.g. nsos[alpha=0.9]."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="The new bag folder for its decisions (must not exist)."),
     scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the bag was recorded on (default: the "
-                                            "shipped scenario the bag names)."),
+                                            "shipped scenario the bag names); for a robot's bag, where its settings come from."),
     fmt: str = typer.Option("mcap", "--format", help="mcap or rosbag2 (SQLite 3), for the new bag."),
     planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner."),
+    goal: Optional[str] = typer.Option(None, "--goal", help="The label to find, for a robot's own bag (a bag of `semsearch "
+                                       "export` names its goal)."),
 ):
     """Ask a door planner where it would go at each re-plan of a recorded bag, the robot moving as it
     moved, and write its answers (/semsearch/goal, /explore/frontiers, /semsearch/decision) to a new
-    bag. The run's own planner makes the run's decisions, decision for decision."""
+    bag. Over a bag of `semsearch export`, the run's own planner makes the run's decisions, decision
+    for decision; a robot's own bag (/map, a pose, /semsearch/detections) needs --goal."""
 
     try:
-        res = api.ros_replay(bag, planner, out_dir, scenario, fmt, planner_file)
+        res = api.ros_replay(bag, planner, out_dir, scenario, fmt, planner_file, goal)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"{res.folder}: {len(res.decisions)} decisions of {planner} over {bag}"

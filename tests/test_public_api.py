@@ -40,7 +40,7 @@ API = {
     "init": ["name", "folder", "force"],
     "verify": ["folder", "scenario", "progress", "workers", "salt_file"],
     "export": ["folder", "out", "fmt", "run", "scenario"],
-    "ros_replay": ["bag", "planner", "out", "scenario", "fmt", "planner_file"],
+    "ros_replay": ["bag", "planner", "out", "scenario", "fmt", "planner_file", "goal"],
     "bench_run": ["suite", "planners", "out", "split", "numbering", "options", "limit", "salt_file", "planner_file", "progress"],
     "bench_list": [],
     "bench_hash": ["suite", "split", "salt_file"],

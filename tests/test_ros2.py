@@ -231,14 +231,14 @@ def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay
     res = CliRunner().invoke(app, ["ros", "replay", str(out / "trip2" / RUN), "--planner", "greedy", "--out", str(tmp_path / "a"),
                                    "--scenario", str(other)])
     assert res.exit_code == 2 and "recorded on another scenario" in " ".join(res.output.split()), res.output
-    # a robot's own bag: a pose and a map, no /semsearch/events
+    # a robot's own bag with a pose but no map
     m = Messages()
     w = BagWriter(tmp_path / "robot", "mcap", m)
     w.write("/semsearch/pose", 1_000_000_000, m.pose_stamped(1_000_000_000, 1.0, 2.0, 0.0))
     w.close()
     res = CliRunner().invoke(app, ["ros", "replay", str(tmp_path / "robot"), "--planner", "greedy", "--out", str(tmp_path / "b"),
-                                   "--scenario", str(scenario)])
-    assert res.exit_code == 2 and "is not built yet" in " ".join(res.output.split()), res.output
+                                   "--goal", "452"])
+    assert res.exit_code == 2 and "a robot's bag needs /map" in " ".join(res.output.split()), res.output
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
 
 
@@ -246,3 +246,35 @@ def test_the_topics_page_lists_every_topic_as_the_code_writes_it():
     page = (Path(__file__).resolve().parents[1] / "docs" / "robot.md").read_text()
     rows = [line for line in page.splitlines() if line.startswith("| `/")]
     assert rows == [f"| `{t}` | `{ty}` | {when} | {what} |" for t, (ty, when, what) in TOPICS.items()]
+
+
+def test_a_robots_own_bag_replays_from_its_map_poses_and_detections(recorded, tmp_path):
+    """A robot's bag: a SLAM map now and then, poses, detections, and nothing of semsearch's own
+    (made here from an exported run's /map, /semsearch/pose and /semsearch/detections). The
+    planner is asked every metre; its targets are free cells of the map it had."""
+    out, L, _, scenario = recorded
+    res = CliRunner().invoke(app, ["export", str(out / "results"), "--out", str(tmp_path / "sim"), "--scenario", str(scenario),
+                                   "--run", RUN])
+    assert res.exit_code == 0, res.output
+    m, robot = Messages(), tmp_path / "robot"
+    w = BagWriter(robot, "mcap", m)
+    with Reader(tmp_path / "sim" / RUN) as r:
+        for c, t, raw in r.messages():
+            if c.topic in ("/map", "/semsearch/pose", "/semsearch/detections"):
+                w.write(c.topic, t, TS.deserialize_cdr(raw, c.msgtype))
+    w.close()
+    no_goal = CliRunner().invoke(app, ["ros", "replay", str(robot), "--planner", "greedy", "--out", str(tmp_path / "x")])
+    assert no_goal.exit_code == 2 and "give the label to find, --goal" in " ".join(no_goal.output.split())
+    res = CliRunner().invoke(app, ["ros", "replay", str(robot), "--planner", "greedy", "--goal", "452", "--out", str(tmp_path / "out")])
+    assert res.exit_code == 0, res.output
+    assert "(the goal was read in the bag)" in " ".join(res.output.split())
+    got = messages(tmp_path / "out")
+    targets = [(g.pose.position.x, g.pose.position.y) for _, g in got["/semsearch/goal"]]
+    sim_decisions = len(decisions_of(tmp_path / "sim" / RUN))
+    assert 5 <= len(targets) and abs(len(targets) - sim_decisions) <= sim_decisions  # about as many decisions as the run made
+    maps = messages(tmp_path / "sim" / RUN)["/map"]
+    fr = L.world.frame
+    for (t, _), (x, y) in zip(got["/semsearch/goal"], targets):
+        grid = [g for s, g in maps if s <= t][-1]  # the last map before the decision
+        r, c = (int(v) for v in fr.to_index(x, y))
+        assert grid.data.reshape(fr.height, fr.width)[::-1][r, c] == 0  # free

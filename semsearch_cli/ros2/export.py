@@ -20,7 +20,7 @@ from ..runner.specs import Loaded, file_stem
 from ..runner.store import read_runs
 from ..runner.verify import replay_run
 from ..tasks.base import Observer
-from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep
+from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep, DoorTask
 from .bag import START_NS, BagWriter, Messages, drop_bag, stamp_ns
 
 SIGN_RGBA = (0.1, 0.3, 0.9, 1.0)
@@ -203,7 +203,7 @@ def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Pat
     outcome, distance, steps and decisions); a :class:`ScenarioError` when it does not replay, and
     then nothing is left behind."""
     task = loaded.task
-    if task.kind != "doors":
+    if not isinstance(task, DoorTask):
         raise ScenarioError(str(loaded.path), "kind", f"is {task.kind}: only door-search runs export as bags so far")
     episodes = {(str(e.goal), e.index): e for e in task.episodes}
     ep = episodes.get((str(row["goal"]), int(row["episode"])))

@@ -10,29 +10,44 @@ where it would go, and its answers are written to a new bag (``/semsearch/goal``
   run's generator state, so that the run's own planner makes the run's decisions, decision for
   decision;
 - a frame sensed by a re-plan (turning on the spot) is taken from the bag when the replayed
-  re-plan senses; frames a re-plan of another planner does not ask for are folded in after it.
+  re-plan senses; frames a re-plan of another planner does not ask for are folded in after it;
+- a robot's own bag (no events) needs a map (``/map``, nav_msgs/OccupancyGrid, as a SLAM node
+  publishes it: free below 20, occupied from 65, as map_saver's thresholds), a pose
+  (:data:`POSE_TOPICS`, PoseStamped or PoseWithCovarianceStamped in the map's frame) and the
+  sign detections (``/semsearch/detections``, JSON ``{"label", ...}``, read from the robot's pose
+  at that moment). The belief's grid covers every map the bag holds; each pose is a frame and a
+  step; a re-plan comes at the first pose that has a map, after every ``replan_every`` metres
+  travelled, and when a sign is read ``min_reads`` times (for planners that re-plan on signs), as
+  the simulator's periodic policy; the goal's label is ``--goal``.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
+from ..belief import DoorBelief
+from ..config import BeliefSpec, DoorCameraSpec, NavigationSpec, RobotSpec
 from ..config.base import sign_label
+from ..geometry import GridFrame
 from ..errors import BudgetSpent, PlannerError, ScenarioError
 from ..planners import Variant
 from ..runner.specs import Loaded
 from ..tasks.base import Observer, RobotState
 from ..tasks.decisions import DecisionPoint
-from ..tasks.doors import DoorDecision, DoorSearch
+from ..tasks.doors import DoorDecision, DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
 
 CAND_RGBA, GOAL_RGBA = (1.0, 0.6, 0.0, 0.9), (0.9, 0.1, 0.1, 1.0)
+POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot bag's pose: the first of these it holds
+FREE_BELOW, OCCUPIED_FROM = 20, 65  # OccupancyGrid values: map_saver's free (0.196) and occupied (0.65) thresholds
 
 
 class BagStream:
@@ -110,7 +125,10 @@ class ReplaySearch(DoorSearch):
         return found, event
 
     def sense(self, st: RobotState) -> tuple[bool, bool]:
-        """A frame sensed inside a re-plan: the bag's next one, if the bag's re-plan sensed it."""
+        """A frame sensed inside a re-plan: the bag's next one, if the bag's re-plan sensed it (a
+        robot's bag has none: a re-plan that would turn on the spot sees nothing new)."""
+        if "/semsearch/events" not in self.stream.topics:
+            return False, False
         while True:
             item = self.stream.peek()
             if item is None:
@@ -166,24 +184,30 @@ class Replayed:
     found: bool
 
 
-def replay_bag(loaded: Loaded, bag: Path, variant: Variant, out: Path, fmt: str = "mcap") -> Replayed:
-    """Run door planner ``variant`` over ``bag`` (written by
-    ``semsearch export`` from a run of ``loaded``'s scenario) and write its decisions to the new
-    bag folder ``out`` (which must not exist)."""
-    task = loaded.task
-    if task.kind != "doors":
-        raise ScenarioError(str(loaded.path), "kind", f"is {task.kind}: a bag replays door planners only")
+def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fmt: str = "mcap", goal=None) -> Replayed:
+    """Run door planner ``variant`` over ``bag`` and write its decisions to the new bag folder
+    ``out`` (which must not exist). A bag ``semsearch export`` wrote replays on ``loaded``, the
+    scenario it was recorded on; a robot's own bag needs ``goal`` (the label to find) and takes
+    the belief's, robot's and navigation's settings from ``loaded`` when given, else their
+    defaults."""
+    if loaded is not None and not isinstance(loaded.task, DoorTask):
+        raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: a bag replays door planners only")
     msgs = Messages()
     stream = BagStream(bag, msgs)
     try:
-        if "/semsearch/events" not in stream.topics:
-            raise ScenarioError(str(bag), "/semsearch/events", "not in the bag: it was not written by `semsearch export`, and "
-                                "replaying a robot's own bag (map, pose and detections alone) is not built yet")
-        setup = _setup(stream, bag)
-        if setup["fingerprint"] != loaded.fingerprint:
-            raise ScenarioError(str(bag), "/semsearch/setup", f"the bag was recorded on another scenario (fingerprint "
-                                f"{setup['fingerprint']}, {loaded.path.name}'s is {loaded.fingerprint}): give the one it was "
-                                "recorded on, --scenario")
+        if "/semsearch/events" in stream.topics:
+            setup = _setup(stream, bag)
+            if loaded is None or setup["fingerprint"] != loaded.fingerprint:
+                have = f"{loaded.path.name}'s is {loaded.fingerprint}" if loaded is not None else "no scenario given"
+                raise ScenarioError(str(bag), "/semsearch/setup", f"the bag was recorded on another scenario (fingerprint "
+                                    f"{setup['fingerprint']}, {have}): give the one it was recorded on, --scenario")
+            task, goal, frame = loaded.task, sign_label(setup["goal"]), loaded.world.frame
+            run = _run
+        else:
+            if goal is None:
+                raise ScenarioError(str(bag), "--goal", "a robot's own bag names no goal: give the label to find, --goal")
+            frame = _robot_frame(bag, msgs)
+            task, goal, run = RobotTask(frame, loaded.sc if loaded is not None else None), sign_label(goal), _run_robot
         if out.exists():
             raise ScenarioError(str(out), "", "exists already: give a new folder for the replay's bag")
         work = out.with_name(f".{out.name}.partial")  # written here, then moved into place whole
@@ -192,7 +216,7 @@ def replay_bag(loaded: Loaded, bag: Path, variant: Variant, out: Path, fmt: str 
         writer = None
         try:
             writer = BagWriter(work / out.name, fmt, msgs)
-            found, rows = _run(task, variant, sign_label(setup["goal"]), stream, writer, loaded.world.frame)
+            found, rows = run(task, variant, goal, stream, writer, frame)
             writer.close()
         except BaseException as exc:
             drop_bag(writer, work)
@@ -281,3 +305,125 @@ def _plan(search: ReplaySearch, st: RobotState) -> None:
             point = gen.send(point.ask())
     except StopIteration:
         pass
+
+
+class _NoSigns:
+    """A robot's bag knows no sign of the world: the goal is matched by its label alone."""
+
+    def indices_of(self, label) -> list:
+        return []
+
+
+@dataclass
+class _RobotWorld:
+    frame: GridFrame
+    signs: _NoSigns
+
+
+class RobotTask:
+    """What a door search needs of its task, for a robot's bag: the grid its maps cover, and the
+    belief's, robot's, camera's and navigation's settings (a scenario's, or the defaults)."""
+
+    kind = "doors"
+
+    def __init__(self, frame: GridFrame, sc=None):
+        self.world = _RobotWorld(frame, _NoSigns())
+        self.sc = sc if sc is not None else SimpleNamespace(belief=BeliefSpec(), robot=RobotSpec(), door_camera=DoorCameraSpec(),
+                                                            navigation=NavigationSpec())
+
+    def new_belief(self) -> DoorBelief:
+        return DoorBelief(self.world.frame, self.sc.belief, self.sc.robot.radius)
+
+
+def _robot_frame(bag: Path, msgs: Messages) -> GridFrame:
+    """The grid that covers every /map of a robot's bag, at their resolution."""
+    stream = BagStream(bag, msgs)
+    try:
+        if "/map" not in stream.topics or not any(t in stream.topics for t in POSE_TOPICS):
+            raise ScenarioError(str(bag), "/map", "a robot's bag needs /map (nav_msgs/OccupancyGrid) and a pose on one of "
+                                f"{', '.join(POSE_TOPICS)} (or it is a bag of `semsearch export`, with /semsearch/events)")
+        res, box = None, [np.inf, np.inf, -np.inf, -np.inf]
+        while (item := stream.next()) is not None:
+            if item[0] != "/map":
+                continue
+            info = item[2].info
+            q = info.origin.orientation
+            if abs(q.z) > 1e-6 or abs(q.x) > 1e-6 or abs(q.y) > 1e-6:
+                raise ScenarioError(str(bag), "/map", "a map rotated in its frame (origin orientation not 0) is not read")
+            if res is None:
+                res = float(info.resolution)
+            elif abs(float(info.resolution) - res) > 1e-9:
+                raise ScenarioError(str(bag), "/map", f"maps of two resolutions ({res} and {info.resolution} m)")
+            x0, y0 = float(info.origin.position.x), float(info.origin.position.y)
+            box = [min(box[0], x0), min(box[1], y0), max(box[2], x0 + info.width * res), max(box[3], y0 + info.height * res)]
+    finally:
+        stream.close()
+    W, H = int(round((box[2] - box[0]) / res)), int(round((box[3] - box[1]) / res))
+    return GridFrame(res, box[0], box[1], H, W)
+
+
+def fold_map(belief, msg) -> None:
+    """Fold a robot's OccupancyGrid (its SLAM map, placed by its origin in the grid that covers every
+    map of the bag) into the belief: -1 unknown, below ``FREE_BELOW`` free, else seen and not free."""
+    fr, info = belief.frame, msg.info
+    h, w = int(info.height), int(info.width)
+    c0 = int(round((float(info.origin.position.x) - fr.origin_x) / fr.res))
+    y0 = int(round((float(info.origin.position.y) - fr.origin_y) / fr.res))
+    values = np.asarray(msg.data, np.int8).reshape(h, w)[::-1]
+    belief.fold_grid(fr.height - y0 - h, c0, values >= 0, (values >= 0) & (values < FREE_BELOW))
+
+
+def _pose_of(msg) -> tuple[float, float, float]:
+    pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose  # PoseWithCovarianceStamped or PoseStamped
+    q = pose.orientation
+    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return float(pose.position.x), float(pose.position.y), yaw
+
+
+def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame) -> tuple[bool, list]:
+    """A robot's bag: each pose a frame and a step, re-plans as the simulator's periodic policy."""
+    planner = variant.build()
+    out = GoalWriter(writer, frame)
+    st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
+    search = ReplaySearch(task, planner, goal, np.random.default_rng(0), out, stream)
+    pose_topic = next(t for t in POSE_TOPICS if t in stream.topics)
+    every = task.sc.navigation.replan_every
+    on_signs = getattr(planner, "replan_on_signs", False)
+    b, fr = st.belief, frame
+    have_map = posed = False
+    since, due = 0.0, True
+    while (item := stream.next()) is not None:
+        topic, t, msg = item
+        out.t = t
+        if topic == "/map":
+            fold_map(b, msg)
+            have_map = True
+        elif topic == pose_topic:
+            x, y, yaw = _pose_of(msg)
+            if posed:
+                moved = math.hypot(x - st.x, y - st.y)
+                st.distance += moved
+                since += moved
+            st.x, st.y, st.heading, posed = x, y, yaw, True
+            st.steps += 1
+            v, u, r, c = fr.point_to_cell(x, y)
+            if not (0 <= r < fr.height and 0 <= c < fr.width):
+                continue
+            b.views.append((v, u, yaw))
+            search.update(st)
+            if have_map and (due or since >= every):
+                since, due = 0.0, False
+                _plan(search, st)
+        elif topic == "/semsearch/detections" and posed:
+            try:
+                label = sign_label(json.loads(msg.data)["label"])
+            except (ValueError, KeyError, TypeError):
+                continue  # not a detection this replay reads: skipped, as a robot's stray message would be
+            _, _, r, c = fr.point_to_cell(st.x, st.y)
+            if 0 <= r < fr.height and 0 <= c < fr.width:
+                if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == b.spec.min_reads and on_signs:
+                    due = True
+                if label == goal:
+                    search.found = True
+                    break
+    return search.found, out.rows
