@@ -278,3 +278,31 @@ def test_a_robots_own_bag_replays_from_its_map_poses_and_detections(recorded, tm
         grid = [g for s, g in maps if s <= t][-1]  # the last map before the decision
         r, c = (int(v) for v in fr.to_index(x, y))
         assert grid.data.reshape(fr.height, fr.width)[::-1][r, c] == 0  # free
+    # the same robot with its pose in /tf only: map -> odom (sent once) -> base_link (every pose)
+    ox, oy, oyaw = 0.5, -0.25, 0.3
+    tf_bag = tmp_path / "robot_tf"
+    w = BagWriter(tf_bag, "mcap", m)
+    first = True
+    with Reader(tmp_path / "sim" / RUN) as r:
+        for c, t, raw in r.messages():
+            msg = TS.deserialize_cdr(raw, c.msgtype)
+            if c.topic == "/semsearch/pose":
+                x, y = msg.pose.position.x, msg.pose.position.y
+                yaw = 2 * math.atan2(msg.pose.orientation.z, msg.pose.orientation.w)
+                dx, dy = x - ox, y - oy  # the pose in odom: the inverse of map -> odom applied to it
+                lx, ly = math.cos(oyaw) * dx + math.sin(oyaw) * dy, -math.sin(oyaw) * dx + math.cos(oyaw) * dy
+                tf = m.tf(t, lx, ly, yaw - oyaw)
+                tf.transforms[0].header.frame_id = "odom"
+                if first:
+                    root = m.tf(t - 1, ox, oy, oyaw)
+                    root.transforms[0].child_frame_id = "odom"
+                    w.write("/tf", t - 1, root)
+                    first = False
+                w.write("/tf", t, tf)
+            elif c.topic in ("/map", "/semsearch/detections"):
+                w.write(c.topic, t, msg)
+    w.close()
+    res = CliRunner().invoke(app, ["ros", "replay", str(tf_bag), "--planner", "greedy", "--goal", "452", "--out", str(tmp_path / "out_tf")])
+    assert res.exit_code == 0, res.output
+    via_tf = [(round(g.pose.position.x, 6), round(g.pose.position.y, 6)) for _, g in messages(tmp_path / "out_tf")["/semsearch/goal"]]
+    assert via_tf == [(round(x, 6), round(y, 6)) for x, y in targets]  # the same targets, the poses composed to within rounding

@@ -13,7 +13,8 @@ where it would go, and its answers are written to a new bag (``/semsearch/goal``
   re-plan senses; frames a re-plan of another planner does not ask for are folded in after it;
 - a robot's own bag (no events) needs a map (``/map``, nav_msgs/OccupancyGrid, as a SLAM node
   publishes it: free below 20, occupied from 65, as map_saver's thresholds), a pose
-  (:data:`POSE_TOPICS`, PoseStamped or PoseWithCovarianceStamped in the map's frame) and the
+  (:data:`POSE_TOPICS`, PoseStamped or PoseWithCovarianceStamped in the map's frame; else /tf
+  and /tf_static composed from map to :data:`BASE_FRAMES`, in the plane) and the
   sign detections (``/semsearch/detections``, JSON ``{"label", ...}``, read from the robot's pose
   at that moment). The belief's grid covers every map the bag holds; each pose is a frame and a
   step; a re-plan comes at the first pose that has a map, after every ``replan_every`` metres
@@ -46,7 +47,8 @@ from ..tasks.doors import DoorDecision, DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
 
 CAND_RGBA, GOAL_RGBA = (1.0, 0.6, 0.0, 0.9), (0.9, 0.1, 0.1, 1.0)
-POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot bag's pose: the first of these it holds
+POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot bag's pose: the first of these it holds, else /tf
+BASE_FRAMES = ("base_link", "base_footprint")  # the robot's frame in /tf, the first that reaches map
 FREE_BELOW, OCCUPIED_FROM = 20, 65  # OccupancyGrid values: map_saver's free (0.196) and occupied (0.65) thresholds
 
 
@@ -339,9 +341,10 @@ def _robot_frame(bag: Path, msgs: Messages) -> GridFrame:
     """The grid that covers every /map of a robot's bag, at their resolution."""
     stream = BagStream(bag, msgs)
     try:
-        if "/map" not in stream.topics or not any(t in stream.topics for t in POSE_TOPICS):
+        if "/map" not in stream.topics or not any(t in stream.topics for t in (*POSE_TOPICS, "/tf")):
             raise ScenarioError(str(bag), "/map", "a robot's bag needs /map (nav_msgs/OccupancyGrid) and a pose on one of "
-                                f"{', '.join(POSE_TOPICS)} (or it is a bag of `semsearch export`, with /semsearch/events)")
+                                f"{', '.join(POSE_TOPICS)} or /tf (map to {' or '.join(BASE_FRAMES)}); or it is a bag of "
+                                "`semsearch export`, with /semsearch/events")
         res, box = None, [np.inf, np.inf, -np.inf, -np.inf]
         while (item := stream.next()) is not None:
             if item[0] != "/map":
@@ -373,11 +376,42 @@ def fold_map(belief, msg) -> None:
     belief.fold_grid(fr.height - y0 - h, c0, values >= 0, (values >= 0) & (values < FREE_BELOW))
 
 
+def _yaw(q) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
 def _pose_of(msg) -> tuple[float, float, float]:
     pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose  # PoseWithCovarianceStamped or PoseStamped
-    q = pose.orientation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-    return float(pose.position.x), float(pose.position.y), yaw
+    return float(pose.position.x), float(pose.position.y), _yaw(pose.orientation)
+
+
+class TfTree:
+    """The latest 2D transform of each frame to its parent, from /tf and /tf_static; ``pose`` of a
+    frame in ``map`` composes them (None while the chain is incomplete)."""
+
+    def __init__(self):
+        self.parent: dict[str, tuple[str, float, float, float]] = {}
+
+    def add(self, msg) -> set[str]:
+        """Take a TFMessage; returns the child frames it updated."""
+        done = set()
+        for tr in msg.transforms:
+            child, t = tr.child_frame_id.lstrip("/"), tr.transform
+            self.parent[child] = (tr.header.frame_id.lstrip("/"), float(t.translation.x), float(t.translation.y), _yaw(t.rotation))
+            done.add(child)
+        return done
+
+    def pose(self, frame: str, root: str = "map") -> tuple[float, float, float] | None:
+        x = y = yaw = 0.0
+        for _ in range(16):  # a tree of a robot is shallow; a loop in it is not followed for ever
+            if frame == root:
+                return x, y, yaw
+            if frame not in self.parent:
+                return None
+            frame, px, py, pyaw = self.parent[frame]
+            c, s = math.cos(pyaw), math.sin(pyaw)
+            x, y, yaw = px + c * x - s * y, py + s * x + c * y, pyaw + yaw
+        return None
 
 
 def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame) -> tuple[bool, list]:
@@ -386,7 +420,8 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
     out = GoalWriter(writer, frame)
     st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
     search = ReplaySearch(task, planner, goal, np.random.default_rng(0), out, stream)
-    pose_topic = next(t for t in POSE_TOPICS if t in stream.topics)
+    pose_topic = next((t for t in POSE_TOPICS if t in stream.topics), None)  # else /tf: map -> odom -> base_link
+    tf = TfTree()
     every = task.sc.navigation.replan_every
     on_signs = getattr(planner, "replan_on_signs", False)
     b, fr = st.belief, frame
@@ -395,25 +430,15 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
     while (item := stream.next()) is not None:
         topic, t, msg = item
         out.t = t
+        pose = None
         if topic == "/map":
             fold_map(b, msg)
             have_map = True
         elif topic == pose_topic:
-            x, y, yaw = _pose_of(msg)
-            if posed:
-                moved = math.hypot(x - st.x, y - st.y)
-                st.distance += moved
-                since += moved
-            st.x, st.y, st.heading, posed = x, y, yaw, True
-            st.steps += 1
-            v, u, r, c = fr.point_to_cell(x, y)
-            if not (0 <= r < fr.height and 0 <= c < fr.width):
-                continue
-            b.views.append((v, u, yaw))
-            search.update(st)
-            if have_map and (due or since >= every):
-                since, due = 0.0, False
-                _plan(search, st)
+            pose = _pose_of(msg)
+        elif pose_topic is None and topic in ("/tf", "/tf_static"):
+            if tf.add(msg) & set(BASE_FRAMES):
+                pose = next(filter(None, map(tf.pose, BASE_FRAMES)), None)
         elif topic == "/semsearch/detections" and posed:
             try:
                 label = sign_label(json.loads(msg.data)["label"])
@@ -426,4 +451,21 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
                 if label == goal:
                     search.found = True
                     break
+        if pose is None:
+            continue
+        x, y, yaw = pose
+        if posed:
+            moved = math.hypot(x - st.x, y - st.y)
+            st.distance += moved
+            since += moved
+        st.x, st.y, st.heading, posed = x, y, yaw, True
+        st.steps += 1
+        v, u, r, c = fr.point_to_cell(x, y)
+        if not (0 <= r < fr.height and 0 <= c < fr.width):
+            continue
+        b.views.append((v, u, yaw))
+        search.update(st)
+        if have_map and (due or since >= every):
+            since, due = 0.0, False
+            _plan(search, st)
     return search.found, out.rows
