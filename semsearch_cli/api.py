@@ -201,6 +201,9 @@ def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | P
     if not ros2.available():
         raise ScenarioError("<command line>", "ros replay", "needs the ros extra (rosbags, mcap): pip install 'semsearch[ros]'")
     bag = Path(bag)
+    if bag.is_file():
+        raise ScenarioError(str(bag), "", f"is a file: give the bag's folder, {bag.parent} (a ROS 2 bag is a folder with "
+                            "metadata.yaml)")
     if not bag.is_dir():
         raise ScenarioError(str(bag), "", "no such bag folder (a ROS 2 bag is a folder with metadata.yaml)")
     name = ros2.recorded_scenario(bag)  # None: a robot's own bag

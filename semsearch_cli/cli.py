@@ -420,8 +420,9 @@ app.add_typer(ros_app, name="ros")
 
 @ros_app.command("replay")
 def ros_replay(
-    bag: Path = typer.Argument(..., help="A bag folder `semsearch export` wrote."),
-    planner: str = typer.Option(..., "--planner", help="The door planner to ask: NAME or NAME[key=value,...], e.g. nsos[alpha=0.9]."),
+    bag: Path = typer.Argument(..., help="A ROS 2 bag folder: one `semsearch export` wrote, or a robot's own (/map, a pose, "
+                               "/semsearch/detections; give --goal)."),
+    planner: str = typer.Option(..., "--planner", help="The door planner to ask: NAME or NAME\\[key=value,...], e.g. nsos\\[alpha=0.9]."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="The new bag folder for its decisions (must not exist)."),
     scenario: Optional[Path] = typer.Option(None, "--scenario", help="The scenario the bag was recorded on (default: the "
                                             "shipped scenario the bag names); for a robot's bag, where its settings come from."),
@@ -439,8 +440,8 @@ def ros_replay(
         res = api.ros_replay(bag, planner, out_dir, scenario, fmt, planner_file, goal)
     except ScenarioError as exc:
         _fail(exc)
-    out.print(f"{res.folder}: {len(res.decisions)} decisions of {planner} over {bag}"
-              f"{' (the goal was read in the bag)' if res.found else ''}")
+    out.print(f"{res.folder}: {len(res.decisions)} decisions of {planner} over {bag} "
+              f"({'the goal was read in the bag' if res.found else 'the goal was never read in the bag'})")
 
 
 @app.command()
@@ -546,7 +547,7 @@ def bench_list():
 @bench_app.command("run")
 def bench_run(
     suite: str = typer.Argument(..., help="A suite's name (semsearch bench list)."),
-    planner: List[str] = typer.Option(..., "--planner", help="NAME or NAME[key=value,...], e.g. nsos[alpha=0.9] (repeatable)."),
+    planner: List[str] = typer.Option(..., "--planner", help="NAME or NAME\\[key=value,...], e.g. nsos\\[alpha=0.9] (repeatable)."),
     out_dir: str = typer.Option(..., "--out", callback=_path, help="The results folder (bench.json, one folder per floor)."),
     split: str = typer.Option("val", "--split", help="val (shipped) or test (hidden: --salt-file)."),
     numbering: str = typer.Option("true", "--numbering", help="true, shuffled, parity-flipped or reversed: the floors' labels permuted."),

@@ -231,6 +231,13 @@ def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay
     res = CliRunner().invoke(app, ["ros", "replay", str(out / "trip2" / RUN), "--planner", "greedy", "--out", str(tmp_path / "a"),
                                    "--scenario", str(other)])
     assert res.exit_code == 2 and "recorded on another scenario" in " ".join(res.output.split()), res.output
+    for extra, says in ((["--goal", "304"], "the bag records a search for 452"),):
+        res = CliRunner().invoke(app, ["ros", "replay", str(out / "trip2" / RUN), "--planner", "greedy", "--out", str(tmp_path / "c"),
+                                       "--scenario", str(scenario), *extra])
+        assert res.exit_code == 2 and says in " ".join(res.output.split()), res.output
+    mcap_file = next((out / "trip2" / RUN).glob("*.mcap"))
+    res = CliRunner().invoke(app, ["ros", "replay", str(mcap_file), "--planner", "greedy", "--out", str(tmp_path / "d")])
+    assert res.exit_code == 2 and "is a file: give the bag's folder" in " ".join(res.output.split()), res.output
     # a robot's own bag with a pose but no map
     m = Messages()
     w = BagWriter(tmp_path / "robot", "mcap", m)
@@ -239,7 +246,7 @@ def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay
     res = CliRunner().invoke(app, ["ros", "replay", str(tmp_path / "robot"), "--planner", "greedy", "--out", str(tmp_path / "b"),
                                    "--goal", "452"])
     assert res.exit_code == 2 and "a robot's bag needs /map" in " ".join(res.output.split()), res.output
-    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+    assert not any((tmp_path / n).exists() for n in "abcd")
 
 
 def test_the_topics_page_lists_every_topic_as_the_code_writes_it():

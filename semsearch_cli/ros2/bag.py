@@ -46,8 +46,9 @@ TOPICS = {
     "/semsearch/goal": ("geometry_msgs/msg/PoseStamped", "at each decision", "the chosen target, facing along its branch"),
     "/semsearch/decision": ("std_msgs/msg/String", "at each decision", "JSON: the decision's row (as --trace writes it)"),
     "/semsearch/events": ("std_msgs/msg/String", "each frame, step and re-plan",
-                          'JSON {"event": "frame" (x, y, heading, the labels read), "step" (the visited kernel), '
-                          '"plan" (start with the generator\'s state, or end)}: what `semsearch ros replay` replays'),
+                          'JSON {"event": "frame" (step, x, y, heading, reads: the labels read, found: the goal\'s sign '
+                          'among them, rng inside a re-plan), "step" (step, x, y, heading, distance: where the visited kernel '
+                          'is marked), "plan" (step, "start" with rng, or "end")}: what `semsearch ros replay` replays'),
 }
 FORMATS = {"mcap": "MCAP", "rosbag2": "SQLITE3"}  # --format -> rosbags' storage plugin
 UPDATE = "map_msgs/msg/OccupancyGridUpdate"

@@ -203,6 +203,9 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
                 have = f"{loaded.path.name}'s is {loaded.fingerprint}" if loaded is not None else "no scenario given"
                 raise ScenarioError(str(bag), "/semsearch/setup", f"the bag was recorded on another scenario (fingerprint "
                                     f"{setup['fingerprint']}, {have}): give the one it was recorded on, --scenario")
+            if goal is not None and sign_label(goal) != sign_label(setup["goal"]):
+                raise ScenarioError(str(bag), "--goal", f"{goal!r}: the bag records a search for {setup['goal']!r}, and its "
+                                    "re-plans are that search's; leave --goal out for a bag of `semsearch export`")
             task, goal, frame = loaded.task, sign_label(setup["goal"]), loaded.world.frame
             run = _run
         else:
@@ -458,8 +461,8 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
             moved = math.hypot(x - st.x, y - st.y)
             st.distance += moved
             since += moved
+        st.steps += posed  # the first pose is step 0, as in an exported bag
         st.x, st.y, st.heading, posed = x, y, yaw, True
-        st.steps += 1
         v, u, r, c = fr.point_to_cell(x, y)
         if not (0 <= r < fr.height and 0 <= c < fr.width):
             continue
