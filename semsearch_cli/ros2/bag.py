@@ -20,14 +20,15 @@ from ..optional import lazy_module
 typesys = lazy_module("rosbags.typesys")  # optional: pip install 'semsearch[ros]'
 rosbag2 = lazy_module("rosbags.rosbag2")
 
+SIGN_RGBA, GOAL_RGBA, CAND_RGBA = (0.1, 0.3, 0.9, 1.0), (0.9, 0.1, 0.1, 1.0), (1.0, 0.6, 0.0, 0.9)  # markers' colours
 SPEED = 0.5  # m/s: the simulated clock's robot speed (stamps only)
 START_NS = 1_000_000_000  # the first step's stamp (1 s: some tools read 0 as "no stamp")
 
 # topic -> (message type, when it is published, what it holds)
 TOPICS = {
     "/semsearch/setup": ("std_msgs/msg/String", "once, first",
-                         'JSON {"scenario", "file", "fingerprint", "goal", "planner", "episode", "seed"}: the run this bag '
-                         'records (its scenario\'s name, file name and fingerprint)'),
+                         'JSON {"scenario", "file", "fingerprint", "rng_inc", "goal", "planner", "episode", "seed"}: the run '
+                         'this bag records (its scenario\'s name, file name and fingerprint; its generator\'s increment)'),
     "/map": ("nav_msgs/msg/OccupancyGrid", "at the start, at each decision and at the end",
              "the belief over the whole grid: -1 never seen, 0 free, 100 occupied"),
     "/semsearch/map_updates": ("map_msgs/msg/OccupancyGridUpdate", "each frame that changed the map",
@@ -98,16 +99,16 @@ class Messages:
         ts = P["geometry_msgs/msg/TransformStamped"](header=self.header(t_ns), child_frame_id="base_link", transform=tr)
         return P["tf2_msgs/msg/TFMessage"](transforms=[ts])
 
-    def grid(self, t_ns: int, seen: np.ndarray, free: np.ndarray, frame) -> object:
-        """The belief over the whole grid (-1 never seen, 0 free, 100 occupied; a few kilobytes
-        once compressed, unknown cells being most), rows flipped to ROS's order (row 0 at the
-        lowest y), its origin the grid's lower-left corner."""
-        data = np.where(seen, np.where(free, 0, 100), -1).astype(np.int8)[::-1]
+    def grid(self, t_ns: int, states: np.ndarray, frame) -> object:
+        """The map over the whole grid from ``states`` (H, W) int8 (-1 never seen, 0 free, 100
+        occupied; a few kilobytes once compressed, unknown cells being most), rows flipped to
+        ROS's order (row 0 at the lowest y), its origin the grid's lower-left corner."""
         P = self.T
         info = P["nav_msgs/msg/MapMetaData"](map_load_time=self._time(t_ns), resolution=float(frame.res),
                                              width=int(frame.width), height=int(frame.height),
                                              origin=self.pose(frame.origin_x, frame.origin_y, 0.0))
-        return P["nav_msgs/msg/OccupancyGrid"](header=self.header(t_ns), info=info, data=np.ascontiguousarray(data).ravel())
+        return P["nav_msgs/msg/OccupancyGrid"](header=self.header(t_ns), info=info,
+                                               data=np.ascontiguousarray(states[::-1]).ravel())
 
     def grid_update(self, t_ns: int, states: np.ndarray, r0: int, c0: int, height: int) -> object:
         """``states`` (h, w) int8 of the grid's cells from row ``r0``, column ``c0`` (the
@@ -161,6 +162,18 @@ class Messages:
 
     def markers(self, items) -> object:
         return self.T["visualization_msgs/msg/MarkerArray"](markers=list(items))
+
+    def frontiers(self, t_ns: int, frame, cands, decision, target_xy) -> tuple:
+        """A decision as explore_lite would show it: (/explore/frontiers, the candidates as
+        spheres, the chosen one larger and red; /semsearch/goal, the target facing along its
+        branch)."""
+        cx, cy = frame.to_world(cands.rows, cands.cols)
+        chosen = np.flatnonzero((cands.rows == decision.row) & (cands.cols == decision.col))
+        items = [self.delete_all(t_ns, "frontiers")]
+        items += [self.marker(t_ns, "frontiers", j, "SPHERE", cx[j], cy[j], GOAL_RGBA if j in chosen else CAND_RGBA,
+                              0.5 if j in chosen else 0.35) for j in range(len(cands))]
+        yaw = float(cands.theta[chosen[0]]) if chosen.size else 0.0
+        return self.markers(items), self.pose_stamped(t_ns, *target_xy, yaw)
 
 
 class BagWriter:

@@ -8,24 +8,22 @@ must give the row's outcome, distance and steps, or nothing is written.
 
 from __future__ import annotations
 
-import math
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..config.base import sign_label
 from ..errors import ScenarioError, did_you_mean
 from ..runner.specs import Loaded, file_stem
-from ..runner.store import read_runs
+from ..runner.store import json_safe, read_runs
 from ..runner.verify import replay_run
 from ..tasks.base import Observer
 from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep, DoorTask
-from .bag import START_NS, BagWriter, Messages, drop_bag, stamp_ns
+from ..tasks.episodes import episode_seed
+from .bag import GOAL_RGBA, SIGN_RGBA, START_NS, BagWriter, Messages, drop_bag, stamp_ns
 
-SIGN_RGBA = (0.1, 0.3, 0.9, 1.0)
-GOAL_RGBA = (0.9, 0.1, 0.1, 1.0)
-CAND_RGBA = (1.0, 0.6, 0.0, 0.9)
 PATH_EVERY_M = 5.0  # /semsearch/path at the first decision after each 5 m of travel (and at the end)
 PATH_STEP_M = 0.5  # its poses, one every 0.5 m
 
@@ -71,7 +69,7 @@ class BagRecorder(Observer):
 
     def _frame(self, e: DoorFrame) -> None:
         first = self.belief is None
-        self.belief = b = e.belief
+        self.belief = e.belief
         t = self._stamp(e.step)
         self.bag.write("/tf", t, self.m.tf(t, e.x, e.y, e.heading))
         self.bag.write("/semsearch/pose", self._stamp(e.step), self.m.pose_stamped(t, e.x, e.y, e.heading))
@@ -82,7 +80,7 @@ class BagRecorder(Observer):
         new = False
         for i, label in e.reads:
             i = int(i)
-            self._write("/semsearch/detections", e.step, self.m.string({"label": _label(label), "x": float(signs.x[i]),
+            self._write("/semsearch/detections", e.step, self.m.string({"label": sign_label(label), "x": float(signs.x[i]),
                                                                         "y": float(signs.y[i]), "facing": float(signs.facing[i])}))
             if i not in self.read:
                 self.read[i] = str(label)
@@ -90,7 +88,7 @@ class BagRecorder(Observer):
         self._write("/semsearch/events", e.step, self.m.string({"event": "frame", **e.row()}))
         if first:
             t = self._stamp(e.step)
-            self.bag.write("/map", t, self.m.grid(t, b.seen, b.free, self.frame))
+            self.bag.write("/map", t, self.m.grid(t, self.state, self.frame))
         if new or first:
             self._signs(self.t)
 
@@ -120,23 +118,19 @@ class BagRecorder(Observer):
         self.bag.write("/semsearch/signs", self._stamp(0), self.m.markers(items))  # after the last message
 
     def _decision(self, e: DoorDecision) -> None:
+        """The map (:attr:`state`, which every frame's update keeps equal to the belief's), the
+        path now and then, the frontiers and target, the decision's row."""
         self.decisions += 1
-        b, c, k = e.belief, e.candidates, e.step
+        k = e.step
         t = self._stamp(k)
-        self.bag.write("/map", t, self.m.grid(t, b.seen, b.free, self.frame))
+        self.bag.write("/map", t, self.m.grid(t, self.state, self.frame))
         if e.distance - self.path_at >= PATH_EVERY_M:
             self.path_at = e.distance
             self.bag.write("/semsearch/path", self._stamp(k), self.m.path(self.t, self._thinned()))
-        t = self.t
-        cx, cy = self.frame.to_world(c.rows, c.cols)
-        chosen = np.flatnonzero((c.rows == e.decision.row) & (c.cols == e.decision.col))
-        items = [self.m.delete_all(t, "frontiers")]
-        items += [self.m.marker(t, "frontiers", j, "SPHERE", cx[j], cy[j], GOAL_RGBA if j in chosen else CAND_RGBA,
-                                0.5 if j in chosen else 0.35) for j in range(len(c))]
-        self._write("/explore/frontiers", k, self.m.markers(items))
-        yaw = float(c.theta[chosen[0]]) if chosen.size else 0.0
-        self._write("/semsearch/goal", k, self.m.pose_stamped(t, *e.target_xy, yaw))
-        self._write("/semsearch/decision", k, self.m.string(_jsonable(e.row())))
+        fronts, goal = self.m.frontiers(self.t, self.frame, e.candidates, e.decision, e.target_xy)
+        self._write("/explore/frontiers", k, fronts)
+        self._write("/semsearch/goal", k, goal)
+        self._write("/semsearch/decision", k, self.m.string(json_safe(e.row())))
 
     def _thinned(self) -> list:
         """The path so far, one pose every ``PATH_STEP_M`` of travel (its last pose kept): a
@@ -147,26 +141,9 @@ class BagRecorder(Observer):
     def finish(self) -> None:
         """The map and the path as the run ended."""
         if self.belief is not None:
-            self.bag.write("/map", self.t + 1000, self.m.grid(self.t, self.belief.seen, self.belief.free, self.frame))
+            self.bag.write("/map", self.t + 1000, self.m.grid(self.t, self.state, self.frame))
             self.bag.write("/semsearch/path", self.t + 2000, self.m.path(self.t, self._thinned()))
             self.t += 2000
-
-
-def _label(v):
-    """A label as JSON writes it: a whole number as a number, anything else as text."""
-    return int(v) if isinstance(v, (int, np.integer)) and not isinstance(v, bool) else str(v)
-
-
-def _jsonable(v):
-    if isinstance(v, dict):
-        return {str(k): _jsonable(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple, np.ndarray)):
-        return [_jsonable(x) for x in v]
-    if isinstance(v, (np.floating, float)):
-        return None if not math.isfinite(float(v)) else float(v)
-    if isinstance(v, (np.integer, np.bool_)):
-        return v.item()
-    return v
 
 
 @dataclass
@@ -219,7 +196,11 @@ def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Pat
         bag = BagWriter(tmp, fmt, Messages())
         rec = BagRecorder(bag, loaded.world, ep.goal, loaded.sc.robot.step, loaded.sc.laser.range)
         setup = {"scenario": loaded.sc.name, "file": loaded.path.stem, "fingerprint": loaded.fingerprint,
-                 "goal": _label(ep.goal), "planner": str(row["planner"]), "episode": int(row["episode"]), "seed": int(row["seed"])}
+                 # the run's generator's increment (fixed for a run; seeded as Task.run seeds it): with the
+                 # states the events carry (rng_word), the replay's generator is the run's
+                 "rng_inc": np.random.default_rng(episode_seed(ep, int(row["seed"]), loaded.sc.experiment.base_seed))
+                 .bit_generator.state["state"]["inc"],
+                 "goal": sign_label(ep.goal), "planner": str(row["planner"]), "episode": int(row["episode"]), "seed": int(row["seed"])}
         bag.write("/semsearch/setup", START_NS - 1000, bag.msgs.string(setup))
         why = replay_run(task, record_file, str(row["planner"]), str(row["goal"]), int(row["episode"]), int(row["seed"]), [row],
                          episodes, observer=rec)

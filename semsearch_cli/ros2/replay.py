@@ -42,20 +42,20 @@ from ..errors import BudgetSpent, PlannerError, ScenarioError
 from ..planners import Variant
 from ..runner.specs import Loaded
 from ..tasks.base import Observer, RobotState
-from ..tasks.decisions import DecisionPoint
+from ..tasks.decisions import DecisionPoint, set_rng
 from ..tasks.doors import DoorDecision, DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
 
-CAND_RGBA, GOAL_RGBA = (1.0, 0.6, 0.0, 0.9), (0.9, 0.1, 0.1, 1.0)
 POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot bag's pose: the first of these it holds, else /tf
 BASE_FRAMES = ("base_link", "base_footprint")  # the robot's frame in /tf, the first that reaches map
-FREE_BELOW, OCCUPIED_FROM = 20, 65  # OccupancyGrid values: map_saver's free (0.196) and occupied (0.65) thresholds
+FREE_BELOW = 20  # OccupancyGrid values under it are free (map_saver's 0.196); from it, seen and not free
 
 
 class BagStream:
-    """A bag's messages in stamp order, decoded, with one message of look-ahead."""
+    """A bag's messages in stamp order (of the topics ``only`` when given), decoded, with one
+    message of look-ahead."""
 
-    def __init__(self, path: Path, messages: Messages):
+    def __init__(self, path: Path, messages: Messages, only: tuple = ()):
         self.path, self.m = Path(path), messages
         try:
             self.reader = rosbag2.Reader(self.path)
@@ -63,7 +63,8 @@ class BagStream:
         except Exception as exc:  # noqa: BLE001  not a bag rosbags reads: named, never a traceback
             raise ScenarioError(str(path), "", f"is not a ROS 2 bag folder rosbags can read ({type(exc).__name__}: {exc})") from None
         self.topics = {c.topic for c in self.reader.connections}
-        self._it = self.reader.messages()
+        conns = [c for c in self.reader.connections if c.topic in only] if only else None  # only these topics decoded
+        self._it = self.reader.messages(connections=conns) if conns is not None else self.reader.messages()
         self._ahead: deque = deque()
 
     def _decode(self, item):
@@ -122,7 +123,7 @@ class ReplaySearch(DoorSearch):
                 event = True
         found = bool(ev.get("found", False))  # the goal's own sign read (a misread of another as the goal is not)
         if "rng" in ev:  # sensed inside a re-plan: the generator as the sensing left it
-            self.rng.bit_generator.state = ev["rng"]
+            set_rng(self.rng, ev["rng"])
         self.found = self.found or found
         return found, event
 
@@ -160,19 +161,12 @@ class GoalWriter(Observer):
     def see(self, event) -> None:
         if not isinstance(event, DoorDecision):
             return
-        c, t = event.candidates, self.t
-        cx, cy = self.frame.to_world(c.rows, c.cols)
-        chosen = np.flatnonzero((c.rows == event.decision.row) & (c.cols == event.decision.col))
-        items = [self.m.delete_all(t, "frontiers")]
-        items += [self.m.marker(t, "frontiers", j, "SPHERE", cx[j], cy[j], GOAL_RGBA if j in chosen else CAND_RGBA,
-                                0.5 if j in chosen else 0.35) for j in range(len(c))]
-        yaw = float(c.theta[chosen[0]]) if chosen.size else 0.0
         row = {"step": int(event.step), "target_cell": [int(event.decision.row), int(event.decision.col)],
                "target": [float(v) for v in event.target_xy]}
         self.rows.append(row)
-        for topic, msg in (("/explore/frontiers", self.m.markers(items)), ("/semsearch/goal", self.m.pose_stamped(t, *event.target_xy, yaw)),
-                           ("/semsearch/decision", self.m.string(row))):
-            self.last = max(t, self.last + 1)  # after the input's moment, and after every message before
+        fronts, goal = self.m.frontiers(self.t, self.frame, event.candidates, event.decision, event.target_xy)
+        for topic, msg in (("/explore/frontiers", fronts), ("/semsearch/goal", goal), ("/semsearch/decision", self.m.string(row))):
+            self.last = max(self.t, self.last + 1)  # after the input's moment, and after every message before
             self.bag.write(topic, self.last, msg)
 
 
@@ -207,12 +201,12 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
                 raise ScenarioError(str(bag), "--goal", f"{goal!r}: the bag records a search for {setup['goal']!r}, and its "
                                     "re-plans are that search's; leave --goal out for a bag of `semsearch export`")
             task, goal, frame = loaded.task, sign_label(setup["goal"]), loaded.world.frame
-            run = _run
+            run, rng_inc = _run, setup["rng_inc"]
         else:
             if goal is None:
                 raise ScenarioError(str(bag), "--goal", "a robot's own bag names no goal: give the label to find, --goal")
             frame = _robot_frame(bag, msgs)
-            task, goal, run = RobotTask(frame, loaded.sc if loaded is not None else None), sign_label(goal), _run_robot
+            task, goal, run, rng_inc = RobotTask(frame, loaded.sc if loaded is not None else None), sign_label(goal), _run_robot, None
         if out.exists():
             raise ScenarioError(str(out), "", "exists already: give a new folder for the replay's bag")
         work = out.with_name(f".{out.name}.partial")  # written here, then moved into place whole
@@ -221,7 +215,7 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
         writer = None
         try:
             writer = BagWriter(work / out.name, fmt, msgs)
-            found, rows = run(task, variant, goal, stream, writer, frame)
+            found, rows = run(task, variant, goal, stream, writer, frame, rng_inc)
             writer.close()
         except BaseException as exc:
             drop_bag(writer, work)
@@ -263,11 +257,14 @@ def _setup(stream: BagStream, bag: Path) -> dict:
     return json.loads(item[2].data)
 
 
-def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame) -> tuple[bool, list]:
+def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc: int) -> tuple[bool, list]:
     planner = variant.build()
     out = GoalWriter(writer, frame)
     st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
     rng = np.random.default_rng(0)
+    state = rng.bit_generator.state
+    state["state"]["inc"] = int(rng_inc)  # the run's: the events' states (rng_word) keep it
+    rng.bit_generator.state = state
     search = ReplaySearch(task, planner, goal, rng, out, stream)
     while (item := stream.next()) is not None:
         out.t = item[1]
@@ -278,7 +275,7 @@ def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame) -> tu
             st.distance = float(ev["distance"])
             search.update(st)
         elif ev["event"] == "plan" and ev.get("plan") == "start":
-            rng.bit_generator.state = ev["rng"]
+            set_rng(rng, ev["rng"])
             _plan(search, st)
             while (item := stream.next()) is not None:  # what the bag's re-plan sensed and this one did not ask for
                 ev = _fold(search, st, item)
@@ -329,8 +326,6 @@ class RobotTask:
     """What a door search needs of its task, for a robot's bag: the grid its maps cover, and the
     belief's, robot's, camera's and navigation's settings (a scenario's, or the defaults)."""
 
-    kind = "doors"
-
     def __init__(self, frame: GridFrame, sc=None):
         self.world = _RobotWorld(frame, _NoSigns())
         self.sc = sc if sc is not None else SimpleNamespace(belief=BeliefSpec(), robot=RobotSpec(), door_camera=DoorCameraSpec(),
@@ -342,7 +337,7 @@ class RobotTask:
 
 def _robot_frame(bag: Path, msgs: Messages) -> GridFrame:
     """The grid that covers every /map of a robot's bag, at their resolution."""
-    stream = BagStream(bag, msgs)
+    stream = BagStream(bag, msgs, only=("/map",))
     try:
         if "/map" not in stream.topics or not any(t in stream.topics for t in (*POSE_TOPICS, "/tf")):
             raise ScenarioError(str(bag), "/map", "a robot's bag needs /map (nav_msgs/OccupancyGrid) and a pose on one of "
@@ -350,8 +345,6 @@ def _robot_frame(bag: Path, msgs: Messages) -> GridFrame:
                                 "`semsearch export`, with /semsearch/events")
         res, box = None, [np.inf, np.inf, -np.inf, -np.inf]
         while (item := stream.next()) is not None:
-            if item[0] != "/map":
-                continue
             info = item[2].info
             q = info.origin.orientation
             if abs(q.z) > 1e-6 or abs(q.x) > 1e-6 or abs(q.y) > 1e-6:
@@ -417,7 +410,7 @@ class TfTree:
         return None
 
 
-def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame) -> tuple[bool, list]:
+def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc=None) -> tuple[bool, list]:
     """A robot's bag: each pose a frame and a step, re-plans as the simulator's periodic policy."""
     planner = variant.build()
     out = GoalWriter(writer, frame)

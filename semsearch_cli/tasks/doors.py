@@ -19,6 +19,7 @@ import numpy as np
 import yaml
 
 from ..belief import DoorBelief
+from ..config.base import sign_label
 from ..errors import ScenarioError
 from ..geometry import wrap_angle
 from ..navigation import NAVIGATORS
@@ -29,7 +30,7 @@ from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
 from ..world.buildings.demo import write_demo
 from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_cell, register_task
-from .decisions import Codec, DecisionPoint, ask
+from .decisions import Codec, DecisionPoint, ask, rng_word
 from .loop import run_loop
 
 MAX_RETRIES = 5
@@ -84,7 +85,7 @@ class DoorSensing:
             if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:
                 event = True
         if self.observer is not None and self.observer.steps:
-            rng = _jsonable_state(self.rng.bit_generator.state) if self._planning else None
+            rng = rng_word(self.rng) if self._planning else None
             self.observer.see(DoorFrame(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=b, reads=tuple(reads),
                                         scan=scan, found=found, rng=rng))
         return found, event
@@ -105,7 +106,7 @@ class DoorFrame(Event):
     ``step``, the belief after folding it in (``belief``: copy what you keep), the signs it read
     [(sign index, label as read)] and its laser scan (beam angles rad in the world, ranges in
     cells, hit flags); ``found``: whether it read the goal's sign; ``rng``: inside a re-plan (a
-    turn on the spot), the run's generator state after it (NumPy's bit-generator state), else
+    turn on the spot), the run's generator state after it (:func:`~.decisions.rng_word`), else
     None. A step senses one frame; turning on the spot senses several within one step. Not
     traced."""
 
@@ -117,7 +118,7 @@ class DoorFrame(Event):
     reads: tuple = ()
     scan: tuple | None = None
     found: bool = False
-    rng: dict | None = None
+    rng: str | None = None
 
     @property
     def traced(self) -> bool:
@@ -126,7 +127,7 @@ class DoorFrame(Event):
     def row(self) -> dict:
         """The frame as the robot has it: its pose, the labels read (a whole number as a number),
         whether the goal's sign was among them, the generator's state inside a re-plan."""
-        labels = [int(v) if isinstance(v, (int, np.integer)) and not isinstance(v, bool) else str(v) for _, v in self.reads]
+        labels = [sign_label(v) for _, v in self.reads]
         return {"step": self.step, "x": float(self.x), "y": float(self.y), "heading": float(self.heading), "reads": labels,
                 "found": bool(self.found), **({"rng": self.rng} if self.rng is not None else {})}
 
@@ -157,13 +158,13 @@ class DoorStep(Event):
 @dataclass(frozen=True, kw_only=True)
 class DoorPlan(Event):
     """A re-plan of a door search starts (``start``) or ends, shown to observers that ask for
-    steps, with the run's generator's state as it starts (``rng``: NumPy's bit-generator state,
+    steps, with the run's generator's state as it starts (``rng``: :func:`~.decisions.rng_word`,
     None at the end): the frames sensed between the two were sensed by the re-plan (turning on
     the spot). Not traced."""
 
     step: int
     start: bool
-    rng: dict | None = None
+    rng: str | None = None
 
     @property
     def traced(self) -> bool:
@@ -206,16 +207,6 @@ class DoorDecision(Event):
                 "y": round(float(self.y), 3), "heading_deg": round(float(np.degrees(self.heading)), 1),
                 "target": [round(float(tx), 2), round(float(ty), 2)], "n_candidates": len(self.candidates),
                 **self.decision.info}
-
-
-def _jsonable_state(state: dict) -> dict:
-    """A bit generator's state with NumPy numbers as Python ones and arrays as lists (JSON writes
-    it as it is; NumPy takes it back)."""
-    def plain(v):
-        if isinstance(v, dict):
-            return _jsonable_state(v)
-        return v.tolist() if hasattr(v, "tolist") else v
-    return {k: plain(v) for k, v in state.items()}
 
 
 def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
@@ -292,7 +283,7 @@ class DoorSearch(DoorSensing):
         (:meth:`sweep`). The retry-and-sweep policy is here alone, for every driver."""
         stepping = self.observer is not None and self.observer.steps
         if stepping:
-            self.observer.see(DoorPlan(step=st.steps, start=True, rng=_jsonable_state(self.rng.bit_generator.state)))
+            self.observer.see(DoorPlan(step=st.steps, start=True, rng=rng_word(self.rng)))
         self._planning = True
         try:
             out = yield from self._plan(st)
