@@ -33,6 +33,7 @@ from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_execu
 from .runner.verify import Verdict, verify_folder
 from .tasks import TASKS
 from .tasks.decisions import Seat
+from .tasks.doors import DoorTask
 from .tasks.episodes import EPISODE_COLUMNS, set_hash
 from .tasks.objects import write_log
 from .files import check_outputs, inside, output_file, output_folder, temp_path
@@ -189,13 +190,17 @@ def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | No
 
 
 def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | Path | None = None, fmt: str = "mcap",
-               planner_file: str | Path | None = None, goal: str | None = None):
+               planner_file: str | Path | None = None, goal: str | None = None, margin: float = 10.0):
     """Run a door planner (``NAME`` or ``NAME[key=value,...]``) over a bag, asked at each of its
     re-plans, and write its decisions as a new bag folder ``out``
     (:func:`~semsearch_cli.ros2.replay_bag`; the ``ros`` extra). A bag ``semsearch export`` wrote
     replays on ``scenario``, the one it was recorded on (default: the shipped scenario the bag
-    names); a robot's own bag (a map, a pose, the detections) needs ``goal``, the label to find, and
-    takes its settings from ``scenario`` when given. Returns the :class:`~semsearch_cli.ros2.Replayed`."""
+    names); a robot's own bag (a map, a pose, the detections) needs ``goal``, the label to find,
+    takes its settings from ``scenario`` when given, and is folded into its first map and ``margin``
+    metres around it (as :func:`ros_live` folds a robot's maps). Returns the
+    :class:`~semsearch_cli.ros2.Replayed`."""
+    if margin < 0:
+        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 or more metres")
     if fmt not in ros2.FORMATS:
         raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
     if not ros2.available():
@@ -213,11 +218,43 @@ def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | P
                                 "the scenario the bag was recorded on, --scenario FILE")
         scenario = name
     loaded = Loaded.load(scenario_file(scenario), planners=False) if scenario is not None else None
+    return ros2.replay_bag(loaded, bag, _door_variant(planner, planner_file), Path(out), fmt, goal, margin)
+
+
+def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | None = None, publish_only: bool = False,
+             repro: str | Path | None = None, margin: float = 10.0, max_distance: float | None = None,
+             planner_file: str | Path | None = None, silence: float = 30.0, log=None):
+    """Explore with a robot through rosbridge (``ws://HOST:PORT``) until the sign ``goal`` is
+    read, door planner ``planner`` choosing where to go (:mod:`semsearch_cli.ros2.live`; the
+    ``ros`` extra): the robot's /map, pose and /semsearch/detections in; /explore/frontiers,
+    /semsearch/goal and Nav2 ``NavigateToPose`` goals out (none with ``publish_only``). The
+    belief's, robot's and navigation's settings come from ``scenario`` when given, and its
+    ``experiment.max_distance`` unless ``max_distance`` is; ``margin`` metres of grid surround the
+    robot's first map; a run that does not find the goal leaves a repro bag at ``repro``. ``log``
+    takes a line of progress. Returns the :class:`~semsearch_cli.ros2.LiveRun`."""
+    if not ros2.available():
+        raise ScenarioError("<command line>", "ros live", "needs the ros extra (rosbags, roslibpy): pip install 'semsearch[ros]'")
+    if margin < 0:
+        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 or more metres")
+    if max_distance is not None and max_distance <= 0:
+        raise ScenarioError("<command line>", "--max-distance", f"{max_distance:g} m: give more than 0")
+    loaded = Loaded.load(scenario_file(scenario), planners=False) if scenario is not None else None
+    if loaded is not None and not isinstance(loaded.task, DoorTask):
+        raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: a robot explores with door planners only")
+    if max_distance is None and loaded is not None:
+        max_distance = loaded.sc.experiment.max_distance
+    live = ros2.Live(rosbridge, _door_variant(planner, planner_file), goal, loaded.sc if loaded is not None else None,
+                     publish_only, repro, margin, max_distance, silence, log)
+    return live.run()
+
+
+def _door_variant(planner: str, planner_file: str | Path | None):
+    """The one door-planner variant ``planner`` (NAME or NAME[key=value,...]) names."""
     variants = expand_variants([planner_spec(planner, planner_file)], "<command line>", TASKS["doors"].planner_kind)
     if len(variants) != 1:
         raise ScenarioError("<command line>", "--planner", f"{planner!r} names {len(variants)} variants: give one value per "
                             "parameter")
-    return ros2.replay_bag(loaded, bag, variants[0], Path(out), fmt, goal)
+    return variants[0]
 
 
 def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None,

@@ -414,7 +414,8 @@ def export(
     out.print(f"{len(done)} bag(s) written to {out_dir} ({fmt})")
 
 
-ros_app = typer.Typer(no_args_is_help=True, help="Door planners over ROS 2 bags (the ros extra; docs/robot.md).")
+ros_app = typer.Typer(no_args_is_help=True, help="Door planners over ROS 2 bags and on robots through rosbridge (the ros extra; "
+                      "docs/robot.md).")
 app.add_typer(ros_app, name="ros")
 
 
@@ -430,6 +431,8 @@ def ros_replay(
     planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner."),
     goal: Optional[str] = typer.Option(None, "--goal", help="The label to find, for a robot's own bag (a bag of `semsearch "
                                        "export` names its goal)."),
+    margin: float = typer.Option(10.0, "--margin", help="For a robot's own bag: metres of grid around its first map (as "
+                                 "`ros live --margin`)."),
 ):
     """Ask a door planner where it would go at each re-plan of a recorded bag, the robot moving as it
     moved, and write its answers (/semsearch/goal, /explore/frontiers, /semsearch/decision) to a new
@@ -437,11 +440,48 @@ def ros_replay(
     for decision; a robot's own bag (/map, a pose, /semsearch/detections) needs --goal."""
 
     try:
-        res = api.ros_replay(bag, planner, out_dir, scenario, fmt, planner_file, goal)
+        res = api.ros_replay(bag, planner, out_dir, scenario, fmt, planner_file, goal, margin)
     except ScenarioError as exc:
         _fail(exc)
     out.print(f"{res.folder}: {len(res.decisions)} decisions of {planner} over {bag} "
               f"({'the goal was read in the bag' if res.found else 'the goal was never read in the bag'})")
+
+
+@ros_app.command("live")
+def ros_live(
+    rosbridge: str = typer.Option(..., "--rosbridge", help="The robot's rosbridge_server: ws://HOST:PORT (it listens on 9090)."),
+    planner: str = typer.Option(..., "--planner", help="The door planner: NAME or NAME\\[key=value,...], e.g. nsos\\[alpha=0.9]."),
+    goal: str = typer.Option(..., "--goal", help="The label to find (a door's number)."),
+    scenario: Optional[Path] = typer.Option(None, "--scenario", help="Where the belief's, robot's and navigation's settings "
+                                            "come from, and the distance budget (default: their defaults, no budget)."),
+    publish_only: bool = typer.Option(False, "--publish-only", help="Drive nothing: publish each goal on /semsearch/goal "
+                                      "(PoseStamped) instead of sending Nav2 NavigateToPose goals."),
+    repro: Optional[str] = typer.Option(None, "--repro", callback=_path, help="Where a run that does not find the goal "
+                                        "leaves its repro bag (default: live-repro-DATE-TIME)."),
+    margin: float = typer.Option(10.0, "--margin", help="Metres of grid around the robot's first map, for the map to grow into."),
+    max_distance: Optional[float] = typer.Option(None, "--max-distance", help="Stop after this many metres (default: the "
+                                                 "scenario's experiment.max_distance, else none)."),
+    planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner."),
+    silence: float = typer.Option(30.0, "--silence", help="Give up when the robot has sent nothing for this many seconds."),
+):
+    """Explore with a robot through rosbridge until the goal's sign is read, in the place of
+    explore_lite: the robot's /map, pose and /semsearch/detections in; /explore/frontiers,
+    /semsearch/goal and Nav2 NavigateToPose goals out; /explore/resume pauses and resumes. A run
+    that does not find the goal leaves a repro bag for `semsearch ros replay`. Exit status 0 when
+    the goal was found, 1 otherwise."""
+
+    try:
+        res = api.ros_live(rosbridge, planner, goal, scenario, publish_only, repro, margin, max_distance, planner_file,
+                           silence, log=lambda text: err.print(text))
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"{res.outcome}: {res.message}; {res.distance:.1f} m over {res.poses} poses, {len(res.decisions)} decisions, "
+              f"{res.goals} goals sent")
+    if res.repro is not None:
+        size = sum(p.stat().st_size for p in res.repro.rglob("*") if p.is_file())
+        out.print(f"repro bag: {res.repro} ({size / 1e6:.2f} MB; semsearch ros replay {res.repro} --goal {goal} --planner "
+                  f"{planner} --out DIR)")
+    raise typer.Exit(0 if res.outcome == "found" else 1)
 
 
 @app.command()

@@ -1,18 +1,20 @@
-"""From the simulator to ROS 2: runs exported as bags (``semsearch export``) and door planners
-replayed over them (``semsearch ros replay``), without a ROS install (the ``ros`` extra: rosbags,
-mcap). See docs/robot.md."""
+"""From the simulator to ROS 2: runs exported as bags (``semsearch export``), door planners
+replayed over them (``semsearch ros replay``) and exploring with a robot through rosbridge
+(``semsearch ros live``), without a ROS install (the ``ros`` extra: rosbags, mcap, roslibpy,
+websockets). See docs/robot.md."""
 
 import importlib.util
 
 from .bag import FORMATS, TOPICS
 from .export import BagRecorder, Exported, export_folder, export_run, recorded_runs
+from .live import Live, LiveRun
 from .replay import Replayed, recorded_scenario, replay_bag
 
 
 def available() -> bool:
-    """Whether the ros extra is installed (rosbags writes the bags)."""
-    return importlib.util.find_spec("rosbags") is not None
+    """Whether the ros extra is installed (rosbags writes the bags; roslibpy speaks to rosbridge)."""
+    return all(importlib.util.find_spec(name) is not None for name in ("rosbags", "roslibpy"))
 
 
-__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Replayed", "available", "export_folder", "export_run",
+__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "available", "export_folder", "export_run",
            "recorded_runs", "recorded_scenario", "replay_bag"]

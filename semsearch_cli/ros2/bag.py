@@ -8,6 +8,7 @@ Frames: ``map`` (the world's metres: x right, y up) and ``base_link`` (the robot
 
 from __future__ import annotations
 
+import base64
 import json
 import math
 import shutil
@@ -15,10 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..config.base import sign_label
 from ..optional import lazy_module
 
 typesys = lazy_module("rosbags.typesys")  # optional: pip install 'semsearch[ros]'
 rosbag2 = lazy_module("rosbags.rosbag2")
+interfaces = lazy_module("rosbags.interfaces")
 
 SIGN_RGBA, GOAL_RGBA, CAND_RGBA = (0.1, 0.3, 0.9, 1.0), (0.9, 0.1, 0.1, 1.0), (1.0, 0.6, 0.0, 0.9)  # markers' colours
 SPEED = 0.5  # m/s: the simulated clock's robot speed (stamps only)
@@ -56,9 +59,19 @@ UPDATE = "map_msgs/msg/OccupancyGridUpdate"
 UPDATE_MSG = "std_msgs/Header header\nint32 x\nint32 y\nuint32 width\nuint32 height\nint8[] data\n"
 
 
+def map_states(seen: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """A belief's map as an OccupancyGrid's values (int8): -1 never seen, 0 free, 100 occupied."""
+    return np.where(seen, np.where(free, 0, 100), -1).astype(np.int8)
+
+
 def stamp_ns(step: int, step_m: float) -> int:
     """The stamp (ns) of step ``step`` of a run whose steps are ``step_m`` metres."""
     return START_NS + int(round(step * step_m / SPEED * 1e9))
+
+
+def step_of(stamp: int, step_m: float) -> int:
+    """The step whose stamp is ``stamp`` (:func:`stamp_ns`'s inverse)."""
+    return int(round((stamp - START_NS) * SPEED / step_m / 1e9))
 
 
 class Messages:
@@ -141,6 +154,11 @@ class Messages:
     def string(self, obj) -> object:
         return self.T["std_msgs/msg/String"](data=json.dumps(obj, separators=(",", ":")))
 
+    def detection(self, signs, i: int, label) -> object:
+        """A sign detection (``/semsearch/detections``): sign ``i`` of ``signs`` read as ``label``."""
+        return self.string({"label": sign_label(label), "x": float(signs.x[i]), "y": float(signs.y[i]),
+                            "facing": float(signs.facing[i])})
+
     def marker(self, t_ns: int, ns: str, mid: int, kind: str, x: float, y: float, rgba, scale: float, text: str = ""):
         P = self.T
         M = P["visualization_msgs/msg/Marker"]
@@ -178,8 +196,8 @@ class Messages:
 
 class BagWriter:
     """A ROS 2 bag folder (``metadata.yaml`` and one storage file: MCAP or SQLite 3) written with
-    rosbags, zstd-compressed (MCAP's chunks, or each SQLite message), one connection per topic of
-    :data:`TOPICS` as it is first written."""
+    rosbags, zstd-compressed (MCAP's chunks, or each SQLite message), one connection per topic
+    (of its first message's type) as it is first written."""
 
     def __init__(self, out: Path, fmt: str, messages: Messages):
         self.msgs = messages
@@ -194,7 +212,7 @@ class BagWriter:
     def write(self, topic: str, t_ns: int, msg) -> None:
         conn = self.conns.get(topic)
         if conn is None:
-            conn = self.conns[topic] = self.writer.add_connection(topic, TOPICS[topic][0], typestore=self.msgs.ts)
+            conn = self.conns[topic] = self.writer.add_connection(topic, msg.__msgtype__, typestore=self.msgs.ts)
         self.writer.write(conn, int(t_ns), self.msgs.serialize(msg))
         self.count += 1
 
@@ -211,3 +229,52 @@ def drop_bag(writer: BagWriter | None, work: Path) -> None:
         pass
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def to_json(msg) -> dict:
+    """A message (rosbags' dataclass) as rosbridge's JSON holds it: fields by name, arrays as
+    lists, ``uint8[]`` as base64 text (rosbridge's rule for bytes)."""
+    out = {}
+    for name in msg.__dataclass_fields__:
+        if name == "__msgtype__":
+            continue
+        v = getattr(msg, name)
+        if isinstance(v, np.ndarray):
+            out[name] = base64.b64encode(v.tobytes()).decode() if v.dtype == np.uint8 else v.tolist()
+        elif isinstance(v, list):
+            out[name] = [to_json(e) if hasattr(e, "__dataclass_fields__") else e for e in v]
+        elif hasattr(v, "__dataclass_fields__"):
+            out[name] = to_json(v)
+        else:
+            out[name] = v
+    return out
+
+
+_BASE = {"bool": bool, "string": str, "float32": float, "float64": float}
+
+
+def from_json(ts, msgtype: str, d: dict):
+    """A rosbridge JSON message of type ``msgtype`` as rosbags' dataclass (:func:`to_json`'s
+    inverse), through the typestore's field definitions; a field the JSON leaves out takes its
+    zero value, as a ROS message's default."""
+    d = d or {}
+    _, fields = ts.fielddefs[msgtype]
+    values = {}
+    for name, (node, desc) in fields:
+        v = d.get(name)
+        if node == interfaces.Nodetype.NAME:
+            values[name] = from_json(ts, desc, v)
+        elif node == interfaces.Nodetype.BASE:
+            cast = _BASE.get(desc[0], int)
+            values[name] = cast(v) if v is not None else cast()
+        else:
+            (sub, subdesc), count = desc  # count: an array's fixed length (0: a sequence)
+            if sub == interfaces.Nodetype.NAME:
+                values[name] = [from_json(ts, subdesc, e) for e in (v or [])]
+            elif subdesc[0] == "string":
+                values[name] = [str(e) for e in (v or [])]
+            elif subdesc[0] in ("uint8", "char") and isinstance(v, str):
+                values[name] = np.frombuffer(base64.b64decode(v), np.uint8).copy()
+            else:
+                values[name] = np.asarray(v if v is not None else [0] * count, bool if subdesc[0] == "bool" else subdesc[0])
+    return ts.types[msgtype](**values)

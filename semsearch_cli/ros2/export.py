@@ -22,7 +22,7 @@ from ..runner.verify import replay_run
 from ..tasks.base import Observer
 from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep, DoorTask
 from ..tasks.episodes import episode_seed
-from .bag import GOAL_RGBA, SIGN_RGBA, START_NS, BagWriter, Messages, drop_bag, stamp_ns
+from .bag import GOAL_RGBA, SIGN_RGBA, START_NS, BagWriter, Messages, drop_bag, map_states, stamp_ns
 
 PATH_EVERY_M = 5.0  # /semsearch/path at the first decision after each 5 m of travel (and at the end)
 PATH_STEP_M = 0.5  # its poses, one every 0.5 m
@@ -80,8 +80,7 @@ class BagRecorder(Observer):
         new = False
         for i, label in e.reads:
             i = int(i)
-            self._write("/semsearch/detections", e.step, self.m.string({"label": sign_label(label), "x": float(signs.x[i]),
-                                                                        "y": float(signs.y[i]), "facing": float(signs.facing[i])}))
+            self._write("/semsearch/detections", e.step, self.m.detection(signs, i, label))
             if i not in self.read:
                 self.read[i] = str(label)
                 new = True
@@ -99,7 +98,7 @@ class BagRecorder(Observer):
         k = self.reach
         r0, r1, c0, c1 = max(0, r - k), min(H, r + k + 1), max(0, c - k), min(W, c + k + 1)
         b = e.belief
-        now = np.where(b.seen[r0:r1, c0:c1], np.where(b.free[r0:r1, c0:c1], 0, 100), -1).astype(np.int8)
+        now = map_states(b.seen[r0:r1, c0:c1], b.free[r0:r1, c0:c1])
         changed = now != self.state[r0:r1, c0:c1]
         if not changed.any():
             return

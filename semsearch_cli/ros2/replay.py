@@ -11,44 +11,34 @@ where it would go, and its answers are written to a new bag (``/semsearch/goal``
   decision;
 - a frame sensed by a re-plan (turning on the spot) is taken from the bag when the replayed
   re-plan senses; frames a re-plan of another planner does not ask for are folded in after it;
-- a robot's own bag (no events) needs a map (``/map``, nav_msgs/OccupancyGrid, as a SLAM node
-  publishes it: free below 20, occupied from 65, as map_saver's thresholds), a pose
-  (:data:`POSE_TOPICS`, PoseStamped or PoseWithCovarianceStamped in the map's frame; else /tf
-  and /tf_static composed from map to :data:`BASE_FRAMES`, in the plane) and the
-  sign detections (``/semsearch/detections``, JSON ``{"label", ...}``, read from the robot's pose
-  at that moment). The belief's grid covers every map the bag holds; each pose is a frame and a
-  step; a re-plan comes at the first pose that has a map, after every ``replan_every`` metres
-  travelled, and when a sign is read ``min_reads`` times (for planners that re-plan on signs), as
-  the simulator's periodic policy; the goal's label is ``--goal``.
+- a robot's own bag (no events) is run through
+  :class:`~semsearch_cli.ros2.robot.RobotSession`, as ``semsearch ros live`` runs a robot: its
+  map (``/map``), its pose (the first of :data:`~semsearch_cli.ros2.robot.POSE_TOPICS` it holds;
+  else /tf and /tf_static composed from map to ``base_link`` or ``base_footprint``, in the plane)
+  and its sign detections (``/semsearch/detections``); the belief's grid covers every map the bag
+  holds; the goal's label is ``--goal``.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import shutil
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
-from ..belief import DoorBelief
-from ..config import BeliefSpec, DoorCameraSpec, NavigationSpec, RobotSpec
 from ..config.base import sign_label
 from ..geometry import GridFrame
 from ..errors import BudgetSpent, PlannerError, ScenarioError
 from ..planners import Variant
 from ..runner.specs import Loaded
-from ..tasks.base import Observer, RobotState
-from ..tasks.decisions import DecisionPoint, set_rng
-from ..tasks.doors import DoorDecision, DoorSearch, DoorTask
+from ..tasks.base import RobotState
+from ..tasks.decisions import set_rng
+from ..tasks.doors import DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
-
-POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot bag's pose: the first of these it holds, else /tf
-BASE_FRAMES = ("base_link", "base_footprint")  # the robot's frame in /tf, the first that reaches map
-FREE_BELOW = 20  # OccupancyGrid values under it are free (map_saver's 0.196); from it, seen and not free
+from .robot import BASE_FRAMES, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree, drive, map_frame
 
 
 class BagStream:
@@ -149,27 +139,6 @@ class ReplaySearch(DoorSearch):
             self.stream.next()
 
 
-class GoalWriter(Observer):
-    """The replayed planner's decisions into the output bag, stamped at the input's time."""
-
-    def __init__(self, bag: BagWriter, frame):
-        self.bag, self.m, self.frame = bag, bag.msgs, frame
-        self.t = 0  # the input's stamp at the re-plan
-        self.last = -1  # the last stamp written
-        self.rows: list[dict] = []
-
-    def see(self, event) -> None:
-        if not isinstance(event, DoorDecision):
-            return
-        row = {"step": int(event.step), "target_cell": [int(event.decision.row), int(event.decision.col)],
-               "target": [float(v) for v in event.target_xy]}
-        self.rows.append(row)
-        fronts, goal = self.m.frontiers(self.t, self.frame, event.candidates, event.decision, event.target_xy)
-        for topic, msg in (("/explore/frontiers", fronts), ("/semsearch/goal", goal), ("/semsearch/decision", self.m.string(row))):
-            self.last = max(self.t, self.last + 1)  # after the input's moment, and after every message before
-            self.bag.write(topic, self.last, msg)
-
-
 @dataclass
 class Replayed:
     """What a replay gave: the output bag folder, the decisions [{step, target_cell, target}],
@@ -180,12 +149,14 @@ class Replayed:
     found: bool
 
 
-def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fmt: str = "mcap", goal=None) -> Replayed:
+def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fmt: str = "mcap", goal=None,
+               margin: float = 10.0) -> Replayed:
     """Run door planner ``variant`` over ``bag`` and write its decisions to the new bag folder
     ``out`` (which must not exist). A bag ``semsearch export`` wrote replays on ``loaded``, the
-    scenario it was recorded on; a robot's own bag needs ``goal`` (the label to find) and takes
-    the belief's, robot's and navigation's settings from ``loaded`` when given, else their
-    defaults."""
+    scenario it was recorded on; a robot's own bag needs ``goal`` (the label to find), is folded
+    into a grid of its first map and ``margin`` metres around it (as ``ros live`` folds a robot's
+    maps), and takes the belief's, robot's and navigation's settings from ``loaded`` when given,
+    else their defaults."""
     if loaded is not None and not isinstance(loaded.task, DoorTask):
         raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: a bag replays door planners only")
     msgs = Messages()
@@ -205,7 +176,7 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
         else:
             if goal is None:
                 raise ScenarioError(str(bag), "--goal", "a robot's own bag names no goal: give the label to find, --goal")
-            frame = _robot_frame(bag, msgs)
+            frame = _robot_frame(bag, msgs, margin)
             task, goal, run, rng_inc = RobotTask(frame, loaded.sc if loaded is not None else None), sign_label(goal), _run_robot, None
         if out.exists():
             raise ScenarioError(str(out), "", "exists already: give a new folder for the replay's bag")
@@ -259,7 +230,7 @@ def _setup(stream: BagStream, bag: Path) -> dict:
 
 def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc: int) -> tuple[bool, list]:
     planner = variant.build()
-    out = GoalWriter(writer, frame)
+    out = GoalWriter(writer.write, writer.msgs, frame)
     st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
     rng = np.random.default_rng(0)
     state = rng.bit_generator.state
@@ -300,168 +271,45 @@ def _fold(search: ReplaySearch, st: RobotState, item) -> dict | None:
 def _plan(search: ReplaySearch, st: RobotState) -> None:
     """One re-plan, each decision point answered by the planner under test; its path is not
     followed (the bag's robot moves as it moved)."""
-    gen = search.plan(st)
-    try:
-        point = next(gen)
-        while isinstance(point, DecisionPoint):
-            point = gen.send(point.ask())
-    except StopIteration:
-        pass
+    drive(search.plan(st))
 
 
-class _NoSigns:
-    """A robot's bag knows no sign of the world: the goal is matched by its label alone."""
-
-    def indices_of(self, label) -> list:
-        return []
-
-
-@dataclass
-class _RobotWorld:
-    frame: GridFrame
-    signs: _NoSigns
-
-
-class RobotTask:
-    """What a door search needs of its task, for a robot's bag: the grid its maps cover, and the
-    belief's, robot's, camera's and navigation's settings (a scenario's, or the defaults)."""
-
-    def __init__(self, frame: GridFrame, sc=None):
-        self.world = _RobotWorld(frame, _NoSigns())
-        self.sc = sc if sc is not None else SimpleNamespace(belief=BeliefSpec(), robot=RobotSpec(), door_camera=DoorCameraSpec(),
-                                                            navigation=NavigationSpec())
-
-    def new_belief(self) -> DoorBelief:
-        return DoorBelief(self.world.frame, self.sc.belief, self.sc.robot.radius)
-
-
-def _robot_frame(bag: Path, msgs: Messages) -> GridFrame:
-    """The grid that covers every /map of a robot's bag, at their resolution."""
+def _robot_frame(bag: Path, msgs: Messages, margin: float) -> GridFrame:
+    """The grid of a robot's bag: its first /map and ``margin`` metres around it, as ``ros live``
+    makes it."""
     stream = BagStream(bag, msgs, only=("/map",))
     try:
         if "/map" not in stream.topics or not any(t in stream.topics for t in (*POSE_TOPICS, "/tf")):
             raise ScenarioError(str(bag), "/map", "a robot's bag needs /map (nav_msgs/OccupancyGrid) and a pose on one of "
                                 f"{', '.join(POSE_TOPICS)} or /tf (map to {' or '.join(BASE_FRAMES)}); or it is a bag of "
                                 "`semsearch export`, with /semsearch/events")
-        res, box = None, [np.inf, np.inf, -np.inf, -np.inf]
-        while (item := stream.next()) is not None:
-            info = item[2].info
-            q = info.origin.orientation
-            if abs(q.z) > 1e-6 or abs(q.x) > 1e-6 or abs(q.y) > 1e-6:
-                raise ScenarioError(str(bag), "/map", "a map rotated in its frame (origin orientation not 0) is not read")
-            if res is None:
-                res = float(info.resolution)
-            elif abs(float(info.resolution) - res) > 1e-9:
-                raise ScenarioError(str(bag), "/map", f"maps of two resolutions ({res} and {info.resolution} m)")
-            x0, y0 = float(info.origin.position.x), float(info.origin.position.y)
-            box = [min(box[0], x0), min(box[1], y0), max(box[2], x0 + info.width * res), max(box[3], y0 + info.height * res)]
+        item = stream.next()
+        if item is None:
+            raise ScenarioError(str(bag), "/map", "holds no message")
+        try:
+            return map_frame(item[2], margin)
+        except ValueError as exc:
+            raise ScenarioError(str(bag), "/map", str(exc)) from None
     finally:
         stream.close()
-    W, H = int(round((box[2] - box[0]) / res)), int(round((box[3] - box[1]) / res))
-    return GridFrame(res, box[0], box[1], H, W)
-
-
-def fold_map(belief, msg) -> None:
-    """Fold a robot's OccupancyGrid (its SLAM map, placed by its origin in the grid that covers every
-    map of the bag) into the belief: -1 unknown, below ``FREE_BELOW`` free, else seen and not free."""
-    fr, info = belief.frame, msg.info
-    h, w = int(info.height), int(info.width)
-    c0 = int(round((float(info.origin.position.x) - fr.origin_x) / fr.res))
-    y0 = int(round((float(info.origin.position.y) - fr.origin_y) / fr.res))
-    values = np.asarray(msg.data, np.int8).reshape(h, w)[::-1]
-    belief.fold_grid(fr.height - y0 - h, c0, values >= 0, (values >= 0) & (values < FREE_BELOW))
-
-
-def _yaw(q) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
-def _pose_of(msg) -> tuple[float, float, float]:
-    pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose  # PoseWithCovarianceStamped or PoseStamped
-    return float(pose.position.x), float(pose.position.y), _yaw(pose.orientation)
-
-
-class TfTree:
-    """The latest 2D transform of each frame to its parent, from /tf and /tf_static; ``pose`` of a
-    frame in ``map`` composes them (None while the chain is incomplete)."""
-
-    def __init__(self):
-        self.parent: dict[str, tuple[str, float, float, float]] = {}
-
-    def add(self, msg) -> set[str]:
-        """Take a TFMessage; returns the child frames it updated."""
-        done = set()
-        for tr in msg.transforms:
-            child, t = tr.child_frame_id.lstrip("/"), tr.transform
-            self.parent[child] = (tr.header.frame_id.lstrip("/"), float(t.translation.x), float(t.translation.y), _yaw(t.rotation))
-            done.add(child)
-        return done
-
-    def pose(self, frame: str, root: str = "map") -> tuple[float, float, float] | None:
-        x = y = yaw = 0.0
-        for _ in range(16):  # a tree of a robot is shallow; a loop in it is not followed for ever
-            if frame == root:
-                return x, y, yaw
-            if frame not in self.parent:
-                return None
-            frame, px, py, pyaw = self.parent[frame]
-            c, s = math.cos(pyaw), math.sin(pyaw)
-            x, y, yaw = px + c * x - s * y, py + s * x + c * y, pyaw + yaw
-        return None
 
 
 def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc=None) -> tuple[bool, list]:
-    """A robot's bag: each pose a frame and a step, re-plans as the simulator's periodic policy."""
-    planner = variant.build()
-    out = GoalWriter(writer, frame)
-    st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
-    search = ReplaySearch(task, planner, goal, np.random.default_rng(0), out, stream)
-    pose_topic = next((t for t in POSE_TOPICS if t in stream.topics), None)  # else /tf: map -> odom -> base_link
-    tf = TfTree()
-    every = task.sc.navigation.replan_every
-    on_signs = getattr(planner, "replan_on_signs", False)
-    b, fr = st.belief, frame
-    have_map = posed = False
-    since, due = 0.0, True
+    """A robot's bag, through :class:`~semsearch_cli.ros2.robot.RobotSession` (as ``ros live``
+    runs a robot): its robot moves as it moved, the planner is asked where it would go."""
+    out = GoalWriter(writer.write, writer.msgs, frame)
+    session = RobotSession(task, variant.build(), goal, out, next((t for t in POSE_TOPICS if t in stream.topics), None))
+    tf = TfTree()  # no pose topic: /tf, map -> odom -> base_link
     while (item := stream.next()) is not None:
         topic, t, msg = item
         out.t = t
-        pose = None
-        if topic == "/map":
-            fold_map(b, msg)
-            have_map = True
-        elif topic == pose_topic:
-            pose = _pose_of(msg)
-        elif pose_topic is None and topic in ("/tf", "/tf_static"):
-            if tf.add(msg) & set(BASE_FRAMES):
-                pose = next(filter(None, map(tf.pose, BASE_FRAMES)), None)
-        elif topic == "/semsearch/detections" and posed:
-            try:
-                label = sign_label(json.loads(msg.data)["label"])
-            except (ValueError, KeyError, TypeError):
-                continue  # not a detection this replay reads: skipped, as a robot's stray message would be
-            _, _, r, c = fr.point_to_cell(st.x, st.y)
-            if 0 <= r < fr.height and 0 <= c < fr.width:
-                if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == b.spec.min_reads and on_signs:
-                    due = True
-                if label == goal:
-                    search.found = True
-                    break
-        if pose is None:
-            continue
-        x, y, yaw = pose
-        if posed:
-            moved = math.hypot(x - st.x, y - st.y)
-            st.distance += moved
-            since += moved
-        st.steps += posed  # the first pose is step 0, as in an exported bag
-        st.x, st.y, st.heading, posed = x, y, yaw, True
-        v, u, r, c = fr.point_to_cell(x, y)
-        if not (0 <= r < fr.height and 0 <= c < fr.width):
-            continue
-        b.views.append((v, u, yaw))
-        search.update(st)
-        if have_map and (due or since >= every):
-            since, due = 0.0, False
-            _plan(search, st)
-    return search.found, out.rows
+        if session.pose_topic is None and topic in ("/tf", "/tf_static"):
+            pose = next(filter(None, map(tf.pose, BASE_FRAMES)), None) if tf.add(msg) & set(BASE_FRAMES) else None
+            what = "plan" if pose is not None and session.pose(*pose) else None
+        else:
+            what = session.take(topic, msg)
+        if what == "found":
+            break
+        if what == "plan":
+            session.plan()
+    return session.found, out.rows

@@ -1,0 +1,275 @@
+"""``semsearch ros live``: a door planner exploring with a robot through rosbridge, in the place of
+explore_lite (docs/robot.md).
+
+The robot's side is rosbridge_server's WebSocket (``roslibpy`` speaks to it, ROS 2 actions
+included); semsearch subscribes to :data:`INPUTS` and runs a
+:class:`~semsearch_cli.ros2.robot.RobotSession` over them, message by message in the order they
+come (so a live run makes the re-plans a bag of the same messages replays to). At each re-plan it
+publishes explore_lite's ``/explore/frontiers`` (the candidates as markers, the chosen one red),
+``/semsearch/goal`` (the target, PoseStamped) and ``/semsearch/decision`` (JSON), and then:
+
+- sends the path's end as a ``nav2_msgs/action/NavigateToPose`` goal on ``/navigate_to_pose`` (a
+  goal at every re-plan, so that the robot's planner starts from where the robot is, as the
+  simulator's re-plan does; Nav2 preempts the one under way); the goal's end (reached, aborted) is
+  a re-plan's "path done";
+- or, with ``publish_only``, drives nothing: ``/semsearch/goal`` is the output, and the goal
+  counts as reached when the robot's pose comes within ``ARRIVED`` of it.
+
+``/explore/resume`` (std_msgs/Bool) pauses (False: the goal under way is cancelled, no re-plan)
+and resumes (True: a re-plan at once), as explore_lite's. The run ends when the goal's sign is
+read (found; the goal under way is cancelled), when the planner has nowhere left to go (stuck),
+at ``max_distance`` (budget), when the robot has been silent for ``silence`` seconds (lost), or
+on Ctrl-C (interrupted). A run that ends otherwise than found leaves a repro bag: the map, poses
+and detections it received, in the order it took them, which ``semsearch ros replay BAG --goal``
+replays to the same re-plans.
+"""
+
+from __future__ import annotations
+
+import math
+import queue
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from urllib.parse import urlparse
+
+from ..errors import ScenarioError
+from ..optional import lazy_module
+from .bag import BagWriter, Messages, drop_bag, from_json, to_json
+from .robot import (DETECTIONS, GOAL_STATUS, MAP, POSE_TYPES, RESUME, GoalWriter, RobotSession, RobotTask, goal_ended,
+                    map_frame)
+
+roslibpy = lazy_module("roslibpy")  # optional: pip install 'semsearch[ros]'
+
+INPUTS = {DETECTIONS: "std_msgs/msg/String", RESUME: "std_msgs/msg/Bool", MAP: "nav_msgs/msg/OccupancyGrid", **POSE_TYPES}
+OUTPUTS = {"/explore/frontiers": "visualization_msgs/msg/MarkerArray", "/semsearch/goal": "geometry_msgs/msg/PoseStamped",
+           "/semsearch/decision": "std_msgs/msg/String"}
+NAVIGATE = ("/navigate_to_pose", "nav2_msgs/action/NavigateToPose")
+ARRIVED = 0.25  # m: with --publish-only, a goal is reached when the robot's pose comes this close
+SUCCEEDED, ABORTED = 4, 6  # action_msgs/GoalStatus
+ABORTS = 5  # goals the robot gives up on in a row, without moving, before the run is stuck
+
+
+@dataclass
+class LiveRun:
+    """What a live run gave: its outcome (found, stuck, budget, lost, interrupted), the distance
+    its poses travelled (m, straight lines between them), the poses, the decisions [{step,
+    target_cell, target}], the goals sent, a note, and the repro bag (None when found)."""
+
+    outcome: str
+    distance: float
+    poses: int
+    decisions: list = field(default_factory=list)
+    goals: int = 0
+    message: str = ""
+    repro: Path | None = None
+
+
+class _Repro:
+    """The messages a live run took, written as they come into a hidden bag folder; kept under
+    ``path`` when the run fails, removed when it finds the goal."""
+
+    def __init__(self, path: Path, msgs: Messages):
+        self.path = path
+        self.work = path.with_name(f".{path.name}.partial")
+        shutil.rmtree(self.work, ignore_errors=True)
+        self.work.mkdir(parents=True)
+        self.writer = BagWriter(self.work / path.name, "mcap", msgs)
+        self.t = 0
+
+    def write(self, topic: str, msg) -> None:
+        self.t = max(time.time_ns(), self.t + 1)  # strictly increasing: read by time, the order they came
+        self.writer.write(topic, self.t, msg)
+
+    def keep(self) -> Path:
+        self.writer.close()
+        (self.work / self.path.name).rename(self.path)
+        self.work.rmdir()
+        return self.path
+
+    def drop(self) -> None:
+        drop_bag(self.writer, self.work)
+
+
+class Live:
+    """One live run (see the module's text): :meth:`run` connects, explores and returns a
+    :class:`LiveRun`."""
+
+    def __init__(self, url: str, variant, goal, sc=None, publish_only: bool = False, repro: Path | None = None,
+                 margin: float = 10.0, max_distance: float | None = None, silence: float = 30.0, log=None):
+        u = urlparse(url)
+        if u.scheme not in ("ws", "wss") or not u.hostname:
+            raise ScenarioError("<command line>", "--rosbridge", f"{url!r} is not a WebSocket address: give ws://HOST:PORT "
+                                "(rosbridge_server listens on 9090)")
+        self.host, self.port, self.secure = u.hostname, u.port or 9090, u.scheme == "wss"
+        self.variant, self.goal, self.sc = variant, goal, sc
+        self.publish_only, self.margin, self.silence = publish_only, margin, silence
+        self.max_distance = max_distance if max_distance is not None else math.inf
+        self.repro_path = Path(repro) if repro is not None else Path(f"live-repro-{time.strftime('%Y%m%d-%H%M%S')}")
+        if self.repro_path.exists():
+            raise ScenarioError(str(self.repro_path), "--repro", "exists already: give a new folder for the repro bag")
+        self.log = log or (lambda text: None)
+        self.m = Messages()
+        self.q: queue.Queue = queue.Queue()
+        self.session: RobotSession | None = None
+        self.out: GoalWriter | None = None
+        self.pose_topic: str | None = None
+        self.early: list = []  # messages before the first map
+        self.stamp = 0  # the last pose's stamp (ns): the goals planned on it carry it
+        self.sent = 0  # goals sent; the one under way is number self.current
+        self.current: int | None = None
+        self.target: tuple[float, float] | None = None
+        self._goal_ids: dict[int, str] = {}  # goal number -> roslibpy's goal id
+        self.aborts = 0
+        self.clipped = False
+
+    # -- the connection ---------------------------------------------------------------
+    def run(self) -> LiveRun:
+        ros = roslibpy.Ros(self.host, self.port, is_secure=self.secure, transport="asyncio")
+        try:
+            ros.run(timeout=10)
+        except Exception as exc:  # noqa: BLE001  no robot there: named, never a traceback
+            ros.close()
+            raise ScenarioError("<command line>", "--rosbridge", f"no rosbridge answers at ws://{self.host}:{self.port} "
+                                f"({type(exc).__name__}): is rosbridge_server running there?") from None
+        self.ros = ros
+        self.pubs = {t: roslibpy.Topic(ros, t, kind) for t, kind in OUTPUTS.items()}
+        for topic in self.pubs.values():
+            topic.advertise()
+        self.nav = roslibpy.ActionClient(ros, *NAVIGATE) if not self.publish_only else None
+        subs = []
+        for t, kind in INPUTS.items():  # the map before the poses: a latched map comes first
+            sub = roslibpy.Topic(ros, t, kind)
+            sub.subscribe(lambda msg, t=t: self.q.put((t, msg)))
+            subs.append(sub)
+        self.repro = _Repro(self.repro_path, self.m)
+        res = None
+        try:
+            res = self._loop()
+        except KeyboardInterrupt:
+            res = self._result("interrupted", "stopped by Ctrl-C")
+        finally:
+            if self.current is not None and self.nav is not None and res is not None:
+                self._cancel()
+            for sub in subs:
+                sub.unsubscribe()
+            for topic in self.pubs.values():
+                topic.unadvertise()
+            time.sleep(0.05)  # the last messages out before the socket closes
+            ros.close()
+            if res is None or res.outcome == "found":
+                self.repro.drop()
+        if res.outcome != "found":
+            res.repro = self.repro.keep()
+        return res
+
+    def _publish(self, topic: str, t_ns: int, msg) -> None:
+        self.pubs[topic].publish(roslibpy.Message(to_json(msg)))
+
+    def _cancel(self) -> None:
+        self.nav.cancel_goal(self._goal_ids[self.current])
+        self.current = None
+
+    # -- the loop -----------------------------------------------------------------------
+    def _loop(self) -> LiveRun:
+        while True:
+            try:
+                topic, payload = self.q.get(timeout=self.silence)
+            except queue.Empty:
+                return self._result("lost", f"no message from the robot for {self.silence:g} s")
+            end = self._take(topic, payload)
+            if end is not None:
+                return end
+
+    def _take(self, topic: str, payload) -> LiveRun | None:
+        """One message (or the end of the goal under way, ``result``); the run's result when it
+        ends the run. What the session takes goes into the repro bag first, in this order."""
+        if topic == "result":
+            k, status = payload
+            if k != self.current:
+                return None  # a goal replaced or cancelled since
+            self.current = None
+            self.aborts = self.aborts + 1 if status == ABORTED else 0
+            if self.aborts >= ABORTS:
+                return self._result("stuck", f"the robot gave up on {ABORTS} goals in a row")
+            topic, msg = GOAL_STATUS, goal_ended(self.m, k, status)
+        else:
+            msg = from_json(self.m.ts, INPUTS[topic], payload)
+            if topic in POSE_TYPES:
+                if self.pose_topic is None:
+                    self.pose_topic = topic
+                    self.log(f"pose from {topic}")
+                if topic != self.pose_topic:
+                    return None
+                self.stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec  # a goal carries its pose's stamp
+        return self._feed(topic, msg)
+
+    def _feed(self, topic: str, msg) -> LiveRun | None:
+        self.repro.write(topic, msg)
+        s = self.session
+        if s is None:
+            if topic != MAP:
+                self.early.append((topic, msg))  # taken once the first map gives the grid
+                return None
+            try:
+                frame = map_frame(msg, self.margin)
+            except ValueError as exc:
+                raise ScenarioError(MAP, "info.origin", str(exc)) from None
+            self.out = GoalWriter(self._publish, self.m, frame)
+            s = self.session = RobotSession(RobotTask(frame, self.sc), self.variant.build(), self.goal, self.out, self.pose_topic)
+            self.log(f"map: {frame.width} x {frame.height} cells at {frame.res:g} m (the first map and {self.margin:g} m "
+                     "around it)")
+            for t, m in self.early:
+                if s.take(t, m) == "found":
+                    return self._result("found", "read the goal's sign")
+        what = s.take(topic, msg)
+        if s.clipped and not self.clipped:
+            self.clipped = True
+            self.log(f"the map outgrew the grid: cells beyond it are left out (give a --margin over {self.margin:g} m)")
+        if what == "found":
+            return self._result("found", "read the goal's sign")
+        if topic == RESUME:
+            self.log(f"explore/resume: {'paused' if s.paused else 'resumed'}")
+            if s.paused and self.current is not None and self.nav is not None:
+                self._cancel()
+        if topic == self.pose_topic:
+            if s.st.distance >= self.max_distance:
+                return self._result("budget", f"travelled {s.st.distance:.1f} m of {self.max_distance:g}")
+            if self.publish_only and self.target is not None and math.hypot(s.st.x - self.target[0],
+                                                                            s.st.y - self.target[1]) <= ARRIVED:
+                self.target = None
+                return self._feed(GOAL_STATUS, goal_ended(self.m, self.sent, SUCCEEDED))  # reached: recorded as Nav2 would
+        return self._replan() if what == "plan" else None
+
+    def _replan(self) -> LiveRun | None:
+        s = self.session
+        self.out.t = time.time_ns()
+        plan = s.plan()
+        if isinstance(plan, str):
+            return self._result(plan, "nowhere left to go" if plan == "stuck" else plan)
+        xs, ys = plan
+        x, y = float(xs[-1]), float(ys[-1])
+        yaw = math.atan2(float(ys[-1] - ys[-2]), float(xs[-1] - xs[-2]))
+        self.target = (x, y)
+        self.sent += 1
+        if self.nav is not None:
+            k = self.current = self.sent
+            goal = roslibpy.Goal({"pose": to_json(self.m.pose_stamped(self.stamp, x, y, yaw)), "behavior_tree": ""})
+
+            def done(res, k=k):  # on roslibpy's thread: the end goes through the queue, in order
+                self.q.put(("result", (k, _status(res))))
+            self._goal_ids[k] = self.nav.send_goal(goal, done, lambda fb: None, done)
+        return None
+
+    def _result(self, outcome: str, message: str) -> LiveRun:
+        s = self.session
+        if s is None:
+            return LiveRun(outcome, 0.0, 0, [], self.sent, message)
+        return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, self.sent, message)
+
+
+def _status(res) -> int:
+    """The status (action_msgs/GoalStatus) of a goal's end as roslibpy gives it."""
+    status = res.get("status") if hasattr(res, "get") else None
+    return int(getattr(status, "value", status) or 0)

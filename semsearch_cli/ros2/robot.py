@@ -1,0 +1,305 @@
+"""A door search fed with a robot's own messages, one at a time: its SLAM map, its pose and its
+sign detections (a robot's bag, ``semsearch ros replay``; a live robot, ``semsearch ros live``).
+
+Both drivers run :class:`RobotSession`, so a bag recorded on a robot replays with the re-plans the
+live bridge made on it:
+
+- the map (``/map``, nav_msgs/OccupancyGrid, as a SLAM node publishes it) is folded in whole at
+  each message: -1 unknown, below :data:`FREE_BELOW` free (map_saver's threshold), else seen and
+  not free; cells outside the belief's grid are left out (:func:`fold_map`);
+- each pose is a frame and a step: the distance grows by the straight line from the pose before,
+  the camera's view is the pose's, the visited kernel is marked;
+- a detection (``/semsearch/detections``, JSON ``{"label", ...}``) of the goal's label ends the
+  search; another is read from the robot's next pose (a read counts towards ``min_reads`` as the
+  simulator's camera read does), so that the reads of a moment are in before that moment's re-plan;
+- a re-plan is due as :meth:`~semsearch_cli.tasks.doors.DoorSearch.replan_due` says: at the first
+  pose that has a map, when the last goal is done (reached, or given up by the robot), every
+  ``replan_every`` metres (``navigation.replan: periodic``) or when the map loses a free cell
+  (``events``), and when a sign is read ``min_reads`` times for planners that re-plan on signs;
+- the robot senses for itself: a re-plan that would turn on the spot to look (no frontier yet, a
+  wall face reached) sees nothing new, since the robot is not asked to turn.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+
+from ..belief import DoorBelief
+from ..config import BeliefSpec, DoorCameraSpec, NavigationSpec, RobotSpec
+from ..config.base import sign_label
+from ..geometry import GridFrame
+from ..tasks.base import Observer, RobotState
+from ..tasks.doors import DoorDecision, DoorSearch
+
+MAP, DETECTIONS, RESUME = "/map", "/semsearch/detections", "/explore/resume"
+GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray: Nav2's goals and how they ended
+ENDS = (4, 6)  # GoalStatus SUCCEEDED, ABORTED: a goal's path is done (CANCELED is a goal replaced or called off)
+POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot's pose: the first of these it publishes
+POSE_TYPES = {"/semsearch/pose": "geometry_msgs/msg/PoseStamped", "/amcl_pose": "geometry_msgs/msg/PoseWithCovarianceStamped",
+              "/pose": "geometry_msgs/msg/PoseWithCovarianceStamped"}  # slam_toolbox's /pose, amcl's /amcl_pose
+BASE_FRAMES = ("base_link", "base_footprint")  # the robot's frame in /tf, the first that reaches map
+FREE_BELOW = 20  # OccupancyGrid values under it are free (map_saver's 0.196); from it, seen and not free
+
+
+class _NoSigns:
+    """A robot's search knows no sign of the world: the goal is matched by its label alone."""
+
+    def indices_of(self, label) -> list:
+        return []
+
+
+@dataclass
+class _RobotWorld:
+    frame: GridFrame
+    signs: _NoSigns
+
+
+class RobotTask:
+    """What a door search needs of its task, for a robot: the grid its maps are folded into, and
+    the belief's, robot's, camera's and navigation's settings (a scenario's, or the defaults)."""
+
+    def __init__(self, frame: GridFrame, sc=None):
+        self.world = _RobotWorld(frame, _NoSigns())
+        self.sc = sc if sc is not None else SimpleNamespace(belief=BeliefSpec(), robot=RobotSpec(), door_camera=DoorCameraSpec(),
+                                                            navigation=NavigationSpec())
+
+    def new_belief(self) -> DoorBelief:
+        return DoorBelief(self.world.frame, self.sc.belief, self.sc.robot.radius)
+
+
+def goal_ended(messages, k: int, status: int):
+    """The GoalStatusArray of goal number ``k`` (its UUID: ``k`` in 16 bytes) ended with ``status``."""
+    T = messages.T
+    info = T["action_msgs/msg/GoalInfo"](goal_id=T["unique_identifier_msgs/msg/UUID"](uuid=np.frombuffer(
+        int(k).to_bytes(16, "big"), np.uint8).copy()), stamp=messages._time(0))
+    return T["action_msgs/msg/GoalStatusArray"](status_list=[T["action_msgs/msg/GoalStatus"](goal_info=info, status=int(status))])
+
+
+def map_resolution(info) -> float:
+    """A map's resolution (m per cell) as its message means it: the field is a float32, so 0.1 read
+    from a bag is 0.10000000149; the shortest decimal that float32 holds (0.1), whether the
+    message came from a bag or as rosbridge's JSON."""
+    return float(str(np.float32(info.resolution)))
+
+
+def map_frame(msg, margin: float = 0.0) -> GridFrame:
+    """The grid of an OccupancyGrid's cells, grown by ``margin`` metres (whole cells) on every
+    side; a ValueError for a map rotated in its frame."""
+    info = msg.info
+    q = info.origin.orientation
+    if abs(q.z) > 1e-6 or abs(q.x) > 1e-6 or abs(q.y) > 1e-6:
+        raise ValueError("a map rotated in its frame (origin orientation not 0) is not read")
+    res = map_resolution(info)
+    k = int(math.ceil(margin / res - 1e-9)) if margin > 0 else 0
+    return GridFrame(res, float(info.origin.position.x) - k * res, float(info.origin.position.y) - k * res,
+                     int(info.height) + 2 * k, int(info.width) + 2 * k)
+
+
+def fold_map(belief, msg) -> bool:
+    """Fold a robot's OccupancyGrid (placed by its origin in the belief's grid, at the grid's
+    resolution) into the belief: -1 unknown, below ``FREE_BELOW`` free, else seen and not free.
+    Cells outside the grid are left out; returns whether some were."""
+    fr, info = belief.frame, msg.info
+    if abs(map_resolution(info) - fr.res) > 1e-9:
+        raise ValueError(f"a map at {info.resolution} m per cell, the belief's grid is at {fr.res} m")
+    h, w = int(info.height), int(info.width)
+    c0 = int(round((float(info.origin.position.x) - fr.origin_x) / fr.res))
+    y0 = int(round((float(info.origin.position.y) - fr.origin_y) / fr.res))
+    r0 = fr.height - y0 - h  # the map's top row in the simulator's rows (row 0 at the top)
+    values = np.asarray(msg.data, np.int8).reshape(h, w)[::-1]
+    top, left = max(r0, 0), max(c0, 0)
+    bottom, right = min(r0 + h, fr.height), min(c0 + w, fr.width)
+    if bottom <= top or right <= left:
+        return h * w > 0
+    values = values[top - r0:bottom - r0, left - c0:right - c0]
+    belief.fold_grid(top, left, values >= 0, (values >= 0) & (values < FREE_BELOW))
+    return values.size < h * w
+
+
+def _yaw(q) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def pose_of(msg) -> tuple[float, float, float]:
+    """(x, y, yaw) of a PoseStamped or PoseWithCovarianceStamped."""
+    pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
+    return float(pose.position.x), float(pose.position.y), _yaw(pose.orientation)
+
+
+class TfTree:
+    """The latest 2D transform of each frame to its parent, from /tf and /tf_static; ``pose`` of a
+    frame in ``map`` composes them (None while the chain is incomplete)."""
+
+    def __init__(self):
+        self.parent: dict[str, tuple[str, float, float, float]] = {}
+
+    def add(self, msg) -> set[str]:
+        """Take a TFMessage; returns the child frames it updated."""
+        done = set()
+        for tr in msg.transforms:
+            child, t = tr.child_frame_id.lstrip("/"), tr.transform
+            self.parent[child] = (tr.header.frame_id.lstrip("/"), float(t.translation.x), float(t.translation.y), _yaw(t.rotation))
+            done.add(child)
+        return done
+
+    def pose(self, frame: str, root: str = "map") -> tuple[float, float, float] | None:
+        x = y = yaw = 0.0
+        for _ in range(16):  # a tree of a robot is shallow; a loop in it is not followed for ever
+            if frame == root:
+                return x, y, yaw
+            if frame not in self.parent:
+                return None
+            frame, px, py, pyaw = self.parent[frame]
+            c, s = math.cos(pyaw), math.sin(pyaw)
+            x, y, yaw = px + c * x - s * y, py + s * x + c * y, pyaw + yaw
+        return None
+
+
+def detection_label(data: str):
+    """The label of a detection (``std_msgs/String`` JSON ``{"label": ...}``), or None for a
+    message that is not one."""
+    try:
+        return sign_label(json.loads(data)["label"])
+    except (ValueError, KeyError, TypeError):
+        return None
+
+
+class GoalWriter(Observer):
+    """A planner's decisions as the messages explore_lite's users look at (``/explore/frontiers``,
+    ``/semsearch/goal``, ``/semsearch/decision``), given to ``sink(topic, stamp_ns, msg)`` (a
+    bag's writer, a live robot's publishers), stamped at the input's time :attr:`t` (or just
+    after the last one); :attr:`rows` keeps them."""
+
+    def __init__(self, sink, messages, frame):
+        self.sink, self.m, self.frame = sink, messages, frame
+        self.t = 0  # the input's stamp at the re-plan
+        self.last = -1  # the last stamp written
+        self.rows: list[dict] = []
+
+    def see(self, event) -> None:
+        if not isinstance(event, DoorDecision):
+            return
+        row = {"step": int(event.step), "target_cell": [int(event.decision.row), int(event.decision.col)],
+               "target": [float(v) for v in event.target_xy]}
+        self.rows.append(row)
+        fronts, goal = self.m.frontiers(self.t, self.frame, event.candidates, event.decision, event.target_xy)
+        for topic, msg in (("/explore/frontiers", fronts), ("/semsearch/goal", goal), ("/semsearch/decision", self.m.string(row))):
+            self.last = max(self.t, self.last + 1)  # after the input's moment, and after every message before
+            self.sink(topic, self.last, msg)
+
+
+class RobotSearch(DoorSearch):
+    """The door search of a robot: the robot senses for itself, so a re-plan that would turn on
+    the spot senses nothing."""
+
+    found = False
+
+    def sense(self, st: RobotState) -> tuple[bool, bool]:
+        return False, False
+
+
+class RobotSession:
+    """One door search over a robot's messages (see the module's text), taken one at a time by
+    :meth:`take`: it says when the goal's sign was read and when to re-plan, and :meth:`plan`
+    re-plans (the planner answers each decision point; decisions go to ``observer``)."""
+
+    def __init__(self, task: RobotTask, planner, goal, observer=None, pose_topic: str | None = None):
+        self.task, self.goal = task, sign_label(goal)
+        self.st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
+        self.search = RobotSearch(task, planner, self.goal, np.random.default_rng(0), observer)
+        self.pose_topic = pose_topic  # None: the first of POSE_TOPICS that speaks
+        self.pending: list = []  # labels read since the last pose
+        self.have_map = self.posed = self.paused = self.clipped = False
+        self.since, self.event, self.done = 0.0, False, True  # done: the last goal ended (none yet at the start)
+        self.ended: set = set()  # the goals whose end was taken (their UUIDs)
+
+    @property
+    def found(self) -> bool:
+        return self.search.found
+
+    def take(self, topic: str, msg) -> str | None:
+        """One message of the robot's (rosbags' message): ``"found"`` when it reads the goal's
+        sign, ``"plan"`` when a re-plan is due now, else None. Topics: ``/map``, the pose
+        (:attr:`pose_topic`), ``/semsearch/detections``, ``/explore/resume`` (False pauses the
+        re-plans, True re-plans at once) and :data:`GOAL_STATUS` (a goal reached or given up on
+        is a path done)."""
+        if topic == MAP:
+            self.map(msg)
+        elif topic == DETECTIONS:
+            label = detection_label(msg.data)  # None: not a detection, skipped as a stray message
+            if label is not None and self.detection(label):
+                return "found"
+        elif topic == RESUME:
+            self.paused = not msg.data
+            if not self.paused:
+                self.done = True
+                return "plan" if self.due() else None
+        elif topic == GOAL_STATUS:
+            ends = [bytes(g.goal_info.goal_id.uuid) for g in msg.status_list if g.status in ENDS]
+            if any(e not in self.ended for e in ends):
+                self.ended.update(ends)
+                self.done = True
+                return "plan" if self.due() else None
+        elif topic in POSE_TYPES and (self.pose_topic or topic) == topic:
+            self.pose_topic = topic
+            return "plan" if self.pose(*pose_of(msg)) else None
+        return None
+
+    def map(self, msg) -> None:
+        """Fold in a map (:attr:`clipped` tells whether some of a map fell outside the grid)."""
+        self.clipped = fold_map(self.st.belief, msg) or self.clipped
+        self.have_map = True
+
+    def detection(self, label) -> bool:
+        """Take a label read; whether it is the goal's (the search is over)."""
+        if label == self.goal:
+            self.search.found = True
+        elif self.posed:
+            self.pending.append(label)
+        return self.search.found
+
+    def pose(self, x: float, y: float, yaw: float) -> bool:
+        """Take the robot's pose (a frame and a step); whether a re-plan is due."""
+        st, fr = self.st, self.task.world.frame
+        if self.posed:
+            moved = math.hypot(x - st.x, y - st.y)
+            st.distance += moved
+            self.since += moved
+        st.steps += self.posed  # the first pose is step 0
+        st.x, st.y, st.heading, self.posed = x, y, yaw, True
+        v, u, r, c = fr.point_to_cell(x, y)
+        if not (0 <= r < fr.height and 0 <= c < fr.width):
+            return False
+        b = st.belief
+        for label in self.pending:
+            if b.reads.add(label, r * fr.width + c, x, y, yaw) == b.spec.min_reads:
+                self.event = True
+        self.pending.clear()
+        b.views.append((v, u, yaw))
+        self.search.update(st)
+        return self.due()
+
+    def due(self) -> bool:
+        return (self.have_map and self.posed and not self.paused
+                and self.search.replan_due(self.done, self.since, self.event))
+
+    def plan(self):
+        """One re-plan, each decision point answered by the planner: waypoints ``(xs, ys)`` (m),
+        or an outcome (``stuck``: nowhere left to go)."""
+        self.since, self.event, self.done = 0.0, False, False
+        return drive(self.search.plan(self.st))
+
+
+def drive(gen):
+    """Run a re-plan's generator, each decision point answered by its planner; its plan."""
+    try:
+        point = next(gen)
+        while True:
+            point = gen.send(point.ask())
+    except StopIteration as stop:
+        return stop.value
