@@ -14,6 +14,7 @@ import pandas as pd
 import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
+from .config.base import sign_label
 from .errors import ScenarioError
 from .world.ground_truth import DuplicateSigns
 from .world.buildings import numbered
@@ -246,6 +247,31 @@ def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | Non
     live = ros2.Live(rosbridge, _door_variant(planner, planner_file), goal, loaded.sc if loaded is not None else None,
                      publish_only, repro, margin, max_distance, silence, log)
     return live.run()
+
+
+def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, period: float = 0.2,
+            follow: str | None = None):
+    """A robot without ROS to try :func:`ros_live` on: the simulator's robot of ``scenario``
+    (goal ``goal``'s first episode, repeat ``seed``) behind a rosbridge server on
+    ``ws://127.0.0.1:port`` (:mod:`semsearch_cli.ros2.loopback`), a step every ``period`` seconds
+    (0.2: a step of 0.1 m at 0.5 m/s); with ``follow``, it also drives to each PoseStamped a
+    client publishes on that topic (``--publish-only``'s goals). Returns the started
+    :class:`~semsearch_cli.ros2.loopback.SimRobot`; ``robot.bridge.stop()`` ends it."""
+    if not ros2.available():
+        raise ScenarioError("<command line>", "ros sim", "needs the ros extra (roslibpy, websockets): pip install 'semsearch[ros]'")
+    if period <= 0:
+        raise ScenarioError("<command line>", "--period", f"{period:g} s: give more than 0")
+    loaded = Loaded.load(scenario_file(scenario), planners=False)
+    if not isinstance(loaded.task, DoorTask):
+        raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: the stand-in robot searches for door signs")
+    goal = sign_label(goal)
+    loaded.task.check_goals([goal], "--goal")
+    bridge = ros2.Rosbridge(port=port)
+    try:
+        bridge.start()
+    except OSError as exc:
+        raise ScenarioError("<command line>", "--port", f"{port}: {exc.strerror or exc}") from None
+    return ros2.SimRobot(bridge, loaded, goal, seed, period=period, follow=follow).start()
 
 
 def _door_variant(planner: str, planner_file: str | Path | None):

@@ -484,6 +484,45 @@ def ros_live(
     raise typer.Exit(0 if res.outcome == "found" else 1)
 
 
+@ros_app.command("sim")
+def ros_sim(
+    scenario: Path = SCENARIO,
+    goal: str = typer.Option(..., "--goal", help="The goal whose first episode the robot starts from (its start, its seed)."),
+    seed: int = typer.Option(0, "--seed", help="The repeat (the generator `semsearch run` gives that episode and seed)."),
+    port: int = typer.Option(9090, "--port", help="The port on 127.0.0.1 (rosbridge_server's is 9090)."),
+    period: float = typer.Option(0.2, "--period", help="Seconds between the robot's steps."),
+    follow: Optional[str] = typer.Option(None, "--follow", help="Also drive to each PoseStamped published on this topic (for "
+                                         "`ros live --publish-only`: /semsearch/goal)."),
+):
+    """A robot without ROS, to try `semsearch ros live` on: the scenario's simulated robot behind a
+    rosbridge server on 127.0.0.1, publishing /map, /semsearch/pose and /semsearch/detections and
+    taking Nav2 NavigateToPose goals on /navigate_to_pose. Runs until Ctrl-C."""
+
+    try:
+        bot = api.ros_sim(scenario, goal, seed, port, period, follow)
+    except ScenarioError as exc:
+        _fail(exc)
+    out.print(f"rosbridge on {bot.bridge.url}: the robot of {scenario} at ({bot.st.x:g}, {bot.st.y:g}), waiting for goals "
+              "(Ctrl-C stops it)")
+    told = False
+
+    def tell():  # once, when the robot's cameras have read the goal's sign
+        nonlocal told
+        if bot.found_at is not None and not told:
+            told = True
+            out.print(f"read the sign {goal} after {bot.found_at:.2f} m, {len(bot.goals)} goals so far")
+    try:
+        while True:
+            time.sleep(0.2)
+            tell()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        bot.bridge.stop()
+    tell()
+    out.print(f"stopped after {bot.distance:.2f} m, {bot.st.steps} steps, {len(bot.goals)} goals")
+
+
 @app.command()
 def validate(scenario: Path = SCENARIO):
     """Check a scenario without simulating: every loader check, sign counts, shortest paths."""

@@ -251,7 +251,8 @@ def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay
 
 def test_the_topics_page_lists_every_topic_as_the_code_writes_it():
     page = (Path(__file__).resolve().parents[1] / "docs" / "robot.md").read_text()
-    rows = [line for line in page.splitlines() if line.startswith("| `/")]
+    section = page.split("## Topics and frames")[1].split("\n## ")[0]
+    rows = [line for line in section.splitlines() if line.startswith("| `/")]
     assert rows == [f"| `{t}` | `{ty}` | {when} | {what} |" for t, (ty, when, what) in TOPICS.items()]
 
 

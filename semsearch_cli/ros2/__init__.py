@@ -8,6 +8,7 @@ import importlib.util
 from .bag import FORMATS, TOPICS
 from .export import BagRecorder, Exported, export_folder, export_run, recorded_runs
 from .live import Live, LiveRun
+from .loopback import Rosbridge, SimRobot
 from .replay import Replayed, recorded_scenario, replay_bag
 
 
@@ -16,5 +17,5 @@ def available() -> bool:
     return all(importlib.util.find_spec(name) is not None for name in ("rosbags", "roslibpy"))
 
 
-__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "available", "export_folder", "export_run",
+__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run",
            "recorded_runs", "recorded_scenario", "replay_bag"]

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import queue
 import shutil
+import socket
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,10 +43,27 @@ from .robot import (DETECTIONS, GOAL_STATUS, MAP, POSE_TYPES, RESUME, GoalWriter
 
 roslibpy = lazy_module("roslibpy")  # optional: pip install 'semsearch[ros]'
 
-INPUTS = {DETECTIONS: "std_msgs/msg/String", RESUME: "std_msgs/msg/Bool", MAP: "nav_msgs/msg/OccupancyGrid", **POSE_TYPES}
-OUTPUTS = {"/explore/frontiers": "visualization_msgs/msg/MarkerArray", "/semsearch/goal": "geometry_msgs/msg/PoseStamped",
-           "/semsearch/decision": "std_msgs/msg/String"}
-NAVIGATE = ("/navigate_to_pose", "nav2_msgs/action/NavigateToPose")
+# topic -> (type, direction, what): the live bridge's topics (docs/robot.md lists them)
+LIVE_TOPICS = {
+    DETECTIONS: ("std_msgs/msg/String", "in", 'a sign read: JSON {"label", ...}'),
+    RESUME: ("std_msgs/msg/Bool", "in", "False pauses the exploration (the goal under way is cancelled), True resumes it"),
+    MAP: ("nav_msgs/msg/OccupancyGrid", "in", "the SLAM map (a latched map arrives at once)"),
+    "/semsearch/pose": ("geometry_msgs/msg/PoseStamped", "in", "the robot's pose in map; of the three pose topics, the first "
+                        "that speaks is used"),
+    "/amcl_pose": ("geometry_msgs/msg/PoseWithCovarianceStamped", "in", "the pose as AMCL publishes it"),
+    "/pose": ("geometry_msgs/msg/PoseWithCovarianceStamped", "in", "the pose as slam_toolbox publishes it"),
+    "/explore/frontiers": ("visualization_msgs/msg/MarkerArray", "out", "at each decision, the candidates as spheres, the "
+                           "chosen one larger and red"),
+    "/semsearch/goal": ("geometry_msgs/msg/PoseStamped", "out", "at each decision, the target"),
+    "/semsearch/decision": ("std_msgs/msg/String", "out", 'at each decision, JSON {"step", "target_cell", "target"}'),
+    "/navigate_to_pose": ("nav2_msgs/action/NavigateToPose", "action goal", "at each re-plan, the path's end (none with "
+                          "--publish-only)"),
+}
+# subscribed in this order: the detections before the poses (a robot's first frame comes with its pose), the map
+# before the poses (a latched map is in before the first pose)
+INPUTS = {t: ty for t, (ty, way, _) in LIVE_TOPICS.items() if way == "in"}
+OUTPUTS = {t: ty for t, (ty, way, _) in LIVE_TOPICS.items() if way == "out"}
+NAVIGATE = next((t, ty) for t, (ty, way, _) in LIVE_TOPICS.items() if way == "action goal")
 ARRIVED = 0.25  # m: with --publish-only, a goal is reached when the robot's pose comes this close
 SUCCEEDED, ABORTED = 4, 6  # action_msgs/GoalStatus
 ABORTS = 5  # goals the robot gives up on in a row, without moving, before the run is stuck
@@ -126,20 +144,26 @@ class Live:
 
     # -- the connection ---------------------------------------------------------------
     def run(self) -> LiveRun:
+        where = f"no rosbridge answers at {'wss' if self.secure else 'ws'}://{self.host}:{self.port}"
+        try:  # at once when nothing listens there (roslibpy would retry until its timeout)
+            socket.create_connection((self.host, self.port), timeout=10).close()
+        except OSError as exc:
+            raise ScenarioError("<command line>", "--rosbridge", f"{where} ({exc.strerror or type(exc).__name__}): is "
+                                "rosbridge_server running there?") from None
         ros = roslibpy.Ros(self.host, self.port, is_secure=self.secure, transport="asyncio")
         try:
             ros.run(timeout=10)
-        except Exception as exc:  # noqa: BLE001  no robot there: named, never a traceback
+        except Exception as exc:  # noqa: BLE001  something listens, but no rosbridge: named, never a traceback
             ros.close()
-            raise ScenarioError("<command line>", "--rosbridge", f"no rosbridge answers at ws://{self.host}:{self.port} "
-                                f"({type(exc).__name__}): is rosbridge_server running there?") from None
+            raise ScenarioError("<command line>", "--rosbridge", f"{where} ({type(exc).__name__}): is it rosbridge_server's "
+                                "WebSocket?") from None
         self.ros = ros
         self.pubs = {t: roslibpy.Topic(ros, t, kind) for t, kind in OUTPUTS.items()}
         for topic in self.pubs.values():
             topic.advertise()
         self.nav = roslibpy.ActionClient(ros, *NAVIGATE) if not self.publish_only else None
         subs = []
-        for t, kind in INPUTS.items():  # the map before the poses: a latched map comes first
+        for t, kind in INPUTS.items():
             sub = roslibpy.Topic(ros, t, kind)
             sub.subscribe(lambda msg, t=t: self.q.put((t, msg)))
             subs.append(sub)

@@ -59,6 +59,7 @@ class Rosbridge:
         self.actions: dict = {}
         self.cancels: dict = {}  # action name -> handler(goal_id)
         self.handlers: dict = {}  # topic -> handler(msg): the robot's own subscriber to what the clients publish
+        self.on_subscribe: dict = {}  # topic -> handler(): called when a client subscribes to it
         self.received: list = []  # (topic, msg) the clients published, in order
         self.ops: list = []  # every op the clients sent, in order (what the tests look at)
         self.advertised: dict[str, str] = {}
@@ -79,6 +80,10 @@ class Rosbridge:
         self.port = self._server.sockets[0].getsockname()[1]
 
     def stop(self) -> None:
+        """Close the server and its loop (once; again does nothing)."""
+        if not self._thread.is_alive():
+            return
+
         async def close():
             for task in asyncio.all_tasks(self.loop):
                 if task is not asyncio.current_task():
@@ -139,6 +144,8 @@ class Rosbridge:
             self.subs.setdefault(msg["topic"], {}).setdefault(ws, set()).add(msg.get("id"))
             if msg["topic"] in self.latched:
                 self._send(ws, json.dumps({"op": "publish", "topic": msg["topic"], "msg": self.latched[msg["topic"]]}))
+            elif msg["topic"] in self.on_subscribe:
+                self.on_subscribe[msg["topic"]]()
         elif op == "unsubscribe":
             ids = self.subs.get(msg["topic"], {}).get(ws, set())
             ids.discard(msg.get("id"))
@@ -222,11 +229,14 @@ class SimRobot:
         return self.st.distance
 
     def start(self) -> "SimRobot":
-        """The first frame (sensed where the robot stands, published latched), then the ticks."""
+        """Wait for a client: the first frame is sensed where the robot stands when one subscribes
+        to the pose (the detections of that frame reach a client that subscribed to them before,
+        as ros live does), then the ticks run."""
         def begin():
-            self._frame()
-            self._task = self.bridge.loop.create_task(self._ticks())
-        self.bridge.call(begin)
+            if self._task is None:
+                self._frame()
+                self._task = self.bridge.loop.create_task(self._ticks())
+        self.bridge.call(self.bridge.on_subscribe.__setitem__, "/semsearch/pose", begin)
         return self
 
     async def _ticks(self):

@@ -259,7 +259,7 @@ class RobotSession:
         """Take a label read; whether it is the goal's (the search is over)."""
         if label == self.goal:
             self.search.found = True
-        elif self.posed:
+        else:
             self.pending.append(label)
         return self.search.found
 
@@ -267,7 +267,10 @@ class RobotSession:
         """Take the robot's pose (a frame and a step); whether a re-plan is due."""
         st, fr = self.st, self.task.world.frame
         if self.posed:
-            moved = math.hypot(x - st.x, y - st.y)
+            # the straight line from the pose before, to the nanometre: coordinates carry float noise
+            # (14.95 - 14.85 is 0.10000000000000142), which is no travel, and summed unrounded puts
+            # a periodic re-plan a step away from the simulator's, whose odometer adds 0.1
+            moved = round(math.hypot(x - st.x, y - st.y), 9)
             st.distance += moved
             self.since += moved
         st.steps += self.posed  # the first pose is step 0

@@ -1,0 +1,288 @@
+"""`semsearch ros live` against a real rosbridge server on loopback (semsearch_cli/ros2/loopback.py:
+the rosbridge v2 JSON protocol over a WebSocket), whose robot is semsearch's simulator, and the
+robot-message session it shares with `ros replay`."""
+
+import json
+import math
+import re
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+pytest.importorskip("roslibpy", reason="the ros extra (roslibpy) is not installed")
+pytest.importorskip("websockets", reason="the ros extra (websockets) is not installed")
+from rosbags.rosbag2 import Reader  # noqa: E402
+from websockets.sync.client import connect  # noqa: E402
+
+from semsearch_cli import api  # noqa: E402
+from semsearch_cli.cli import app  # noqa: E402
+from semsearch_cli.ros2 import replay_bag  # noqa: E402
+from semsearch_cli.ros2.bag import Messages, from_json, to_json  # noqa: E402
+from semsearch_cli.ros2.live import LIVE_TOPICS  # noqa: E402
+from semsearch_cli.ros2.loopback import Rosbridge, SimRobot  # noqa: E402
+from semsearch_cli.ros2.robot import GOAL_STATUS, RobotSession, RobotTask, fold_map, goal_ended, map_frame  # noqa: E402
+from semsearch_cli.planners import Variant  # noqa: E402
+
+PERIOD = 0.04  # s between the stand-in robot's steps: ros live answers a step within it (see docs/robot.md)
+
+
+@pytest.fixture
+def robot(demo_loaded):
+    """A rosbridge server on 127.0.0.1 (a free port) and a stand-in robot factory behind it."""
+    bridge = Rosbridge().start()
+    made = []
+
+    def make(goal, seed=0, **kw):
+        made.append(SimRobot(bridge, demo_loaded, goal, seed, period=PERIOD, **kw).start())
+        return made[-1]
+
+    yield bridge, make
+    bridge.stop()
+
+
+def live(bridge, planner, goal, tmp_path, **kw):
+    kw.setdefault("silence", 20.0)
+    return api.ros_live(bridge.url, planner, goal, repro=tmp_path / "repro", **kw)
+
+
+@pytest.mark.parametrize("planner,goal", [("greedy", "304"), ("nsos", "452")])
+def test_live_finds_the_goal_and_travels_what_run_travels(robot, demo_loaded, tmp_path, planner, goal):
+    """Over the loopback rosbridge, with the simulator as the robot (Nav2's NavigateToPose goals
+    driven as `semsearch run` drives its paths), ros live finds the goal and the robot travels
+    what the run of the same episode and seed travels, within 5% (measured: greedy 304 the same
+    22.10 m, nsos 452 26.30 m against 27.40 m; the periodic re-plan counts metres from the poses,
+    the simulator from its odometer, so one may come a step apart; docs/robot.md)."""
+    bridge, make = robot
+    run = demo_loaded.task.run(Variant(planner, ()), goal, 0)
+    bot = make(goal)
+    res = live(bridge, planner, goal, tmp_path)
+    assert res.outcome == "found" and run.outcome == "found"
+    assert res.repro is None and not (tmp_path / "repro").exists() and not list(tmp_path.glob(".repro*"))
+    assert bot.found_at == pytest.approx(run.distance_m, rel=0.05)
+    assert len(res.decisions) == pytest.approx(run.decisions, rel=0.2)
+    # every goal went to Nav2's action, stamped with the pose it was planned on; none was ignored
+    sent = [op for op in bridge.ops if op["op"] == "send_action_goal"]
+    assert len(sent) == res.goals == len(bot.goals) > 0
+    assert {(op["action"], op["action_type"]) for op in sent} == {("/navigate_to_pose", "nav2_msgs/action/NavigateToPose")}
+    assert all(op["args"]["pose"]["header"]["frame_id"] == "map" for op in sent)
+    # explore_lite's frontiers, the goal and the decision, as advertised, at each decision
+    advertised = {op["topic"]: op["type"] for op in bridge.ops if op["op"] == "advertise"}
+    assert advertised == {"/explore/frontiers": "visualization_msgs/msg/MarkerArray", "/semsearch/goal": "geometry_msgs/msg/PoseStamped",
+                          "/semsearch/decision": "std_msgs/msg/String"}
+    assert not bridge.advertised  # unadvertised at the end
+    published = [t for t, _ in bridge.received]
+    assert published.count("/explore/frontiers") == published.count("/semsearch/goal") == len(res.decisions)
+    fronts = next(m for t, m in bridge.received if t == "/explore/frontiers")
+    assert fronts["markers"][0]["action"] == 3 and {m["ns"] for m in fronts["markers"]} == {"frontiers"}  # DELETEALL first
+    decision = json.loads(next(m for t, m in bridge.received if t == "/semsearch/decision")["data"])
+    assert decision == res.decisions[0]
+
+
+def free_port() -> int:
+    with socket.socket() as sock:  # a port nobody listens on once it is closed
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def test_the_command_line_finds_the_goal_and_a_failing_run_leaves_a_repro_bag_that_replays(demo_dir, demo_loaded, tmp_path):
+    """`semsearch ros sim` (another process) is the robot; `semsearch ros live` exits 0 when
+    found. A run stopped by its budget exits 1 and leaves a repro bag (map, pose, detections, goal
+    ends) of a few kilobytes, which `ros replay` runs to the live run's decisions."""
+    port = free_port()
+    sim = subprocess.Popen([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "ros", "sim",
+                            str(demo_dir / "scenario.yaml"), "--goal", "304", "--port", str(port), "--period", str(PERIOD)],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first = sim.stdout.readline()
+        assert first.startswith(f"rosbridge on ws://127.0.0.1:{port}: the robot of "), sim.stderr.read() if not first else first
+        r = CliRunner().invoke(app, ["ros", "live", "--rosbridge", f"ws://127.0.0.1:{port}", "--planner", "greedy", "--goal",
+                                     "304", "--repro", str(tmp_path / "ok")])
+    finally:
+        sim.send_signal(signal.SIGINT)
+        rest, _ = sim.communicate(timeout=30)
+    assert r.exit_code == 0, r.output
+    assert "found: read the goal's sign; " in r.output and "repro" not in r.output and not (tmp_path / "ok").exists()
+    run = demo_loaded.task.run(Variant("greedy", ()), "304", 0)
+    said = " ".join(rest.split())
+    found_at = float(re.search(r"read the sign 304 after ([0-9.]+) m", said).group(1))
+    assert found_at == pytest.approx(run.distance_m, rel=0.05) and said.endswith(" goals") and sim.returncode == 0
+
+    bridge = Rosbridge().start()
+    try:
+        SimRobot(bridge, demo_loaded, "452", 0, period=PERIOD).start()
+        r = CliRunner().invoke(app, ["ros", "live", "--rosbridge", bridge.url, "--planner", "greedy", "--goal", "452",
+                                     "--max-distance", "15", "--repro", str(tmp_path / "repro")])
+    finally:
+        bridge.stop()
+    assert r.exit_code == 1, r.output
+    out = " ".join(r.output.split())
+    assert "budget: travelled 15." in out and f"repro bag: {tmp_path / 'repro'}" in out
+    bag = tmp_path / "repro"
+    size = sum(p.stat().st_size for p in bag.rglob("*") if p.is_file())
+    assert size < 200_000
+    with Reader(bag) as rd:
+        topics = {c.topic: c.msgtype for c in rd.connections}
+        stamps = [t for _, t, _ in rd.messages()]
+    took = {"/map": "nav_msgs/msg/OccupancyGrid", "/semsearch/pose": "geometry_msgs/msg/PoseStamped",
+            "/semsearch/detections": "std_msgs/msg/String"}
+    assert took.items() <= topics.items() <= {**took, GOAL_STATUS: "action_msgs/msg/GoalStatusArray"}.items()
+    assert stamps == sorted(set(stamps))
+    decided = int(re.search(r"poses, (\d+) decisions", out).group(1))
+    rep = replay_bag(None, bag, Variant("greedy", ()), tmp_path / "replayed", "mcap", "452")
+    assert len(rep.decisions) == decided > 0
+    r2 = CliRunner().invoke(app, ["ros", "replay", str(bag), "--planner", "greedy", "--goal", "452", "--out",
+                                  str(tmp_path / "replayed2")])
+    assert r2.exit_code == 0, r2.output
+
+
+def test_live_decisions_are_the_repro_bags_decisions(robot, tmp_path):
+    bridge, make = robot
+    make("452")
+    res = live(bridge, "nsos", "452", tmp_path, max_distance=12.0)
+    assert res.outcome == "budget" and res.repro == tmp_path / "repro"
+    rep = replay_bag(None, res.repro, Variant("nsos", ()), tmp_path / "replayed", "mcap", "452")
+    assert rep.decisions == res.decisions and len(res.decisions) > 3
+
+
+def test_publish_only_drives_nothing_and_the_robots_own_stack_follows_its_goals(robot, demo_loaded, tmp_path):
+    """--publish-only sends no action goal: the goal goes out as a PoseStamped on
+    /semsearch/goal, which the robot's own navigation (here the stand-in's, following that topic)
+    drives to; a goal counts as reached when the pose comes within 0.25 m of it."""
+    bridge, make = robot
+    bot = make("304", follow="/semsearch/goal")
+    res = live(bridge, "greedy", "304", tmp_path, publish_only=True)
+    assert res.outcome == "found"
+    assert not [op for op in bridge.ops if op["op"] in ("send_action_goal", "cancel_action_goal")]
+    goals = [m for t, m in bridge.received if t == "/semsearch/goal"]
+    assert len(goals) == len(bot.goals) == len(res.decisions) > 3
+    run = demo_loaded.task.run(Variant("greedy", ()), "304", 0)
+    assert bot.found_at == pytest.approx(run.distance_m, rel=0.25)
+
+
+def test_explore_resume_pauses_and_resumes(robot, tmp_path):
+    """/explore/resume False cancels the goal under way and stops the re-plans (the robot stands
+    still); True re-plans at once and the search goes on to the goal."""
+    bridge, make = robot
+    bot = make("304")
+    box = {}
+    worker = threading.Thread(target=lambda: box.update(res=live(bridge, "greedy", "304", tmp_path)))
+    worker.start()
+    deadline = time.monotonic() + 30
+    while bot.st.steps < 40 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    bridge.call(bot.resume, False)
+    time.sleep(0.5)
+    steps, goals = bot.st.steps, len(bot.goals)
+    time.sleep(0.5)
+    assert (bot.st.steps, len(bot.goals)) == (steps, goals)  # standing, no new goal
+    assert any(op["op"] == "cancel_action_goal" for op in bridge.ops)
+    assert bot.ended[-1][1] == 5  # CANCELED
+    bridge.call(bot.resume, True)
+    worker.join(60)
+    assert box["res"].outcome == "found" and len(bot.goals) > goals
+
+
+def test_a_bad_address_no_server_and_an_existing_repro_folder_exit_2(tmp_path):
+    runner = CliRunner()
+    base = ["ros", "live", "--planner", "greedy", "--goal", "304", "--repro", str(tmp_path / "r")]
+    r = runner.invoke(app, base + ["--rosbridge", "http://localhost:9090"])
+    assert r.exit_code == 2 and "is not a WebSocket address: give ws://HOST:PORT" in " ".join(r.output.split())
+    port = free_port()
+    r = runner.invoke(app, base + ["--rosbridge", f"ws://127.0.0.1:{port}"])
+    assert r.exit_code == 2 and "no rosbridge answers at" in " ".join(r.output.split())
+    (tmp_path / "r").mkdir()
+    r = runner.invoke(app, base + ["--rosbridge", f"ws://127.0.0.1:{port}"])
+    assert r.exit_code == 2 and "exists already" in r.output
+    r = runner.invoke(app, ["ros", "live", "--planner", "nsoss", "--goal", "304", "--rosbridge", f"ws://127.0.0.1:{port}"])
+    assert r.exit_code == 2 and "'nsos'" in r.output, r.output
+
+
+def test_the_loopback_server_speaks_rosbridge_v2(robot, demo_loaded):
+    """Subscribe (a latched topic's last message at once), publish to another client, unsubscribe,
+    an action goal answered by its result, and a status error for an op it does not serve."""
+    bridge, make = robot
+    bot = make("304")
+    with connect(bridge.url) as a, connect(bridge.url) as b:
+        b.send(json.dumps({"op": "subscribe", "id": "s0", "topic": "/semsearch/pose", "type": "geometry_msgs/msg/PoseStamped"}))
+        assert json.loads(b.recv(timeout=5))["msg"]["pose"]["position"]["x"] == bot.st.x  # the robot's first frame
+        a.send(json.dumps({"op": "subscribe", "id": "s1", "topic": "/map", "type": "nav_msgs/msg/OccupancyGrid"}))
+        first = json.loads(a.recv(timeout=5))  # latched
+        assert first["op"] == "publish" and first["topic"] == "/map"
+        grid = first["msg"]
+        assert (grid["info"]["width"], grid["info"]["height"]) == (demo_loaded.world.frame.width, demo_loaded.world.frame.height)
+        assert set(grid["data"]) <= {-1, 0, 100} and 0 in grid["data"]
+        a.send(json.dumps({"op": "unsubscribe", "id": "s1", "topic": "/map"}))
+        b.send(json.dumps({"op": "subscribe", "id": "s2", "topic": "/chatter", "type": "std_msgs/msg/String"}))
+        time.sleep(0.1)
+        a.send(json.dumps({"op": "advertise", "id": "p1", "topic": "/chatter", "type": "std_msgs/msg/String"}))
+        a.send(json.dumps({"op": "publish", "topic": "/chatter", "msg": {"data": "hello"}}))
+        assert json.loads(b.recv(timeout=5)) == {"op": "publish", "topic": "/chatter", "msg": {"data": "hello"}}
+        a.send(json.dumps({"op": "call_service", "id": "c1", "service": "/rosapi/topics", "args": {}}))
+        err = json.loads(a.recv(timeout=5))
+        assert err["op"] == "status" and err["level"] == "error" and "call_service" in err["msg"]
+        a.send(json.dumps({"op": "send_action_goal", "id": "g1", "action": "/navigate_to_pose",
+                           "action_type": "nav2_msgs/action/NavigateToPose", "feedback": True,
+                           "args": {"pose": {"header": {"frame_id": "map"},
+                                             "pose": {"position": {"x": bot.st.x, "y": bot.st.y}}}}}))
+        end = json.loads(a.recv(timeout=5))  # the goal is where the robot stands: reached at once
+        assert (end["op"], end["id"], end["status"], end["result"]) == ("action_result", "g1", 4, True)
+
+
+def test_json_messages_round_trip_and_maps_fold_into_a_grid_with_a_margin():
+    m = Messages()
+    frame0 = type("F", (), {"res": 0.1, "origin_x": -1.0, "origin_y": 2.0, "height": 3, "width": 4})()
+    states = np.array([[-1, 0, 100, 0], [0, 0, 0, 0], [100, 100, -1, -1]], np.int8)
+    grid = m.grid(7, states, frame0)
+    back = from_json(m.ts, "nav_msgs/msg/OccupancyGrid", json.loads(json.dumps(to_json(grid))))
+    assert m.serialize(back) == m.serialize(grid)
+    frame = map_frame(grid, margin=0.25)  # 3 whole cells around it
+    assert (frame.height, frame.width, frame.origin_x, frame.origin_y) == (9, 10, pytest.approx(-1.3), pytest.approx(1.7))
+    task = RobotTask(frame)
+    b = task.new_belief()
+    assert fold_map(b, grid) is False
+    assert b.seen[3:6, 3:7].tolist() == (states >= 0).tolist() and b.free[3:6, 3:7].tolist() == (states == 0).tolist()
+    assert not b.seen[:3].any() and not b.seen[6:].any()
+    # a map that outgrew the grid: the cells beyond it are left out, and said to be
+    small = RobotTask(map_frame(grid)).new_belief()
+    grid.info.origin.position.x = -1.2
+    assert fold_map(small, grid) is True
+    assert small.seen[:, :2].tolist() == (states[:, 2:] >= 0).tolist() and not small.seen[:, 2:].any()  # 2 cells to the left
+
+
+def test_a_session_takes_goal_ends_once_and_resume_replans_at_once():
+    m = Messages()
+    frame0 = type("F", (), {"res": 0.1, "origin_x": 0.0, "origin_y": 0.0, "height": 20, "width": 20})()
+    states = np.zeros((20, 20), np.int8)
+    states[0], states[-1], states[:, 0], states[:, -1] = 100, 100, 100, 100
+    grid = m.grid(0, states, frame0)
+    s = RobotSession(RobotTask(map_frame(grid)), Variant("greedy", ()).build(), "7")
+    assert s.take("/semsearch/pose", m.pose_stamped(0, 1.0, 1.0, 0.0)) is None  # no map yet
+    assert s.take("/map", grid) is None
+    assert s.take("/semsearch/pose", m.pose_stamped(0, 1.05, 1.0, 0.0)) == "plan"  # the first pose with a map
+    s.plan()
+    assert s.take("/semsearch/pose", m.pose_stamped(0, 1.1, 1.0, 0.0)) is None
+    assert s.take(GOAL_STATUS, goal_ended(m, 1, 4)) == "plan"  # goal 1 reached
+    s.plan()
+    assert s.take(GOAL_STATUS, goal_ended(m, 1, 4)) is None  # the same end again: taken once
+    assert s.take(GOAL_STATUS, goal_ended(m, 2, 5)) is None  # cancelled: not a path done
+    assert s.take("/explore/resume", m.T["std_msgs/msg/Bool"](data=False)) is None
+    assert s.take(GOAL_STATUS, goal_ended(m, 3, 6)) is None  # paused: no re-plan
+    assert s.take("/explore/resume", m.T["std_msgs/msg/Bool"](data=True)) == "plan"
+    assert s.take("/semsearch/detections", m.string({"label": 8})) is None
+    assert s.take("/semsearch/detections", m.string({"label": "7"})) == "found"
+    assert math.isclose(s.st.distance, 0.1)
+
+
+def test_the_live_topics_table_is_the_codes():
+    page = (Path(__file__).resolve().parents[1] / "docs" / "robot.md").read_text()
+    section = page.split("## Live on a robot")[1].split("\n## ")[0].split("\n### ")[0]
+    rows = [line for line in section.splitlines() if line.startswith("| `/")]
+    assert rows == [f"| `{t}` | `{ty}` | {way} | {what} |" for t, (ty, way, what) in LIVE_TOPICS.items()]
