@@ -25,9 +25,9 @@ from output import emit
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-from semsearch_cli.api import _door_variant  # noqa: E402
 from semsearch_cli.report.document import markdown_table  # noqa: E402
 from semsearch_cli.ros2.live import Live  # noqa: E402
+from semsearch_cli.planners import Variant  # noqa: E402
 from semsearch_cli.ros2.loopback import Rosbridge, SimRobot  # noqa: E402
 from semsearch_cli.runner import Loaded  # noqa: E402
 from semsearch_cli.tasks.base import Observer  # noqa: E402
@@ -44,7 +44,7 @@ class Decisions(Observer):
 
 
 def one(loaded, planner: str, goal: str, seed: int, period: float, tmp: Path) -> dict:
-    variant = _door_variant(planner, None)
+    variant = Variant(planner, ())
     seen = Decisions()
     res = loaded.task.run(variant, goal, seed, observer=seen)
     bridge = Rosbridge().start()

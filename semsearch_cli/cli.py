@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import shlex
 import signal
 import sys
 import time
@@ -479,8 +480,9 @@ def ros_live(
               f"{res.goals} goals sent")
     if res.repro is not None:
         size = sum(p.stat().st_size for p in res.repro.rglob("*") if p.is_file())
-        out.print(f"repro bag: {res.repro} ({size / 1e6:.2f} MB; semsearch ros replay {res.repro} --goal {goal} --planner "
-                  f"{planner} --out DIR)")
+        again = f" --margin {margin:g}" + (f" --scenario {shlex.quote(str(scenario))}" if scenario is not None else "")
+        out.print(f"repro bag: {res.repro} ({size / 1e6:.2f} MB; semsearch ros replay {shlex.quote(str(res.repro))} --goal "
+                  f"{shlex.quote(goal)} --planner {shlex.quote(planner)}{again} --out DIR)")
     raise typer.Exit(0 if res.outcome == "found" else 1)
 
 

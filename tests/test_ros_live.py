@@ -5,6 +5,7 @@ robot-message session it shares with `ros replay`."""
 import json
 import math
 import re
+import select
 import signal
 import socket
 import subprocess
@@ -28,8 +29,10 @@ from semsearch_cli.ros2 import replay_bag  # noqa: E402
 from semsearch_cli.ros2.bag import Messages, from_json, to_json  # noqa: E402
 from semsearch_cli.ros2.live import LIVE_TOPICS  # noqa: E402
 from semsearch_cli.ros2.loopback import Rosbridge, SimRobot  # noqa: E402
-from semsearch_cli.ros2.robot import GOAL_STATUS, RobotSession, RobotTask, fold_map, goal_ended, map_frame  # noqa: E402
+from semsearch_cli.ros2.robot import GOAL_STATUS, RobotSession, RobotTask, fold_map, goal_ended, map_frame, pose_of  # noqa: E402
 from semsearch_cli.planners import Variant  # noqa: E402
+from semsearch_cli.tasks.base import Observer  # noqa: E402
+from semsearch_cli.tasks.doors import DoorDecision  # noqa: E402
 
 PERIOD = 0.04  # s between the stand-in robot's steps: ros live answers a step within it (see docs/robot.md)
 
@@ -53,21 +56,34 @@ def live(bridge, planner, goal, tmp_path, **kw):
     return api.ros_live(bridge.url, planner, goal, repro=tmp_path / "repro", **kw)
 
 
+class Decisions(Observer):
+    def __init__(self):
+        self.rows = []
+
+    def see(self, event):
+        if isinstance(event, DoorDecision):
+            self.rows.append({"step": int(event.step), "target": [round(float(v), 6) for v in event.target_xy]})
+
+
 @pytest.mark.parametrize("planner,goal", [("greedy", "304"), ("nsos", "452")])
 def test_live_finds_the_goal_and_travels_what_run_travels(robot, demo_loaded, tmp_path, planner, goal):
     """Over the loopback rosbridge, with the simulator as the robot (Nav2's NavigateToPose goals
-    driven as `semsearch run` drives its paths), ros live finds the goal and the robot travels
-    what the run of the same episode and seed travels, within 5% (measured: greedy 304 the same
-    22.10 m, nsos 452 26.30 m against 27.40 m; the periodic re-plan counts metres from the poses,
-    the simulator from its odometer, so one may come a step apart; docs/robot.md)."""
+    driven as `semsearch run` drives its paths), ros live finds the goal. When every goal reached
+    the robot before its next step, it makes the run's decisions, step and target, and the robot
+    travels the run's distance; a late goal (a slow machine) may part them, and then the distance
+    is within 5% (benchmarks/ros_live.py measures both; docs/robot.md)."""
     bridge, make = robot
-    run = demo_loaded.task.run(Variant(planner, ()), goal, 0)
+    seen = Decisions()
+    run = demo_loaded.task.run(Variant(planner, ()), goal, 0, observer=seen)
     bot = make(goal)
     res = live(bridge, planner, goal, tmp_path)
     assert res.outcome == "found" and run.outcome == "found"
     assert res.repro is None and not (tmp_path / "repro").exists() and not list(tmp_path.glob(".repro*"))
-    assert bot.found_at == pytest.approx(run.distance_m, rel=0.05)
-    assert len(res.decisions) == pytest.approx(run.decisions, rel=0.2)
+    got = [{"step": r["step"], "target": [round(v, 6) for v in r["target"]]} for r in res.decisions]
+    if max(bot.late) == 0:
+        assert got == seen.rows and bot.found_at == pytest.approx(run.distance_m, abs=1e-9)
+    else:
+        assert bot.found_at == pytest.approx(run.distance_m, rel=0.05)
     # every goal went to Nav2's action, stamped with the pose it was planned on; none was ignored
     sent = [op for op in bridge.ops if op["op"] == "send_action_goal"]
     assert len(sent) == res.goals == len(bot.goals) > 0
@@ -77,6 +93,9 @@ def test_live_finds_the_goal_and_travels_what_run_travels(robot, demo_loaded, tm
     advertised = {op["topic"]: op["type"] for op in bridge.ops if op["op"] == "advertise"}
     assert advertised == {"/explore/frontiers": "visualization_msgs/msg/MarkerArray", "/semsearch/goal": "geometry_msgs/msg/PoseStamped",
                           "/semsearch/decision": "std_msgs/msg/String"}
+    deadline = time.monotonic() + 5
+    while bridge.advertised and time.monotonic() < deadline:
+        time.sleep(0.02)
     assert not bridge.advertised  # unadvertised at the end
     published = [t for t, _ in bridge.received]
     assert published.count("/explore/frontiers") == published.count("/semsearch/goal") == len(res.decisions)
@@ -101,6 +120,7 @@ def test_the_command_line_finds_the_goal_and_a_failing_run_leaves_a_repro_bag_th
                             str(demo_dir / "scenario.yaml"), "--goal", "304", "--port", str(port), "--period", str(PERIOD)],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
+        assert select.select([sim.stdout], [], [], 60)[0], "ros sim said nothing in 60 s"
         first = sim.stdout.readline()
         assert first.startswith(f"rosbridge on ws://127.0.0.1:{port}: the robot of "), sim.stderr.read() if not first else first
         r = CliRunner().invoke(app, ["ros", "live", "--rosbridge", f"ws://127.0.0.1:{port}", "--planner", "greedy", "--goal",
@@ -155,7 +175,7 @@ def test_live_decisions_are_the_repro_bags_decisions(robot, tmp_path):
 def test_publish_only_drives_nothing_and_the_robots_own_stack_follows_its_goals(robot, demo_loaded, tmp_path):
     """--publish-only sends no action goal: the goal goes out as a PoseStamped on
     /semsearch/goal, which the robot's own navigation (here the stand-in's, following that topic)
-    drives to; a goal counts as reached when the pose comes within 0.25 m of it."""
+    drives to; a goal counts as reached when the pose comes within 0.5 m of it."""
     bridge, make = robot
     bot = make("304", follow="/semsearch/goal")
     res = live(bridge, "greedy", "304", tmp_path, publish_only=True)
@@ -183,11 +203,11 @@ def test_explore_resume_pauses_and_resumes(robot, tmp_path):
     steps, goals = bot.st.steps, len(bot.goals)
     time.sleep(0.5)
     assert (bot.st.steps, len(bot.goals)) == (steps, goals)  # standing, no new goal
-    assert any(op["op"] == "cancel_action_goal" for op in bridge.ops)
-    assert bot.ended[-1][1] == 5  # CANCELED
+    # the goal under way was cancelled (unless it had just been reached as the pause came)
+    assert bot.ended[-1][1] == 5 and any(op["op"] == "cancel_action_goal" for op in bridge.ops) or bot.ended[-1][1] == 4
     bridge.call(bot.resume, True)
     worker.join(60)
-    assert box["res"].outcome == "found" and len(bot.goals) > goals
+    assert not worker.is_alive() and box["res"].outcome == "found" and len(bot.goals) > goals
 
 
 def test_a_bad_address_no_server_and_an_existing_repro_folder_exit_2(tmp_path):
@@ -273,6 +293,9 @@ def test_a_session_takes_goal_ends_once_and_resume_replans_at_once():
     s.plan()
     assert s.take(GOAL_STATUS, goal_ended(m, 1, 4)) is None  # the same end again: taken once
     assert s.take(GOAL_STATUS, goal_ended(m, 2, 5)) is None  # cancelled: not a path done
+    replaced = goal_ended(m, 4, 6)  # Nav2 aborts goal 4 as goal 5 replaces it: the newest, 5, is under way
+    replaced.status_list.append(goal_ended(m, 5, 2).status_list[0])
+    assert s.take(GOAL_STATUS, replaced) is None
     assert s.take("/explore/resume", m.T["std_msgs/msg/Bool"](data=False)) is None
     assert s.take(GOAL_STATUS, goal_ended(m, 3, 6)) is None  # paused: no re-plan
     assert s.take("/explore/resume", m.T["std_msgs/msg/Bool"](data=True)) == "plan"
@@ -286,3 +309,30 @@ def test_the_live_topics_table_is_the_codes():
     section = page.split("## Live on a robot")[1].split("\n## ")[0].split("\n### ")[0]
     rows = [line for line in section.splitlines() if line.startswith("| `/")]
     assert rows == [f"| `{t}` | `{ty}` | {way} | {what} |" for t, (ty, way, what) in LIVE_TOPICS.items()]
+
+
+def test_a_silent_robot_is_lost_and_its_repro_bag_kept(tmp_path):
+    """A rosbridge with no robot behind it: after --silence seconds without a message the run
+    ends as lost, exit status 1, and leaves its (empty) repro bag."""
+    bridge = Rosbridge().start()
+    try:
+        r = CliRunner().invoke(app, ["ros", "live", "--rosbridge", bridge.url, "--planner", "greedy", "--goal", "304",
+                                     "--silence", "1", "--repro", str(tmp_path / "repro")])
+    finally:
+        bridge.stop()
+    assert r.exit_code == 1 and "lost: no message from the robot for 1 s; 0.0 m over 0 poses" in " ".join(r.output.split())
+    with Reader(tmp_path / "repro") as rd:
+        assert rd.message_count == 0
+    assert not list(tmp_path.glob(".repro*"))
+
+
+def test_an_axis_heading_comes_back_from_its_quaternion_to_the_bit():
+    """A grid path's headings (multiples of 45 degrees, as atan2 gives them) survive the pose's
+    quaternion exactly, so that nsos's heading bins (edges on +-90 degrees) see what the simulator
+    saw; other headings come back within 1e-15 rad."""
+    m = Messages()
+    for dx, dy in [(0.1, 0.0), (0.1, 0.1), (0.0, 0.1), (-0.1, 0.1), (-0.1, 0.0), (-0.1, -0.1), (0.0, -0.1), (0.1, -0.1)]:
+        yaw = math.atan2(dy, dx)
+        assert pose_of(m.pose_stamped(0, 1.0, 2.0, yaw)) == (1.0, 2.0, yaw)
+    for yaw in (0.3, -2.0, 1.5707963):
+        assert pose_of(m.pose_stamped(0, 1.0, 2.0, yaw))[2] == pytest.approx(yaw, abs=1e-15)

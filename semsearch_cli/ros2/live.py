@@ -26,6 +26,7 @@ replays to the same re-plans.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import queue
 import shutil
@@ -38,8 +39,8 @@ from urllib.parse import urlparse
 from ..errors import ScenarioError
 from ..optional import lazy_module
 from .bag import BagWriter, Messages, drop_bag, from_json, to_json
-from .robot import (DETECTIONS, GOAL_STATUS, MAP, POSE_TYPES, RESUME, GoalWriter, RobotSession, RobotTask, goal_ended,
-                    map_frame)
+from .robot import (ABORTED, DETECTIONS, GOAL_STATUS, MAP, NAVIGATE_ACTION, POSE_TYPES, RESUME, SUCCEEDED, GoalWriter,
+                    RobotSession, RobotTask, goal_ended, map_frame)
 
 roslibpy = lazy_module("roslibpy")  # optional: pip install 'semsearch[ros]'
 
@@ -56,16 +57,14 @@ LIVE_TOPICS = {
                            "chosen one larger and red"),
     "/semsearch/goal": ("geometry_msgs/msg/PoseStamped", "out", "at each decision, the target"),
     "/semsearch/decision": ("std_msgs/msg/String", "out", 'at each decision, JSON {"step", "target_cell", "target"}'),
-    "/navigate_to_pose": ("nav2_msgs/action/NavigateToPose", "action goal", "at each re-plan, the path's end (none with "
+    NAVIGATE_ACTION[0]: (NAVIGATE_ACTION[1], "action goal", "at each re-plan, the path's end (none with "
                           "--publish-only)"),
 }
 # subscribed in this order: the detections before the poses (a robot's first frame comes with its pose), the map
 # before the poses (a latched map is in before the first pose)
 INPUTS = {t: ty for t, (ty, way, _) in LIVE_TOPICS.items() if way == "in"}
 OUTPUTS = {t: ty for t, (ty, way, _) in LIVE_TOPICS.items() if way == "out"}
-NAVIGATE = next((t, ty) for t, (ty, way, _) in LIVE_TOPICS.items() if way == "action goal")
-ARRIVED = 0.25  # m: with --publish-only, a goal is reached when the robot's pose comes this close
-SUCCEEDED, ABORTED = 4, 6  # action_msgs/GoalStatus
+ARRIVED = 0.5  # m: with --publish-only, a goal is reached when the pose comes this close (twice Nav2's default 0.25 m)
 ABORTS = 5  # goals the robot gives up on in a row, without moving, before the run is stuck
 
 
@@ -139,6 +138,7 @@ class Live:
         self.current: int | None = None
         self.target: tuple[float, float] | None = None
         self._goal_ids: dict[int, str] = {}  # goal number -> roslibpy's goal id
+        self.sent_at = 0.0  # when the goal under way was sent (time.monotonic)
         self.aborts = 0
         self.clipped = False
 
@@ -157,63 +157,94 @@ class Live:
             ros.close()
             raise ScenarioError("<command line>", "--rosbridge", f"{where} ({type(exc).__name__}): is it rosbridge_server's "
                                 "WebSocket?") from None
-        self.ros = ros
         self.pubs = {t: roslibpy.Topic(ros, t, kind) for t, kind in OUTPUTS.items()}
         for topic in self.pubs.values():
             topic.advertise()
-        self.nav = roslibpy.ActionClient(ros, *NAVIGATE) if not self.publish_only else None
+        self.nav = roslibpy.ActionClient(ros, *NAVIGATE_ACTION) if not self.publish_only else None
         subs = []
         for t, kind in INPUTS.items():
             sub = roslibpy.Topic(ros, t, kind)
             sub.subscribe(lambda msg, t=t: self.q.put((t, msg)))
             subs.append(sub)
+        ros.on("close", lambda *_: self.q.put(("closed", None)))
         self.repro = _Repro(self.repro_path, self.m)
         res = None
         try:
             res = self._loop()
         except KeyboardInterrupt:
             res = self._result("interrupted", "stopped by Ctrl-C")
-        finally:
-            if self.current is not None and self.nav is not None and res is not None:
-                self._cancel()
-            for sub in subs:
-                sub.unsubscribe()
-            for topic in self.pubs.values():
-                topic.unadvertise()
+        finally:  # each step alone: one that fails leaves the others done
+            with contextlib.suppress(Exception):
+                if self.current is not None:
+                    self._cancel()  # the robot stops (rosbridge does not cancel a goal when its client goes)
+            for topic in [*subs, *self.pubs.values()]:
+                with contextlib.suppress(Exception):
+                    topic.unsubscribe() if topic in subs else topic.unadvertise()
             time.sleep(0.05)  # the last messages out before the socket closes
-            ros.close()
-            if res is None or res.outcome == "found":
+            with contextlib.suppress(Exception):
+                ros.close()
+            if res is not None and res.outcome == "found":
                 self.repro.drop()
-        if res.outcome != "found":
-            res.repro = self.repro.keep()
+            else:  # a failed run's, or what a run that raised had taken: kept
+                kept = self.repro.keep()
+                if res is None:
+                    self.log(f"stopped: the messages taken so far are in {kept}")
+                else:
+                    res.repro = kept
         return res
 
     def _publish(self, topic: str, t_ns: int, msg) -> None:
         self.pubs[topic].publish(roslibpy.Message(to_json(msg)))
 
     def _cancel(self) -> None:
-        self.nav.cancel_goal(self._goal_ids[self.current])
-        self.current = None
+        gid, self.current = self._goal_ids.get(self.current), None
+        if gid is not None and self.nav is not None:
+            self.nav.cancel_goal(gid)
 
     # -- the loop -----------------------------------------------------------------------
     def _loop(self) -> LiveRun:
+        heard = moved = time.monotonic()  # the last message; the last time the robot's pose changed
+        where = None
         while True:
             try:
-                topic, payload = self.q.get(timeout=self.silence)
+                topic, payload = self.q.get(timeout=1.0)
             except queue.Empty:
+                topic = payload = None
+            now = time.monotonic()
+            if topic is not None:
+                heard = now if topic != "result" else heard
+                end = self._take(topic, payload)
+                if end is not None:
+                    return end
+                s = self.session
+                if s is not None and (s.st.x, s.st.y) != where:
+                    where, moved = (s.st.x, s.st.y), now
+            if now - heard >= self.silence:
                 return self._result("lost", f"no message from the robot for {self.silence:g} s")
-            end = self._take(topic, payload)
-            if end is not None:
-                return end
+            if self.current is not None and now - max(moved, self.sent_at) >= self.silence:
+                # a goal nobody answers (rejected, or lost with a connection) and the robot standing
+                self.log(f"goal {self.current}: no answer and no move for {self.silence:g} s; taken as given up")
+                moved = now
+                end = self._take("result", (self.current, ABORTED))
+                if end is not None:
+                    return end
 
     def _take(self, topic: str, payload) -> LiveRun | None:
         """One message (or the end of the goal under way, ``result``); the run's result when it
         ends the run. What the session takes goes into the repro bag first, in this order."""
+        if topic == "closed":
+            self.log("the connection to rosbridge closed; roslibpy reconnects (the goal under way is given up)")
+            if self.current is None:
+                return None
+            topic, payload = "result", (self.current, ABORTED)
         if topic == "result":
             k, status = payload
             if k != self.current:
                 return None  # a goal replaced or cancelled since
             self.current = None
+            # the goal under way ended: reached, or not (aborted; cancelled by someone else; a goal
+            # rosbridge failed to send, status 0), which is the robot giving up on it
+            status = SUCCEEDED if status == SUCCEEDED else ABORTED
             self.aborts = self.aborts + 1 if status == ABORTED else 0
             if self.aborts >= ABORTS:
                 return self._result("stuck", f"the robot gave up on {ABORTS} goals in a row")
@@ -246,13 +277,13 @@ class Live:
                      "around it)")
             for t, m in self.early:
                 if s.take(t, m) == "found":
-                    return self._result("found", "read the goal's sign")
+                    return self._found()
         what = s.take(topic, msg)
         if s.clipped and not self.clipped:
             self.clipped = True
             self.log(f"the map outgrew the grid: cells beyond it are left out (give a --margin over {self.margin:g} m)")
         if what == "found":
-            return self._result("found", "read the goal's sign")
+            return self._found()
         if topic == RESUME:
             self.log(f"explore/resume: {'paused' if s.paused else 'resumed'}")
             if s.paused and self.current is not None and self.nav is not None:
@@ -260,15 +291,19 @@ class Live:
         if topic == self.pose_topic:
             if s.st.distance >= self.max_distance:
                 return self._result("budget", f"travelled {s.st.distance:.1f} m of {self.max_distance:g}")
-            if self.publish_only and self.target is not None and math.hypot(s.st.x - self.target[0],
-                                                                            s.st.y - self.target[1]) <= ARRIVED:
+            if (what != "plan" and self.publish_only and self.target is not None
+                    and math.hypot(s.st.x - self.target[0], s.st.y - self.target[1]) <= ARRIVED):
+                # reached (no one says so with --publish-only): recorded as Nav2 would say it, so that
+                # the repro bag replays this re-plan
                 self.target = None
-                return self._feed(GOAL_STATUS, goal_ended(self.m, self.sent, SUCCEEDED))  # reached: recorded as Nav2 would
+                topic, msg = GOAL_STATUS, goal_ended(self.m, self.sent, SUCCEEDED)
+                self.repro.write(topic, msg)
+                what = s.take(topic, msg)
         return self._replan() if what == "plan" else None
 
     def _replan(self) -> LiveRun | None:
         s = self.session
-        self.out.t = time.time_ns()
+        self.out.t = self.stamp  # the decisions' messages, stamped as the pose they were made at
         plan = s.plan()
         if isinstance(plan, str):
             return self._result(plan, "nowhere left to go" if plan == "stuck" else plan)
@@ -278,13 +313,17 @@ class Live:
         self.target = (x, y)
         self.sent += 1
         if self.nav is not None:
-            k = self.current = self.sent
+            k = self.sent
             goal = roslibpy.Goal({"pose": to_json(self.m.pose_stamped(self.stamp, x, y, yaw)), "behavior_tree": ""})
 
             def done(res, k=k):  # on roslibpy's thread: the end goes through the queue, in order
                 self.q.put(("result", (k, _status(res))))
             self._goal_ids[k] = self.nav.send_goal(goal, done, lambda fb: None, done)
+            self.current, self.sent_at = k, time.monotonic()
         return None
+
+    def _found(self) -> LiveRun:
+        return self._result("found", "read the goal's sign")
 
     def _result(self, outcome: str, message: str) -> LiveRun:
         s = self.session

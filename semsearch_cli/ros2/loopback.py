@@ -15,7 +15,7 @@ sign its cameras read (``/semsearch/detections``), and takes ``nav2_msgs/action/
 goals on ``/navigate_to_pose``: a goal is a path planned by the scenario's navigator on the
 robot's own map, followed ``robot.step`` metres per tick (a tick every ``period`` seconds of wall
 time) with the simulator's motion and sensing, step by step as ``semsearch run`` moves; a new goal
-replaces the one under way (Nav2's preemption: the old one ends CANCELED), and a goal ends
+replaces the one under way (Nav2's preemption: the old one ends ABORTED), and a goal ends
 SUCCEEDED at its last waypoint or ABORTED when there is no path. With ``follow``, a PoseStamped
 a client publishes on that topic is a goal too (a navigation stack that takes ``--publish-only``'s
 goals). The robot moves only towards a goal: standing, it neither senses nor publishes. Its start and its generator are those of the
@@ -38,18 +38,20 @@ from ..tasks.base import Observer
 from ..tasks.doors import DoorFrame, DoorSensing, DoorTask
 from ..tasks.episodes import episode_seed
 from .bag import Messages, map_states, stamp_ns, step_of, to_json
+from .robot import ABORTED, CANCELED, NAVIGATE_ACTION, SUCCEEDED
 
 ws_server = lazy_module("websockets.asyncio.server")  # optional: the ros extra
 
-SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
-NAVIGATE = "/navigate_to_pose"
+NAVIGATE = NAVIGATE_ACTION[0]
 LATCHED = ("/map", "/semsearch/pose")  # transient local, as a map server's and amcl's topics are
 
 
 class Rosbridge:
     """A rosbridge v2 server on ``host`` (loopback), in a thread of its own (:meth:`start`,
     :meth:`stop`); the robot's side publishes with :meth:`publish` and serves actions registered
-    with :attr:`actions` (name -> ``handler(client, goal_id, args)``, called on the loop)."""
+    with :attr:`actions` (name -> ``handler(client, goal_id, args)``). Everything but
+    :meth:`start`, :meth:`stop` and :meth:`call` runs on the server's loop: from another thread,
+    go through :meth:`call`."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0):
         self.host, self.port = host, port
@@ -72,7 +74,12 @@ class Rosbridge:
 
     def start(self) -> "Rosbridge":
         self._thread.start()
-        asyncio.run_coroutine_threadsafe(self._open(), self.loop).result(10)
+        try:
+            asyncio.run_coroutine_threadsafe(self._open(), self.loop).result(10)
+        except BaseException:  # the port taken, say: no thread left behind
+            self.loop.call_soon_threadsafe(self.loop.stop)
+            self._thread.join(10)
+            raise
         return self
 
     async def _open(self):
@@ -219,10 +226,10 @@ class SimRobot:
         self.ended: list = []  # (goal id, status)
         self._last_map = None
         self._task = None
-        bridge.actions[NAVIGATE] = self._goal
-        bridge.cancels[NAVIGATE] = self._cancel
+        bridge.call(bridge.actions.__setitem__, NAVIGATE, self._goal)  # on the loop, as everything of the bridge's
+        bridge.call(bridge.cancels.__setitem__, NAVIGATE, self._cancel)
         if follow is not None:  # a navigation stack of its own that drives to each PoseStamped on this topic
-            bridge.handlers[follow] = lambda msg: self._goal(None, None, {"pose": msg})
+            bridge.call(bridge.handlers.__setitem__, follow, lambda msg: self._goal(None, None, {"pose": msg}))
 
     @property
     def distance(self) -> float:
@@ -253,7 +260,7 @@ class SimRobot:
         self.late.append(self.st.steps - step_of(planned, self.step_m))  # steps taken since the pose it was planned on
         self.goals.append((goal_id, x, y))
         if self.path is not None:
-            self._end(CANCELED)  # preempted by the new goal
+            self._end(ABORTED)  # preempted by the new goal: Nav2 aborts it
         self.goal_id, self.client = goal_id, client
         b, fr = self.st.belief, self.task.world.frame
         r, c = (int(v) for v in fr.to_index(self.st.x, self.st.y))

@@ -7,11 +7,14 @@ live bridge made on it:
 - the map (``/map``, nav_msgs/OccupancyGrid, as a SLAM node publishes it) is folded in whole at
   each message: -1 unknown, below :data:`FREE_BELOW` free (map_saver's threshold), else seen and
   not free; cells outside the belief's grid are left out (:func:`fold_map`);
-- each pose is a frame and a step: the distance grows by the straight line from the pose before,
-  the camera's view is the pose's, the visited kernel is marked;
+- each pose (the first of :data:`POSE_TOPICS` that speaks, or the one given) is a frame and a
+  step: the distance grows by the straight line from the pose before (to the nanometre), the
+  camera's view is the pose's, the visited kernel is marked;
 - a detection (``/semsearch/detections``, JSON ``{"label", ...}``) of the goal's label ends the
   search; another is read from the robot's next pose (a read counts towards ``min_reads`` as the
   simulator's camera read does), so that the reads of a moment are in before that moment's re-plan;
+- the end of the newest goal (:data:`GOAL_STATUS`, Nav2's action status: SUCCEEDED or ABORTED,
+  taken once; Nav2 aborts a goal that a newer one replaces) is a path done; ``/explore/resume`` False pauses the re-plans, True re-plans at once;
 - a re-plan is due as :meth:`~semsearch_cli.tasks.doors.DoorSearch.replan_due` says: at the first
   pose that has a map, when the last goal is done (reached, or given up by the robot), every
   ``replan_every`` metres (``navigation.replan: periodic``) or when the map loses a free cell
@@ -38,7 +41,9 @@ from ..tasks.doors import DoorDecision, DoorSearch
 
 MAP, DETECTIONS, RESUME = "/map", "/semsearch/detections", "/explore/resume"
 GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray: Nav2's goals and how they ended
-ENDS = (4, 6)  # GoalStatus SUCCEEDED, ABORTED: a goal's path is done (CANCELED is a goal replaced or called off)
+NAVIGATE_ACTION = ("/navigate_to_pose", "nav2_msgs/action/NavigateToPose")
+SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
+ENDS = (SUCCEEDED, ABORTED)  # the newest goal's path is done (CANCELED: called off by whoever sent it)
 POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot's pose: the first of these it publishes
 POSE_TYPES = {"/semsearch/pose": "geometry_msgs/msg/PoseStamped", "/amcl_pose": "geometry_msgs/msg/PoseWithCovarianceStamped",
               "/pose": "geometry_msgs/msg/PoseWithCovarianceStamped"}  # slam_toolbox's /pose, amcl's /amcl_pose
@@ -73,10 +78,11 @@ class RobotTask:
 
 
 def goal_ended(messages, k: int, status: int):
-    """The GoalStatusArray of goal number ``k`` (its UUID: ``k`` in 16 bytes) ended with ``status``."""
+    """The GoalStatusArray of goal number ``k`` (its UUID: ``k`` in 16 bytes; accepted at ``k``
+    ns, so that a later goal is newer) ended with ``status``."""
     T = messages.T
     info = T["action_msgs/msg/GoalInfo"](goal_id=T["unique_identifier_msgs/msg/UUID"](uuid=np.frombuffer(
-        int(k).to_bytes(16, "big"), np.uint8).copy()), stamp=messages._time(0))
+        int(k).to_bytes(16, "big"), np.uint8).copy()), stamp=messages._time(int(k)))
     return T["action_msgs/msg/GoalStatusArray"](status_list=[T["action_msgs/msg/GoalStatus"](goal_info=info, status=int(status))])
 
 
@@ -121,8 +127,19 @@ def fold_map(belief, msg) -> bool:
     return values.size < h * w
 
 
+EIGHTH = math.pi / 4
+
+
 def _yaw(q) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    """The yaw of a quaternion. One within 1e-9 rad of a multiple of 45 degrees is that multiple,
+    as ``atan2`` gives it: a grid path's headings, which the quaternion gives back only to 1e-16
+    rad, and nsos's heading histogram has bin edges on +-90 degrees, so that noise moved a pose of
+    a robot driving along y into the neighbouring bin (docs/robot.md)."""
+    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    k = round(yaw / EIGHTH)
+    if abs(yaw - k * EIGHTH) < 1e-9:
+        return math.atan2(math.sin(k * EIGHTH), math.cos(k * EIGHTH))
+    return yaw
 
 
 def pose_of(msg) -> tuple[float, float, float]:
@@ -239,10 +256,12 @@ class RobotSession:
             if not self.paused:
                 self.done = True
                 return "plan" if self.due() else None
-        elif topic == GOAL_STATUS:
-            ends = [bytes(g.goal_info.goal_id.uuid) for g in msg.status_list if g.status in ENDS]
-            if any(e not in self.ended for e in ends):
-                self.ended.update(ends)
+        elif topic == GOAL_STATUS and msg.status_list:
+            # the newest goal only: Nav2 aborts the goal a new one replaces, which is no path done
+            newest = max(msg.status_list, key=lambda g: (g.goal_info.stamp.sec, g.goal_info.stamp.nanosec))
+            uuid = bytes(newest.goal_info.goal_id.uuid)
+            if newest.status in ENDS and uuid not in self.ended:
+                self.ended.add(uuid)
                 self.done = True
                 return "plan" if self.due() else None
         elif topic in POSE_TYPES and (self.pose_topic or topic) == topic:
