@@ -476,8 +476,9 @@ def ros_live(
                            silence, log=lambda text: err.print(text))
     except ScenarioError as exc:
         _fail(exc)
+    sent = "published on /semsearch/goal" if publish_only else f"{res.goals} goals sent to Nav2"
     out.print(f"{res.outcome}: {res.message}; {res.distance:.1f} m over {res.poses} poses, {len(res.decisions)} decisions, "
-              f"{res.goals} goals sent")
+              f"{sent}")
     if res.repro is not None:
         size = sum(p.stat().st_size for p in res.repro.rglob("*") if p.is_file())
         again = f" --margin {margin:g}" + (f" --scenario {shlex.quote(str(scenario))}" if scenario is not None else "")
@@ -519,10 +520,10 @@ def ros_sim(
             tell()
     except KeyboardInterrupt:
         pass
-    finally:
+    finally:  # Ctrl-C, or SIGTERM (which goes on to exit 143)
         bot.bridge.stop()
-    tell()
-    out.print(f"stopped after {bot.distance:.2f} m, {bot.st.steps} steps, {len(bot.goals)} goals")
+        tell()
+        out.print(f"stopped after {bot.distance:.2f} m, {bot.st.steps} steps, {len(bot.goals)} goals")
 
 
 @app.command()
@@ -971,6 +972,8 @@ def main() -> None:
     warnings.filterwarnings("default", category=DeprecationWarning, message=".*deprecated since semsearch")
     warnings.showwarning = _show_warning
     resume = "finished runs are kept in runs.csv; run the same command again to resume"
+    if sys.argv[1:2] == ["ros"]:  # ros live keeps what it took in its repro bag (and says where); ros sim holds nothing
+        resume = "nothing is lost: a live run keeps the messages it took in its repro bag"
     if "stdout" in CLOSED:
         err.print("error: standard output is closed (>&-); give it a file, or /dev/null to discard what semsearch prints",
                   highlight=False, soft_wrap=True)

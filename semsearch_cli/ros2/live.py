@@ -72,7 +72,8 @@ ABORTS = 5  # goals the robot gives up on in a row, without moving, before the r
 class LiveRun:
     """What a live run gave: its outcome (found, stuck, budget, lost, interrupted), the distance
     its poses travelled (m, straight lines between them), the poses, the decisions [{step,
-    target_cell, target}], the goals sent, a note, and the repro bag (None when found)."""
+    target_cell, target}], the NavigateToPose goals sent (none with ``publish_only``), a note,
+    and the repro bag (None when found)."""
 
     outcome: str
     distance: float
@@ -134,7 +135,7 @@ class Live:
         self.pose_topic: str | None = None
         self.early: list = []  # messages before the first map
         self.stamp = 0  # the last pose's stamp (ns): the goals planned on it carry it
-        self.sent = 0  # goals sent; the one under way is number self.current
+        self.sent = 0  # goals (re-plans' targets) so far, numbered from 1; the one under way is number self.current
         self.current: int | None = None
         self.target: tuple[float, float] | None = None
         self._goal_ids: dict[int, str] = {}  # goal number -> roslibpy's goal id
@@ -328,8 +329,8 @@ class Live:
     def _result(self, outcome: str, message: str) -> LiveRun:
         s = self.session
         if s is None:
-            return LiveRun(outcome, 0.0, 0, [], self.sent, message)
-        return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, self.sent, message)
+            return LiveRun(outcome, 0.0, 0, [], len(self._goal_ids), message)
+        return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, len(self._goal_ids), message)
 
 
 def _status(res) -> int:
