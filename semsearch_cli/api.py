@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import shutil
@@ -200,8 +201,8 @@ def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | P
     takes its settings from ``scenario`` when given, and is folded into its first map and ``margin``
     metres around it (as :func:`ros_live` folds a robot's maps). Returns the
     :class:`~semsearch_cli.ros2.Replayed`."""
-    if margin < 0:
-        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 or more metres")
+    _margin(margin)
+    goal = _label(goal) if goal is not None else None
     if fmt not in ros2.FORMATS:
         raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
     if not ros2.available():
@@ -235,10 +236,12 @@ def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | Non
     takes a line of progress. Returns the :class:`~semsearch_cli.ros2.LiveRun`."""
     if not ros2.available():
         raise ScenarioError("<command line>", "ros live", "needs the ros extra (rosbags, roslibpy): pip install 'semsearch[ros]'")
-    if margin < 0:
-        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 or more metres")
-    if max_distance is not None and max_distance <= 0:
+    _margin(margin)
+    if max_distance is not None and not max_distance > 0:
         raise ScenarioError("<command line>", "--max-distance", f"{max_distance:g} m: give more than 0")
+    if not 0 < silence < math.inf:
+        raise ScenarioError("<command line>", "--silence", f"{silence:g} s: give a number of seconds over 0")
+    goal = _label(goal)
     loaded = Loaded.load(scenario_file(scenario), planners=False) if scenario is not None else None
     if loaded is not None and not isinstance(loaded.task, DoorTask):
         raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: a robot explores with door planners only")
@@ -259,19 +262,35 @@ def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, pe
     :class:`~semsearch_cli.ros2.loopback.SimRobot`; ``robot.bridge.stop()`` ends it."""
     if not ros2.available():
         raise ScenarioError("<command line>", "ros sim", "needs the ros extra (roslibpy, websockets): pip install 'semsearch[ros]'")
-    if period <= 0:
-        raise ScenarioError("<command line>", "--period", f"{period:g} s: give more than 0")
+    if not 0 < period < math.inf:
+        raise ScenarioError("<command line>", "--period", f"{period:g} s: give a number of seconds over 0")
+    if follow is not None and not follow.startswith("/"):
+        raise ScenarioError("<command line>", "--follow", f"{follow!r}: give a topic's absolute name, e.g. /semsearch/goal")
     loaded = Loaded.load(scenario_file(scenario), planners=False)
     if not isinstance(loaded.task, DoorTask):
         raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: the stand-in robot searches for door signs")
-    goal = sign_label(goal)
-    loaded.task.check_goals([goal], "--goal")
+    goal = _label(goal)
+    if loaded.world.signs.index_of(goal) < 0:
+        raise ScenarioError(str(loaded.path), "--goal", f"no door sign carries {goal!r} in this scenario")
     bridge = ros2.Rosbridge(port=port)
     try:
         bridge.start()
     except OSError as exc:
         raise ScenarioError("<command line>", "--port", f"{port}: {exc.strerror or exc}") from None
     return ros2.SimRobot(bridge, loaded, goal, seed, period=period, follow=follow).start()
+
+
+def _margin(margin: float) -> None:
+    if not 0 <= margin < math.inf:
+        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 or more metres")
+
+
+def _label(goal) -> str | int:
+    """A goal's label as signs carry it (a whole number is a number), or a ScenarioError."""
+    try:
+        return sign_label(goal)
+    except ValueError as exc:
+        raise ScenarioError("<command line>", "--goal", f"{goal!r}: {exc}") from None
 
 
 def _door_variant(planner: str, planner_file: str | Path | None):

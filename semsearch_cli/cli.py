@@ -435,8 +435,9 @@ def ros_replay(
     margin: float = typer.Option(10.0, "--margin", help="For a robot's own bag: metres of grid around its first map (as "
                                  "`ros live --margin`)."),
 ):
-    """Ask a door planner where it would go at each re-plan of a recorded bag, the robot moving as it
-    moved, and write its answers (/semsearch/goal, /explore/frontiers, /semsearch/decision) to a new
+    """Ask a door planner where it would go at each re-plan of a bag.
+
+    The robot moves as it moved; the planner's answers (/semsearch/goal, /explore/frontiers, /semsearch/decision) to a new
     bag. Over a bag of `semsearch export`, the run's own planner makes the run's decisions, decision
     for decision; a robot's own bag (/map, a pose, /semsearch/detections) needs --goal."""
 
@@ -465,8 +466,9 @@ def ros_live(
     planner_file: Optional[Path] = typer.Option(None, "--planner-file", help="A Python file that registers the planner."),
     silence: float = typer.Option(30.0, "--silence", help="Give up when the robot has sent nothing for this many seconds."),
 ):
-    """Explore with a robot through rosbridge until the goal's sign is read, in the place of
-    explore_lite: the robot's /map, pose and /semsearch/detections in; /explore/frontiers,
+    """Explore with a robot through rosbridge until the goal's sign is read.
+
+    In the place of explore_lite: the robot's /map, pose and /semsearch/detections in; /explore/frontiers,
     /semsearch/goal and Nav2 NavigateToPose goals out; /explore/resume pauses and resumes. A run
     that does not find the goal leaves a repro bag for `semsearch ros replay`. Exit status 0 when
     the goal was found, 1 otherwise."""
@@ -476,14 +478,19 @@ def ros_live(
                            silence, log=lambda text: err.print(text))
     except ScenarioError as exc:
         _fail(exc)
-    sent = "published on /semsearch/goal" if publish_only else f"{res.goals} goals sent to Nav2"
-    out.print(f"{res.outcome}: {res.message}; {res.distance:.1f} m over {res.poses} poses, {len(res.decisions)} decisions, "
+    n = len(res.decisions)
+    sent = "targets published on /semsearch/goal" if publish_only else f"{res.goals} goals sent to Nav2 (one a re-plan)"
+    out.print(f"{res.outcome}: {res.message}; {res.distance:.1f} m along {res.poses} poses, {n} decision{'s' * (n != 1)}, "
               f"{sent}")
     if res.repro is not None:
         size = sum(p.stat().st_size for p in res.repro.rglob("*") if p.is_file())
-        again = f" --margin {margin:g}" + (f" --scenario {shlex.quote(str(scenario))}" if scenario is not None else "")
-        out.print(f"repro bag: {res.repro} ({size / 1e6:.2f} MB; semsearch ros replay {shlex.quote(str(res.repro))} --goal "
-                  f"{shlex.quote(goal)} --planner {shlex.quote(planner)}{again} --out DIR)")
+        if res.poses == 0:
+            out.print(f"repro bag: {res.repro} ({size / 1e6:.2f} MB; no pose came, so there is nothing to replay)")
+        else:
+            again = f" --margin {margin:g}" + (f" --scenario {shlex.quote(str(scenario))}" if scenario is not None else "")
+            out.print(f"repro bag: {res.repro} ({size / 1e6:.2f} MB; replay it: semsearch ros replay {shlex.quote(str(res.repro))}"
+                      f" --goal {shlex.quote(goal)} --planner {shlex.quote(planner)}{again} --out "
+                      f"{shlex.quote(str(res.repro) + '-replayed')})")
     raise typer.Exit(0 if res.outcome == "found" else 1)
 
 
@@ -491,15 +498,17 @@ def ros_live(
 def ros_sim(
     scenario: Path = SCENARIO,
     goal: str = typer.Option(..., "--goal", help="The goal whose first episode the robot starts from (its start, its seed)."),
-    seed: int = typer.Option(0, "--seed", help="The repeat (the generator `semsearch run` gives that episode and seed)."),
-    port: int = typer.Option(9090, "--port", help="The port on 127.0.0.1 (rosbridge_server's is 9090)."),
+    seed: int = typer.Option(0, "--seed", min=0, help="The repeat (the generator `semsearch run` gives that episode and seed)."),
+    port: int = typer.Option(9090, "--port", min=0, max=65535, help="The port on 127.0.0.1 (rosbridge_server's is 9090)."),
     period: float = typer.Option(0.2, "--period", help="Seconds between the robot's steps."),
     follow: Optional[str] = typer.Option(None, "--follow", help="Also drive to each PoseStamped published on this topic (for "
                                          "`ros live --publish-only`: /semsearch/goal)."),
 ):
-    """A robot without ROS, to try `semsearch ros live` on: the scenario's simulated robot behind a
-    rosbridge server on 127.0.0.1, publishing /map, /semsearch/pose and /semsearch/detections and
-    taking Nav2 NavigateToPose goals on /navigate_to_pose. Runs until Ctrl-C."""
+    """A robot without ROS, to try `semsearch ros live` on.
+
+    The scenario's simulated robot (one episode: the goal's first, and one seed) behind a rosbridge
+    server on 127.0.0.1, publishing /map, /semsearch/pose and /semsearch/detections and taking Nav2
+    NavigateToPose goals on /navigate_to_pose. Runs until Ctrl-C; start it again for another run."""
 
     try:
         bot = api.ros_sim(scenario, goal, seed, port, period, follow)
@@ -972,8 +981,9 @@ def main() -> None:
     warnings.filterwarnings("default", category=DeprecationWarning, message=".*deprecated since semsearch")
     warnings.showwarning = _show_warning
     resume = "finished runs are kept in runs.csv; run the same command again to resume"
-    if sys.argv[1:2] == ["ros"]:  # ros live keeps what it took in its repro bag (and says where); ros sim holds nothing
-        resume = "nothing is lost: a live run keeps the messages it took in its repro bag"
+    resume = {"live": "the goal under way was cancelled, and the messages taken are in the repro bag named above",
+              "sim": "the stand-in robot holds nothing to keep", "replay": "no half-written bag is left"}.get(
+        sys.argv[2] if sys.argv[1:2] == ["ros"] and len(sys.argv) > 2 else "", resume)
     if "stdout" in CLOSED:
         err.print("error: standard output is closed (>&-); give it a file, or /dev/null to discard what semsearch prints",
                   highlight=False, soft_wrap=True)

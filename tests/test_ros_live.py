@@ -148,16 +148,22 @@ def test_the_command_line_finds_the_goal_and_a_failing_run_leaves_a_repro_bag_th
     bag = tmp_path / "repro"
     size = sum(p.stat().st_size for p in bag.rglob("*") if p.is_file())
     assert size < 200_000
+    m = Messages()
     with Reader(bag) as rd:
         topics = {c.topic: c.msgtype for c in rd.connections}
-        stamps = [t for _, t, _ in rd.messages()]
+        stamps, chosen = [], []
+        for c, t, raw in rd.messages():
+            stamps.append(t)
+            if c.topic == "/semsearch/decision":
+                chosen.append(json.loads(m.ts.deserialize_cdr(raw, c.msgtype).data))
     took = {"/map": "nav_msgs/msg/OccupancyGrid", "/semsearch/pose": "geometry_msgs/msg/PoseStamped",
-            "/semsearch/detections": "std_msgs/msg/String"}
+            "/semsearch/detections": "std_msgs/msg/String", "/explore/frontiers": "visualization_msgs/msg/MarkerArray",
+            "/semsearch/goal": "geometry_msgs/msg/PoseStamped", "/semsearch/decision": "std_msgs/msg/String"}
     assert took.items() <= topics.items() <= {**took, GOAL_STATUS: "action_msgs/msg/GoalStatusArray"}.items()
     assert stamps == sorted(set(stamps))
-    decided = int(re.search(r"poses, (\d+) decisions", out).group(1))
+    decided = int(re.search(r"poses, (\d+) decisions?,", out).group(1))
     rep = replay_bag(None, bag, Variant("greedy", ()), tmp_path / "replayed", "mcap", "452")
-    assert len(rep.decisions) == decided > 0
+    assert rep.decisions == chosen and len(chosen) == decided > 0  # what the live run chose, decision for decision
     r2 = CliRunner().invoke(app, ["ros", "replay", str(bag), "--planner", "greedy", "--goal", "452", "--out",
                                   str(tmp_path / "replayed2")])
     assert r2.exit_code == 0, r2.output
@@ -223,6 +229,23 @@ def test_a_bad_address_no_server_and_an_existing_repro_folder_exit_2(tmp_path):
     assert r.exit_code == 2 and "exists already" in r.output
     r = runner.invoke(app, ["ros", "live", "--planner", "nsoss", "--goal", "304", "--rosbridge", f"ws://127.0.0.1:{port}"])
     assert r.exit_code == 2 and "'nsos'" in r.output, r.output
+    live = ["ros", "live", "--planner", "greedy", "--rosbridge", f"ws://127.0.0.1:{port}"]
+    for args, field in [(["--goal", ""], "--goal"), (["--goal", "304", "--silence", "0"], "--silence"),
+                        (["--goal", "304", "--margin", "nan"], "--margin"), (["--goal", "304", "--max-distance", "-5"], "--max-distance")]:
+        r = runner.invoke(app, live + args)
+        assert r.exit_code == 2 and f"field '{field}'" in r.output and "Traceback" not in r.output, (args, r.output)
+
+
+def test_ros_sim_refuses_what_it_cannot_be(demo_dir):
+    runner = CliRunner()
+    sim = ["ros", "sim", str(demo_dir / "scenario.yaml")]
+    for args, field in [(["--goal", "999"], "--goal"), (["--goal", ""], "--goal"), (["--goal", "304", "--period", "nan"], "--period"),
+                        (["--goal", "304", "--follow", "semsearch/goal"], "--follow")]:
+        r = runner.invoke(app, sim + args)
+        assert r.exit_code == 2 and f"field '{field}'" in r.output and "Traceback" not in r.output, (args, r.output)
+    for args in (["--goal", "304", "--port", "99999"], ["--goal", "304", "--seed", "-1"]):
+        r = runner.invoke(app, sim + args)
+        assert r.exit_code == 2 and "Invalid value" in r.output, (args, r.output)
 
 
 def test_the_loopback_server_speaks_rosbridge_v2(robot, demo_loaded):
@@ -320,7 +343,7 @@ def test_a_silent_robot_is_lost_and_its_repro_bag_kept(tmp_path):
                                      "--silence", "1", "--repro", str(tmp_path / "repro")])
     finally:
         bridge.stop()
-    assert r.exit_code == 1 and "lost: no message from the robot for 1 s; 0.0 m over 0 poses" in " ".join(r.output.split())
+    assert r.exit_code == 1 and "lost: no message from the robot for 1 s; 0.0 m along 0 poses" in " ".join(r.output.split())
     with Reader(tmp_path / "repro") as rd:
         assert rd.message_count == 0
     assert not list(tmp_path.glob(".repro*"))

@@ -27,6 +27,7 @@ replays to the same re-plans.
 from __future__ import annotations
 
 import contextlib
+import logging
 import math
 import queue
 import shutil
@@ -151,6 +152,9 @@ class Live:
         except OSError as exc:
             raise ScenarioError("<command line>", "--rosbridge", f"{where} ({exc.strerror or type(exc).__name__}): is "
                                 "rosbridge_server running there?") from None
+        # roslibpy logs a traceback for each frame it cannot send once the socket closed, and an error for
+        # each rosbridge status message (it has no handler for them): this run says what happened itself
+        logging.getLogger("roslibpy").setLevel(logging.CRITICAL)
         ros = roslibpy.Ros(self.host, self.port, is_secure=self.secure, transport="asyncio")
         try:
             ros.run(timeout=10)
@@ -195,7 +199,10 @@ class Live:
         return res
 
     def _publish(self, topic: str, t_ns: int, msg) -> None:
+        """A decision's message out to the robot, and into the repro bag (``ros replay`` reads only
+        the robot's topics from it; these say what the live run chose)."""
         self.pubs[topic].publish(roslibpy.Message(to_json(msg)))
+        self.repro.write(topic, msg)
 
     def _cancel(self) -> None:
         gid, self.current = self._goal_ids.get(self.current), None
@@ -221,7 +228,8 @@ class Live:
                 if s is not None and (s.st.x, s.st.y) != where:
                     where, moved = (s.st.x, s.st.y), now
             if now - heard >= self.silence:
-                return self._result("lost", f"no message from the robot for {self.silence:g} s")
+                hint = " (with --publish-only, is something driving to /semsearch/goal?)" if self.publish_only else ""
+                return self._result("lost", f"no message from the robot for {self.silence:g} s{hint}")
             if self.current is not None and now - max(moved, self.sent_at) >= self.silence:
                 # a goal nobody answers (rejected, or lost with a connection) and the robot standing
                 self.log(f"goal {self.current}: no answer and no move for {self.silence:g} s; taken as given up")
