@@ -43,6 +43,7 @@ API = {
     "ros_replay": ["bag", "planner", "out", "scenario", "fmt", "planner_file", "goal", "margin"],
     "ros_live": ["rosbridge", "planner", "goal", "scenario", "publish_only", "repro", "margin", "max_distance", "planner_file",
                  "silence", "log"],
+    "ros_sim": ["scenario", "goal", "seed", "port", "period", "follow"],
     "bench_run": ["suite", "planners", "out", "split", "numbering", "options", "limit", "salt_file", "planner_file", "progress"],
     "bench_list": [],
     "bench_hash": ["suite", "split", "salt_file"],
