@@ -154,7 +154,15 @@ class Live:
                                 "rosbridge_server running there?") from None
         # roslibpy logs a traceback for each frame it cannot send once the socket closed, and an error for
         # each rosbridge status message (it has no handler for them): this run says what happened itself
-        logging.getLogger("roslibpy").setLevel(logging.CRITICAL)
+        logger = logging.getLogger("roslibpy")
+        level = logger.level
+        logger.setLevel(logging.CRITICAL)
+        try:
+            return self._connected(where)
+        finally:
+            logger.setLevel(level)
+
+    def _connected(self, where: str) -> LiveRun:
         ros = roslibpy.Ros(self.host, self.port, is_secure=self.secure, transport="asyncio")
         try:
             ros.run(timeout=10)
