@@ -88,9 +88,10 @@ class Messages:
 
     # -- parts -------------------------------------------------------------------------
     def header(self, t_ns: int, frame: str = "map"):
-        return self.T["std_msgs/msg/Header"](stamp=self._time(t_ns), frame_id=frame)
+        return self.T["std_msgs/msg/Header"](stamp=self.time(t_ns), frame_id=frame)
 
-    def _time(self, t_ns: int):
+    def time(self, t_ns: int):
+        """A builtin_interfaces/Time of ``t_ns`` nanoseconds."""
         return self.T["builtin_interfaces/msg/Time"](sec=int(t_ns // 1_000_000_000), nanosec=int(t_ns % 1_000_000_000))
 
     def pose(self, x: float, y: float, yaw: float):
@@ -117,7 +118,7 @@ class Messages:
         occupied; a few kilobytes once compressed, unknown cells being most), rows flipped to
         ROS's order (row 0 at the lowest y), its origin the grid's lower-left corner."""
         P = self.T
-        info = P["nav_msgs/msg/MapMetaData"](map_load_time=self._time(t_ns), resolution=float(frame.res),
+        info = P["nav_msgs/msg/MapMetaData"](map_load_time=self.time(t_ns), resolution=float(frame.res),
                                              width=int(frame.width), height=int(frame.height),
                                              origin=self.pose(frame.origin_x, frame.origin_y, 0.0))
         return P["nav_msgs/msg/OccupancyGrid"](header=self.header(t_ns), info=info,

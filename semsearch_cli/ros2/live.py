@@ -50,10 +50,9 @@ LIVE_TOPICS = {
     DETECTIONS: ("std_msgs/msg/String", "in", 'a sign read: JSON {"label", ...}'),
     RESUME: ("std_msgs/msg/Bool", "in", "False pauses the exploration (the goal under way is cancelled), True resumes it"),
     MAP: ("nav_msgs/msg/OccupancyGrid", "in", "the SLAM map (a latched map arrives at once)"),
-    "/semsearch/pose": ("geometry_msgs/msg/PoseStamped", "in", "the robot's pose in map; of the three pose topics, the first "
-                        "that speaks is used"),
-    "/amcl_pose": ("geometry_msgs/msg/PoseWithCovarianceStamped", "in", "the pose as AMCL publishes it"),
-    "/pose": ("geometry_msgs/msg/PoseWithCovarianceStamped", "in", "the pose as slam_toolbox publishes it"),
+    **{t: (POSE_TYPES[t], "in", what) for t, what in zip(POSE_TYPES, (
+        "the robot's pose in map; of the three pose topics, the first that speaks is used",
+        "the pose as AMCL publishes it", "the pose as slam_toolbox publishes it"))},
     "/explore/frontiers": ("visualization_msgs/msg/MarkerArray", "out", "at each decision, the candidates as spheres, the "
                            "chosen one larger and red"),
     "/semsearch/goal": ("geometry_msgs/msg/PoseStamped", "out", "at each decision, the target"),

@@ -184,7 +184,7 @@ class Rosbridge:
 
 
 class _Frames(Observer):
-    """The labels each frame read (sign index, label), and whether it read the goal's sign."""
+    """The signs the last frame read: [(sign index, label as read)]."""
 
     steps = True
 

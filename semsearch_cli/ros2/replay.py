@@ -15,8 +15,8 @@ where it would go, and its answers are written to a new bag (``/semsearch/goal``
   :class:`~semsearch_cli.ros2.robot.RobotSession`, as ``semsearch ros live`` runs a robot: its
   map (``/map``), its pose (the first of :data:`~semsearch_cli.ros2.robot.POSE_TOPICS` it holds;
   else /tf and /tf_static composed from map to ``base_link`` or ``base_footprint``, in the plane)
-  and its sign detections (``/semsearch/detections``); the belief's grid covers every map the bag
-  holds; the goal's label is ``--goal``.
+  and its sign detections (``/semsearch/detections``); the belief's grid is its first map and
+  ``--margin`` metres around it, as ``ros live`` makes it; the goal's label is ``--goal``.
 """
 
 from __future__ import annotations

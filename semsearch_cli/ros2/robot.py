@@ -44,9 +44,10 @@ GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray:
 NAVIGATE_ACTION = ("/navigate_to_pose", "nav2_msgs/action/NavigateToPose")
 SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
 ENDS = (SUCCEEDED, ABORTED)  # the newest goal's path is done (CANCELED: called off by whoever sent it)
-POSE_TOPICS = ("/semsearch/pose", "/amcl_pose", "/pose")  # a robot's pose: the first of these it publishes
+# a robot's pose: the first of these topics it publishes (amcl's /amcl_pose, slam_toolbox's /pose), and their types
 POSE_TYPES = {"/semsearch/pose": "geometry_msgs/msg/PoseStamped", "/amcl_pose": "geometry_msgs/msg/PoseWithCovarianceStamped",
-              "/pose": "geometry_msgs/msg/PoseWithCovarianceStamped"}  # slam_toolbox's /pose, amcl's /amcl_pose
+              "/pose": "geometry_msgs/msg/PoseWithCovarianceStamped"}
+POSE_TOPICS = tuple(POSE_TYPES)
 BASE_FRAMES = ("base_link", "base_footprint")  # the robot's frame in /tf, the first that reaches map
 FREE_BELOW = 20  # OccupancyGrid values under it are free (map_saver's 0.196); from it, seen and not free
 
@@ -82,7 +83,7 @@ def goal_ended(messages, k: int, status: int):
     ns, so that a later goal is newer) ended with ``status``."""
     T = messages.T
     info = T["action_msgs/msg/GoalInfo"](goal_id=T["unique_identifier_msgs/msg/UUID"](uuid=np.frombuffer(
-        int(k).to_bytes(16, "big"), np.uint8).copy()), stamp=messages._time(int(k)))
+        int(k).to_bytes(16, "big"), np.uint8).copy()), stamp=messages.time(int(k)))
     return T["action_msgs/msg/GoalStatusArray"](status_list=[T["action_msgs/msg/GoalStatus"](goal_info=info, status=int(status))])
 
 
