@@ -49,6 +49,17 @@ class PlannerError(Exception):
     the value."""
 
 
+class Unavailable(Exception):
+    """A run that failed for a cause outside it: a package its planner needs is not installed, a
+    service it talks to (a language model's endpoint) did not answer. The run is recorded with
+    outcome ``error`` and a message that starts with :data:`UNAVAILABLE`; such a row is never
+    taken as done: the same command runs it again (its row kept in ``runs.superseded.csv``). A run
+    that failed on its own (a planner's exception, :class:`PlannerError`) stays done."""
+
+
+UNAVAILABLE = "unavailable: "  # how the message of a run that failed for a cause outside it starts
+
+
 class BudgetSpent(PlannerError):
     """A planner's own budget for a run (a language model's calls or tokens) is spent: the run
     ends with outcome ``budget`` and this message, as when the scenario's distance budget is."""
