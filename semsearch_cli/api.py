@@ -16,7 +16,7 @@ import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .config.base import sign_label
-from .errors import ScenarioError
+from .errors import MissingExtra, ScenarioError
 from .world.ground_truth import DuplicateSigns
 from .world.buildings import numbered
 from .world.importers import kth, mobilesim, ros
@@ -115,6 +115,9 @@ def first_prompt(scenario: str | Path, options: BatchOptions = BatchOptions()) -
     if not variants:
         raise ScenarioError(str(loaded.path), "planners", "no planner of this scenario calls a language model (llm); "
                             "--dry-run prints the first prompt such a planner would send")
+    fault = _package_fault(variants[0])
+    if fault:  # what a real batch refuses before its first run, a dry run refuses too (it calls no server)
+        raise ScenarioError(str(loaded.path), f"planners.{fault[0]}", f"{variants[0].label}: {fault[1]}")
     goals = set(map(str, options.goals or ()))
     for ep in task.episodes:
         if goals and str(ep.goal) not in goals:
@@ -125,6 +128,17 @@ def first_prompt(scenario: str | Path, options: BatchOptions = BatchOptions()) -
             return stop.text()
     raise ScenarioError(str(loaded.path), "planners", f"{variants[0].label} was asked nothing on these episodes (each "
                         "found its goal before a decision)")
+
+
+def _package_fault(variant) -> tuple[str, str] | None:
+    """A missing package a planner that calls a language model needs (the llm planner's ``openai``),
+    as its preflight names it; the endpoint itself is not looked at (a dry run calls nothing)."""
+    from .planners.llm import client
+
+    params = variant.resolved(planner_class(variant))
+    if getattr(params, "replay", None) is None and client.openai is None:
+        return "name", client.MISSING
+    return None
 
 
 def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", "html"), replay: bool | str = True) -> list[Path]:
@@ -184,7 +198,7 @@ def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | No
     if fmt not in ros2.FORMATS:
         raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
     if not ros2.available():
-        raise ScenarioError("<command line>", "export", "needs the ros extra (rosbags, mcap): pip install 'semsearch[ros]'")
+        raise MissingExtra("semsearch export", "ros")
     folder = Path(folder)
     _, loaded = _rows_scenario(folder, scenario)
     with folder_lock(Path(out)):
@@ -206,7 +220,7 @@ def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | P
     if fmt not in ros2.FORMATS:
         raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
     if not ros2.available():
-        raise ScenarioError("<command line>", "ros replay", "needs the ros extra (rosbags, mcap): pip install 'semsearch[ros]'")
+        raise MissingExtra("semsearch ros replay", "ros")
     bag = Path(bag)
     if bag.is_file():
         raise ScenarioError(str(bag), "", f"is a file: give the bag's folder, {bag.parent} (a ROS 2 bag is a folder with "
@@ -235,7 +249,7 @@ def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | Non
     robot's first map; a run that does not find the goal leaves a repro bag at ``repro``. ``log``
     takes a line of progress. Returns the :class:`~semsearch_cli.ros2.LiveRun`."""
     if not ros2.available():
-        raise ScenarioError("<command line>", "ros live", "needs the ros extra (rosbags, roslibpy): pip install 'semsearch[ros]'")
+        raise MissingExtra("semsearch ros live", "ros")
     _margin(margin)
     if max_distance is not None and not max_distance > 0:
         raise ScenarioError("<command line>", "--max-distance", f"{max_distance:g} m: give more than 0")
@@ -261,7 +275,7 @@ def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, pe
     client publishes on that topic (``--publish-only``'s goals). Returns the started
     :class:`~semsearch_cli.ros2.loopback.SimRobot`; ``robot.bridge.stop()`` ends it."""
     if not ros2.available():
-        raise ScenarioError("<command line>", "ros sim", "needs the ros extra (roslibpy, websockets): pip install 'semsearch[ros]'")
+        raise MissingExtra("semsearch ros sim", "ros")
     if not 0 < period < math.inf:
         raise ScenarioError("<command line>", "--period", f"{period:g} s: give a number of seconds over 0")
     if follow is not None and not follow.startswith("/"):

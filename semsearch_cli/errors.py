@@ -26,6 +26,30 @@ class ScenarioError(Exception):
         super().__init__(f"{where}: {message}")
 
 
+class MissingExtra(ScenarioError):
+    """An optional package that is not installed (or too old) for what was asked: one line,
+    ``semsearch export needs the ros extra: pip install 'semsearch[ros]'``, exit status 2.
+
+    Parameters
+    ----------
+    what : str
+        What needs it (``"semsearch export"``, ``"the llm planner"``).
+    extra : str
+        The pyproject extra that installs it.
+    detail : str
+        Why, when more than absence (an import error's text).
+    """
+
+    def __init__(self, what: str, extra: str, detail: str = ""):
+        self.extra = extra
+        message = f"{what} needs the {extra} extra: pip install 'semsearch[{extra}]'" + (f" ({detail})" if detail else "")
+        super().__init__("<install>", "", message)
+        self.args = (message,)
+
+    def __str__(self) -> str:
+        return self.message
+
+
 class BatchStopped(Exception):
     """A batch stopped by a fault, not by bad input: a worker process died, the disk filled, the
     batch was told to stop (SIGTERM). The rows finished are kept; the same command resumes.

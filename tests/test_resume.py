@@ -125,3 +125,60 @@ def test_a_users_planner_under_any_valid_name_resumes_exactly(demo_dir, name, la
         run_batch(Loaded.load(path), expand(loaded, 1), out, BatchOptions(workers=1))
         again = _text(out / "runs.csv")
         assert again.drop(columns="wall_s").equals(first.drop(columns="wall_s"))
+
+
+FAILING = '''
+import os
+from semsearch_cli.errors import Unavailable
+from semsearch_cli.planners import register_planner
+from semsearch_cli.planners.doors.greedy import Greedy
+
+
+@register_planner("u_service")
+class Service(Greedy):
+    """Greedy behind a service that is down while the file DOWN exists."""
+
+    def choose(self, ctx, cands):
+        if os.path.exists({down!r}):
+            raise Unavailable("the service at 127.0.0.1:9 did not answer")
+        return super().choose(ctx, cands)
+
+
+@register_planner("u_broken")
+class Broken(Greedy):
+    """A planner that fails on its own: its exception is its result."""
+
+    def choose(self, ctx, cands):
+        raise RuntimeError("a bug of the planner's own")
+'''
+
+
+def test_resume_runs_again_what_failed_for_a_cause_outside_the_run_and_keeps_what_failed_on_its_own(demo_dir, tmp_path):
+    for f in ("map.png", "doors.csv"):
+        shutil.copy(demo_dir / f, tmp_path / f)
+    down = tmp_path / "DOWN"
+    down.touch()
+    (tmp_path / "mine.py").write_text(FAILING.format(down=str(down)))
+    sc = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
+    sc.update(map={**sc["map"], "image": "map.png"}, doors="doors.csv", goals=["304"], experiment={"seeds": 1, "max_distance": 120.0},
+              planners=[{"name": "u_service", "module": "mine.py"}, {"name": "u_broken", "module": "mine.py"}])
+    path = tmp_path / "scenario.yaml"
+    path.write_text(yaml.safe_dump(sc))
+    out = tmp_path / "out"
+    loaded = Loaded.load(path)
+    run_batch(loaded, expand(loaded, 1), out, BatchOptions(workers=1))
+    first = _text(out / "runs.csv").set_index("planner")
+    assert first.loc["u_service", "outcome"] == "error"
+    assert first.loc["u_service", "message"] == "unavailable: the service at 127.0.0.1:9 did not answer"
+    assert first.loc["u_broken", "outcome"] == "error" and first.loc["u_broken", "message"].startswith("RuntimeError: a bug")
+    run_batch(Loaded.load(path), expand(loaded, 1), out, BatchOptions(workers=1))  # still down: retried, fails again
+    assert _text(out / "runs.superseded.csv")["planner"].tolist() == ["u_service"]
+    down.unlink()
+    run_batch(Loaded.load(path), expand(loaded, 1), out, BatchOptions(workers=1))
+    again = _text(out / "runs.csv").set_index("planner")
+    assert sorted(again.index) == ["u_broken", "u_service"]  # one row each: nothing duplicated, nothing dropped
+    assert again.loc["u_service", "outcome"] == "found"
+    kept, was = again.loc["u_broken"].drop("wall_s"), first.loc["u_broken"].drop("wall_s")
+    # kept as it was, not run again (a missing number reads back missing: nan then, empty once rows were moved aside)
+    assert kept.replace("nan", "").to_dict() == was.replace("nan", "").to_dict()
+    assert _text(out / "runs.superseded.csv")["planner"].tolist() == ["u_service", "u_service"]

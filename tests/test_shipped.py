@@ -78,20 +78,28 @@ def test_init_copies_a_scenario_with_its_files_rewritten_to_the_copies(tmp_path)
     assert Loaded.load(mine / "hotel_thesis.yaml").fingerprint == Loaded.load(shipped.path("hotel_thesis")).fingerprint
 
 
-def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_and_its_commit(tmp_path):
-    pytest.importorskip("gymnasium")
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory):
+    """A wheel built from a copy of the checkout (as a user builds one), once for this module."""
     if not (ROOT / ".git").exists():
         pytest.skip("not a git checkout: the wheel would carry no commit")
-    src = tmp_path / "src"
+    tmp = tmp_path_factory.mktemp("wheel")
+    src = tmp / "src"
     shutil.copytree(ROOT, src, symlinks=True, ignore=shutil.ignore_patterns(
         ".venv", "venv", "results", "build", "*.egg-info", "__pycache__", ".pytest_cache", ".hypothesis", "site"))
-    wheels = tmp_path / "wheels"
+    wheels = tmp / "wheels"
     # without build isolation: the build backend is the test extra's setuptools, so this needs no network
     built = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(wheels),
                             str(src)], capture_output=True, text=True)
     assert built.returncode == 0, built.stderr[-2000:]
-    (wheel,) = wheels.glob("semsearch-*.whl")
+    (whl,) = wheels.glob("semsearch-*.whl")
     head = subprocess.run(["git", "-C", str(src), "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+    return whl, head
+
+
+def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_and_its_commit(wheel, tmp_path):
+    pytest.importorskip("gymnasium")
+    wheel, head = wheel
     assert wheel.name.startswith(f"semsearch-{__version__}-")  # a plain release: indexes refuse local versions
     site = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)], check=True,
@@ -114,6 +122,40 @@ def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "--version"],
                          capture_output=True, text=True, cwd=elsewhere, env=env)
     assert res.stdout.startswith(f"semsearch {__version__} (code ") and f"commit {head}" in res.stdout, res.stdout
+    res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "bench", "list"],
+                         capture_output=True, text=True, cwd=elsewhere, env=env)
+    assert res.returncode == 0 and "doors-real-v1" in res.stdout, res.stdout + res.stderr
+
+
+def test_the_wheel_holds_every_data_file_the_code_opens(wheel, tmp_path, monkeypatch):
+    """The package data is every file tracked under semsearch_cli/data/ (the wheel adds only the
+    commit it was built from), and every file that the commands which read package data open there
+    (an audit hook records each open) is in the wheel: a glob in pyproject.toml that leaves a
+    file out fails here, not on a user's machine."""
+    import zipfile
+
+    wheel, _ = wheel
+    held = {n.removeprefix("semsearch_cli/data/") for n in zipfile.ZipFile(wheel).namelist() if n.startswith("semsearch_cli/data/")}
+    data = ROOT / "semsearch_cli" / "data"
+    tracked = subprocess.run(["git", "ls-files", "."], cwd=data, capture_output=True, text=True, check=True).stdout.split()
+    assert held - set(tracked) == {"build_commit.txt"} and set(tracked) - held == set()
+    opened: set[str] = set()
+
+    def hook(event, args):
+        if event == "open" and isinstance(args[0], (str, bytes, os.PathLike)):
+            p = Path(os.fsdecode(args[0])).resolve()
+            if p.is_relative_to(data.resolve()) and p.is_file():
+                opened.add(p.relative_to(data.resolve()).as_posix())
+
+    sys.addaudithook(hook)  # for the rest of the session; it records only opens under data/
+    monkeypatch.chdir(tmp_path)
+    for args in (["bench", "list"], ["scenarios"], ["planners"], ["validate", "hotel"], ["validate", "hospital"],
+                 ["validate", "indirect_quick"], ["validate", "office"], ["init", "hotel", "mine"],
+                 ["bench", "run", "doors-v1", "--planner", "learned", "--limit", "1", "--out", "b"]):
+        res = runner.invoke(app, args)
+        assert res.exit_code == 0, (args, res.output)
+    assert opened and {"bench/doors-real-v1/sources.json", "models/learned-doors-v1.json"} <= opened
+    assert sorted(opened - held) == []
 
 
 def test_the_package_data_holds_no_half_written_folder():

@@ -3,8 +3,7 @@ replayed over them (``semsearch ros replay``) and exploring with a robot through
 (``semsearch ros live``), without a ROS install (the ``ros`` extra: rosbags, mcap, roslibpy,
 websockets). See docs/robot.md."""
 
-import importlib.util
-
+from ..optional import installed
 from .bag import FORMATS, TOPICS
 from .export import BagRecorder, Exported, export_folder, export_run, recorded_runs
 from .live import Live, LiveRun
@@ -13,8 +12,9 @@ from .replay import Replayed, recorded_scenario, replay_bag
 
 
 def available() -> bool:
-    """Whether the ros extra is installed (rosbags writes the bags; roslibpy speaks to rosbridge)."""
-    return all(importlib.util.find_spec(name) is not None for name in ("rosbags", "roslibpy"))
+    """Whether the ros extra is installed (rosbags writes the bags; roslibpy speaks to rosbridge;
+    websockets serves the stand-in robot)."""
+    return all(installed(name) for name in ("rosbags", "roslibpy", "websockets"))
 
 
 __all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run",

@@ -19,9 +19,9 @@ import numpy as np
 from ..config.base import sign_label
 from ..optional import lazy_module
 
-typesys = lazy_module("rosbags.typesys")  # optional: pip install 'semsearch[ros]'
-rosbag2 = lazy_module("rosbags.rosbag2")
-interfaces = lazy_module("rosbags.interfaces")
+typesys = lazy_module("rosbags.typesys", "ros")  # optional: pip install 'semsearch[ros]'
+rosbag2 = lazy_module("rosbags.rosbag2", "ros")
+interfaces = lazy_module("rosbags.interfaces", "ros")
 
 SIGN_RGBA, GOAL_RGBA, CAND_RGBA = (0.1, 0.3, 0.9, 1.0), (0.9, 0.1, 0.1, 1.0), (1.0, 0.6, 0.0, 0.9)  # markers' colours
 SPEED = 0.5  # m/s: the simulated clock's robot speed (stamps only)

@@ -43,7 +43,7 @@ from .bag import BagWriter, Messages, drop_bag, from_json, to_json
 from .robot import (ABORTED, DETECTIONS, GOAL_STATUS, MAP, NAVIGATE_ACTION, POSE_TYPES, RESUME, SUCCEEDED, GoalWriter,
                     RobotSession, RobotTask, goal_ended, map_frame)
 
-roslibpy = lazy_module("roslibpy")  # optional: pip install 'semsearch[ros]'
+roslibpy = lazy_module("roslibpy", "ros")  # optional: pip install 'semsearch[ros]'
 
 # topic -> (type, direction, what): the live bridge's topics (docs/robot.md lists them)
 LIVE_TOPICS = {

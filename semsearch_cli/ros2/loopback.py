@@ -40,7 +40,7 @@ from ..tasks.episodes import episode_seed
 from .bag import Messages, map_states, stamp_ns, step_of, to_json
 from .robot import ABORTED, CANCELED, NAVIGATE_ACTION, SUCCEEDED
 
-ws_server = lazy_module("websockets.asyncio.server")  # optional: the ros extra
+ws_server = lazy_module("websockets.asyncio.server", "ros")  # optional: the ros extra
 
 NAVIGATE = NAVIGATE_ACTION[0]
 LATCHED = ("/map", "/semsearch/pose")  # transient local, as a map server's and amcl's topics are

@@ -11,7 +11,7 @@ from typing import Callable, Sequence
 
 import pandas as pd
 
-from ..errors import DISK_FULL, BatchStopped, ScenarioError
+from ..errors import DISK_FULL, UNAVAILABLE, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
 from ..metrics import columns_for
 from ..planners import code_of, planner_class
@@ -60,6 +60,14 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
             names = ", ".join(sorted({str(p) for p in done.loc[stale, "planner"]}))
             _supersede(out, lambda rows: rows["planner"].astype(str).isin(done.loc[stale, "planner"].astype(str)),
                        f"were made by other code ({names}: the planner's file or semsearch changed since)")
+            done = run_rows(read_runs(runs_csv, as_written=True))
+    if len(done):
+        outside = (done["outcome"].astype(str) == "error") & done["message"].astype(str).str.startswith(UNAVAILABLE)
+        if outside.any():  # a cause outside the run (a missing package, a model that did not answer): not done
+            keys = set(zip(*(done.loc[outside, c].astype(str) for c in ("planner", "goal", "episode", "seed"))))
+            _supersede(out, lambda rows: pd.Series([k in keys for k in zip(*(rows[c].astype(str) for c in ("planner", "goal", "episode", "seed")))],
+                                                   index=rows.index, dtype=bool),
+                       "failed for a cause outside the run (a package missing, a service that did not answer)")
             done = run_rows(read_runs(runs_csv, as_written=True))
     if len(done):
         moved = _moved_episodes(loaded, done)

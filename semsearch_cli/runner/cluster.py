@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 from typing import Iterable, Iterator
 
-from ..errors import ScenarioError
+from ..errors import MissingExtra, ScenarioError
 from ..optional import lazy_module
 from .execution import Executor, Watch, execute
 from .executors import register_executor
@@ -31,8 +31,8 @@ from .store import save_run_files
 CONNECT_S = 8  # s to reach a scheduler before the command gives up
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")  # a scheduler's protocols; all but ucx run over TCP and are probed first
 _ADDRESS = re.compile(r"(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):(?P<port>\d{1,5})/?")
-dask = lazy_module("dask")  # imported at first use (the dask extra; None without it)
-distributed = lazy_module("distributed")
+dask = lazy_module("dask", "dask")  # imported at first use (the dask extra; None without it)
+distributed = lazy_module("distributed", "dask")
 
 
 def _run_chunk(loaded: Loaded, specs: list[RunSpec], watch: Watch) -> list[tuple]:
@@ -201,11 +201,16 @@ def _close(client, cluster) -> None:
         cluster.close()
 
 
+def require() -> None:
+    """:class:`MissingExtra` unless the dask extra (``distributed``) is installed."""
+    if distributed is None:
+        raise MissingExtra("--executor dask", "dask")
+
+
 @register_executor("dask")
 def dask_executor(workers: int, start_method: str | None, address: str | None, chunk: int) -> DaskExecutor:
     """The Dask scheduler at ``address``, or a local cluster of ``workers`` processes."""
-    if distributed is None:
-        raise ScenarioError("<command line>", "--executor", "dask needs the distributed package: pip install 'semsearch[dask]'")
+    require()
     if address:
         check_address(address)  # a malformed address is refused before a client is made
     return DaskExecutor(workers, address, chunk)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import RunTimeout
+from ..errors import UNAVAILABLE, MissingExtra, RunTimeout, Unavailable
 from ..kernels import announce_compiling
 from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
 from ..tasks.decisions import Recording, Seat
@@ -42,7 +42,9 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
     """Run one spec; returns (rows, result). A planner that raises or exits (``sys.exit``
     included) gives one row with outcome ``error`` and the message; a run past
     ``experiment.run_time_limit`` s of wall-clock time, one with outcome ``timeout``; either
-    way the rest of the batch goes on."""
+    way the rest of the batch goes on. A run that failed for a cause outside it
+    (:class:`~semsearch_cli.errors.Unavailable`: a service that did not answer; a missing package)
+    is an ``error`` whose message starts with ``unavailable:``, which a resumed batch runs again."""
     task = loaded.task
     limit = loaded.sc.experiment.run_time_limit
     empty = np.zeros((0, 2), np.float32)
@@ -66,6 +68,8 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
     except RunTimeout:
         res = RunResult("timeout", math.nan, 0, 0, limit, empty,
                         message=f"the run took longer than {limit:g} s of wall-clock time (experiment.run_time_limit)")
+    except (Unavailable, MissingExtra) as exc:  # a cause outside the run: recorded, and run again by the same command
+        res = RunResult("error", math.nan, 0, 0, 0.0, empty, message=f"{UNAVAILABLE}{exc}")
     except (Exception, SystemExit) as exc:  # a user's planner (or a bug): recorded, not fatal to the batch
         where = traceback.extract_tb(exc.__traceback__)[-1]
         msg = f"{type(exc).__name__}: {exc} ({Path(where.filename).name}:{where.lineno})"

@@ -15,7 +15,7 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Iterable, Iterator
 
-from ..errors import BatchStopped, ScenarioError
+from ..errors import BatchStopped, ScenarioError, did_you_mean
 from ..registry import Registry
 from .execution import Executor, Watch, run_and_save
 from .specs import Loaded, RunSpec
@@ -123,7 +123,7 @@ def process_executor(workers: int, start_method: str | None, address: str | None
 def check_kind(kind: str) -> None:
     """A :class:`ScenarioError` for ``--executor`` unless ``kind`` is one of :data:`EXECUTORS`."""
     if kind not in EXECUTORS:
-        raise ScenarioError("<command line>", "--executor", f"unknown executor {kind!r}; valid: {', '.join(EXECUTORS)}")
+        raise ScenarioError("<command line>", "--executor", f"unknown executor {kind!r}{did_you_mean(kind, EXECUTORS)}; valid: {', '.join(EXECUTORS)}")
 
 
 def make_executor(workers: int, start_method: str | None = None, kind: str = "processes", address: str | None = None,

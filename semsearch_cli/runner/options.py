@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ScenarioError
-from .cluster import check_address
+from .cluster import check_address, require
 from .executors import check_kind
 
 MAX_WORKERS = 512  # even with --oversubscribe
@@ -57,6 +57,8 @@ class BatchOptions:
         ``oversubscribe``. With a scheduler the cluster's own workers run the batch, and
         ``workers`` is not checked."""
         check_kind(self.executor)
+        if self.executor == "dask":
+            require()  # its package, before anything is written
         if self.scheduler is not None and self.executor != "dask":
             raise ScenarioError("<command line>", "--scheduler", "a scheduler address goes with --executor dask")
         if self.scheduler is not None and not self.scheduler.strip():
