@@ -214,7 +214,8 @@ def test_ten_thousand_fuzzed_replies_give_no_traceback_and_every_one_is_counted(
     planners, decisions = [], 0
     with ChatServer(fuzz) as srv:
         for mode, upto in (("actor", 6_000), ("estimator", 10_000)):  # the first 6,000 replies to an actor, then an estimator
-            p = LlmPlanner(LlmParams(base_url=srv.base_url, model="fuzz", mode=mode, retries=0, timeout_s=0.5, max_calls=10**6))
+            p = LlmPlanner(LlmParams(base_url=srv.base_url, model="fuzz", mode=mode, retries=0, timeout_s=0.5, max_calls=10**6,
+                                     unavailable_after=0))  # the counting measured, not the stop of a failing model
             p.start_run({"scenario": "demo", "planner": "llm", "goal": "304", "episode": 0, "seed": 0})
             planners.append(p)
             while len(srv.requests) < upto:
@@ -449,3 +450,122 @@ def test_a_report_never_calls_the_model(tmp_path):
     gifs = sorted(p.name for p in (tmp_path / "report").rglob("replay_*.gif"))
     assert gifs and all("greedy" in g for g in gifs)
     assert not list((tmp_path / "again").rglob("replay_*.gif"))
+
+
+# ---- a model that does not answer is never a result ---------------------------------------------
+def closed_port() -> int:
+    """A loopback port nothing listens on (bound, then let go)."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def refused(tmp_path: Path, entry: dict, env: dict | None = None) -> str:
+    """``semsearch run`` of the demo with greedy and ``entry``: exit 2 before any row, in under 10 s;
+    its output."""
+    import time
+
+    sc = scenario(tmp_path, [{"name": "greedy"}, entry], seeds=1)
+    t0 = time.monotonic()
+    res = CliRunner().invoke(app, ["run", str(sc), "--out", str(tmp_path / "out"), "--workers", "1"], env=env)
+    assert res.exit_code == 2, res.output
+    assert time.monotonic() - t0 < 10.0  # fails fast: no retries, a short timeout
+    assert not (tmp_path / "out" / "runs.csv").exists() or len(pd.read_csv(tmp_path / "out" / "runs.csv")) == 0
+    assert "Traceback" not in res.output and res.output.startswith("error: ")
+    return " ".join(res.output.split())
+
+
+def test_a_server_that_answers_500_is_refused_before_the_first_run(tmp_path):
+    with ChatServer(models=["scripted"], status=500) as srv:
+        text = refused(tmp_path, llm(srv))
+        assert srv.gets == ["/v1/models"] and srv.requests == []  # one look, no call
+    assert f"field 'planners.base_url': llm[base_url={srv.base_url},model=scripted]: the server at {srv.base_url} " \
+           f"answered HTTP 500 at {srv.base_url}/models" in text
+
+
+def test_a_base_url_without_v1_is_refused_naming_v1(tmp_path):
+    with ChatServer(models=["scripted"]) as srv:
+        bare = srv.base_url[:-len("/v1")]
+        text = refused(tmp_path, {**llm(srv), "base_url": bare})
+    assert f"the server at {bare} answered HTTP 404 at {bare}/models: an OpenAI-compatible server serves under /v1, and " \
+           f"base_url does not end in /v1 (e.g. {bare}/v1)" in text
+
+
+def test_a_closed_port_is_refused_at_once(tmp_path):
+    url = f"http://127.0.0.1:{closed_port()}/v1"
+    text = refused(tmp_path, {"name": "llm", "base_url": url, "model": "m"})
+    assert f"field 'planners.base_url': llm[base_url={url},model=m]: no connection to {url} (ConnectError" in text
+
+
+def test_a_key_the_server_wants_and_the_variable_unset_are_refused(tmp_path, monkeypatch):
+    monkeypatch.delenv("OPENAI_API_KEY", raising=False)
+    monkeypatch.delenv("SEMSEARCH_TEST_KEY", raising=False)
+    with ChatServer(models=["scripted"], key="sk-right") as srv:
+        text = refused(tmp_path / "a", llm(srv))  # the default variable, unset: the server says 401
+        assert f"planners.base_url': llm[base_url={srv.base_url},model=scripted]: the server at {srv.base_url} answered " \
+               "HTTP 401 (not authorised): the variable OPENAI_API_KEY (api_key_env) is not set" in text
+        text = refused(tmp_path / "b", llm(srv, api_key_env="SEMSEARCH_TEST_KEY"))  # a variable named and unset: no request
+        assert "field 'planners.api_key_env'" in text and "api_key_env names the variable SEMSEARCH_TEST_KEY, which is " \
+               "not set in this environment" in text
+        assert len(srv.gets) == 1
+        monkeypatch.setenv("SEMSEARCH_TEST_KEY", "sk-wrong")
+        text = refused(tmp_path / "c", llm(srv, api_key_env="SEMSEARCH_TEST_KEY"))
+        assert "answered HTTP 401 (not authorised): the key in SEMSEARCH_TEST_KEY (api_key_env) was refused" in text
+        monkeypatch.setenv("SEMSEARCH_TEST_KEY", "sk-right")  # the right key: the batch runs
+        sc = scenario(tmp_path / "d", [llm(srv, api_key_env="SEMSEARCH_TEST_KEY")], seeds=1, goals=[452])
+        api.run(sc, BatchOptions(out=tmp_path / "d" / "out", workers=1), plots=False)
+    assert rows_of(tmp_path / "d" / "out", "llm")["outcome"].tolist() == ["found"]
+
+
+def test_a_model_the_server_does_not_list_is_refused(tmp_path):
+    with ChatServer(models=["qwen2.5:7b", "llama3.1:8b"]) as srv:
+        text = refused(tmp_path, llm(srv))
+        assert srv.requests == []
+    assert f"field 'planners.model': llm[base_url={srv.base_url},model=scripted]: the server at {srv.base_url} does not " \
+           "serve the model 'scripted'; it lists qwen2.5:7b, llama3.1:8b" in text
+
+
+def test_a_base_url_without_a_scheme_is_a_scenario_error(tmp_path):
+    sc = scenario(tmp_path, [{"name": "llm", "base_url": "localhost:8000", "model": "m"}])
+    res = CliRunner().invoke(app, ["validate", str(sc)])
+    assert res.exit_code == 2 and "field 'planners[0].base_url'" in res.output
+    assert "'localhost:8000' is not an http:// or https:// address with a host; write it whole, e.g. " \
+           "http://localhost:8000/v1" in " ".join(res.output.split())
+
+
+def test_a_run_whose_model_fails_ends_error_unavailable_not_found(tmp_path):
+    # the endpoint answers its list of models (the look before the batch passes), then 500 to every call
+    with ChatServer(lambda r, n: Answer(status=500), models=["scripted"]) as srv:
+        sc = scenario(tmp_path, [llm(srv, retries=0)], seeds=1, goals=[452])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+    row = rows_of(tmp_path / "out", "llm").iloc[0]
+    assert row["outcome"] == "error" and "unavailable" in row["message"].lower()
+    assert "every call of its first 3 decisions was invalid (9 calls; the last: HTTP 500 from the server)" in row["message"]
+    assert (row["llm_calls"], row["fallbacks"]) == (9, 3) and len(srv.requests) == 9  # 3 decisions x (1 + 2 re-asks)
+    # a model that answers its first decision, then nothing: more than half its decisions fell back by the end
+    with ChatServer(lambda r, n: first_target(r, n) if n == 0 else Answer("I am not sure."), models=["scripted"]) as srv:
+        sc = scenario(tmp_path, [llm(srv, reasks=0)], seeds=1, goals=[452])
+        api.run(sc, BatchOptions(out=tmp_path / "out2", workers=1), plots=False)
+    row = rows_of(tmp_path / "out2", "llm").iloc[0]
+    assert row["outcome"] == "error" and f"{row['fallbacks']} of its {row['fallbacks'] + 1} decisions fell back (more " \
+        "than max_fallback_share = 0.5); the last failure: the reply is not one number" in row["message"], row["message"]
+
+
+def test_without_openai_run_bench_and_dry_run_refuse_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    sc = scenario(tmp_path, [{"name": "greedy"}, {"name": "llm", "base_url": "http://127.0.0.1:9/v1", "model": "m"}], seeds=1)
+    no_openai = "import sys; sys.modules['openai'] = None; from semsearch_cli.cli import main; sys.argv[0] = 'semsearch'; main()"
+    line = "the llm planner needs the llm extra: pip install 'semsearch[llm]'"
+    for args, out in ((["run", str(sc), "--out", str(tmp_path / "r")], tmp_path / "r"),
+                      (["run", str(sc), "--dry-run", "--out", str(tmp_path / "d")], tmp_path / "d"),
+                      (["bench", "run", "doors-classic-v1", "--planner", "llm[base_url=http://127.0.0.1:9/v1,model=m]",
+                        "--out", str(tmp_path / "b"), "--limit", "1"], tmp_path / "b")):
+        res = subprocess.run([sys.executable, "-c", no_openai, *args], capture_output=True, text=True, timeout=120,
+                             env={**os.environ, "PYTHONPATH": str(ROOT), "COLUMNS": "400"})
+        assert res.returncode == 2, (args, res.stderr)
+        assert len(res.stderr.strip().splitlines()) == 1 and line in res.stderr and "Traceback" not in res.stderr, res.stderr
+        assert not list(out.rglob("runs.csv")) or all(len(pd.read_csv(f)) == 0 for f in out.rglob("runs.csv"))

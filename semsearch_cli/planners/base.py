@@ -215,6 +215,15 @@ class Planner:
         planner's prompt and transcripts). Nothing by default."""
         return ""
 
+    @classmethod
+    def preflight(cls, params: BaseModel) -> tuple[str, str] | None:
+        """What stops the planner from running at all (the field to name, the message), looked
+        at once per batch, before its first run, in the process that starts the batch: a package
+        it needs, a service it answers through that does not answer (the llm planner's endpoint,
+        docs/llm.md). None when nothing does (the default): a batch then refuses to start rather
+        than record runs that could not be the planner's."""
+        return None
+
 
 class DoorPlanner(Planner):
     """A door-search planner: ``choose(ctx, cands)`` gets a :class:`DoorContext` and the
@@ -655,6 +664,27 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                 seen.add(key)
                 out.append(v)
     return out
+
+
+def has_preflight(cls: type[Planner]) -> bool:
+    """Whether a planner class looks before it runs (overrides :meth:`Planner.preflight`)."""
+    return getattr(cls.preflight, "__func__", None) is not Planner.preflight.__func__
+
+
+def preflight(variants, file: str, field: str | None = None) -> None:
+    """Refuse (a :class:`ScenarioError` naming ``file``, the planner and the field, or ``field``
+    when given: ``--planner`` for a planner the command line named) the first of ``variants``
+    whose planner's :meth:`Planner.preflight` finds it cannot run; each distinct planner and
+    parameters is looked at once."""
+    seen = set()
+    for v in variants:
+        cls = planner_class(v)
+        if not has_preflight(cls) or (v.name, v.params) in seen:
+            continue
+        seen.add((v.name, v.params))
+        fault = cls.preflight(v.resolved(cls))
+        if fault:
+            raise ScenarioError(file, field or f"planners.{fault[0]}", f"{v.label}: {fault[1]}")
 
 
 def _parameters(cls: type[Planner]) -> str:

@@ -15,6 +15,7 @@ from ..errors import DISK_FULL, UNAVAILABLE, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
 from ..metrics import columns_for
 from ..planners import code_of, planner_class
+from ..planners.base import has_preflight, preflight
 from .execution import Executor, Watch
 from .executors import SerialExecutor, make_executor
 from .options import BatchOptions
@@ -224,6 +225,8 @@ class Batch:
         todo = (s for s in specs if s.key not in have)
         if total >= MANY_RUNS:
             print(f"runs: {total:,} to do ({len(self.variants):,} planner variant(s) x goals, episodes and seeds)", file=sys.stderr)
+        if total:  # a planner that cannot run at all (a language model's endpoint that does not answer): refused here
+            preflight(_pending(self.variants, specs, have), str(loaded.path))
         if total and executor == "processes" and runner is None:
             check_memory(loaded, max(1, min(workers, total)))
         if runner is None:
@@ -255,6 +258,22 @@ class Batch:
             except OSError:
                 pass
         return read_runs(runs_csv)
+
+
+def _pending(variants, specs, have: set) -> list:
+    """The variants whose planner looks before it runs (:meth:`~semsearch_cli.planners.Planner.preflight`)
+    with a run left to do (a spec whose key is not in ``have``); a pass over the specs that stops
+    once every such variant is found (none: no pass)."""
+    left, found = {v for v in variants if has_preflight(planner_class(v))}, []
+    if not left:
+        return found
+    for s in specs:
+        if s.variant in left and s.key not in have:
+            left.discard(s.variant)
+            found.append(s.variant)
+            if not left:
+                break
+    return found
 
 
 def run_batch(loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),

@@ -24,15 +24,18 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from ...errors import ScenarioError
 from ...files import cache_dir
 from ...optional import lazy_module
 
-openai = lazy_module("openai")  # optional: pip install 'semsearch[llm]'
+openai = lazy_module("openai", "llm")  # optional: pip install 'semsearch[llm]'
 
 NO_KEY = "not-needed"  # what the client sends when api_key_env is unset (local servers ignore the key)
 SLOT_WAIT_S = 0.01  # s between looks for a free request slot
+PREFLIGHT_TIMEOUT_S = 5.0  # s the check of an endpoint before a batch waits for the server (no retries)
+MISSING = "the llm planner needs the llm extra: pip install 'semsearch[llm]'"  # the openai package, not installed
 
 
 @dataclass
@@ -81,11 +84,64 @@ class Slots:
             fh.close()
 
 
-def require_openai(where: str) -> None:
+def require_openai(where: str, field: str = "name") -> None:
     """A :class:`ScenarioError` naming ``where`` when the ``openai`` package is not installed."""
     if openai is None:
-        raise ScenarioError(where, "name", "the llm planner talks to its model through the openai package, which is not "
-                            "installed: pip install 'semsearch[llm]'")
+        raise ScenarioError(where, field, MISSING)
+
+
+def url_fault(base_url: str) -> str | None:
+    """What is wrong with ``base_url`` as written (no scheme, no host), or None."""
+    parts = urlsplit(base_url.strip())
+    if parts.scheme not in ("http", "https") or not parts.netloc:
+        example = "http://" + base_url.strip().split("://")[-1].rstrip("/") if base_url.strip() else "http://localhost:8000"
+        if not example.endswith("/v1"):
+            example += "/v1"
+        return (f"{base_url!r} is not an http:// or https:// address with a host; write it whole, e.g. {example}")
+    return None
+
+
+def preflight(base_url: str, model: str, api_key_env: str, key_named: bool) -> tuple[str, str] | None:
+    """One look at the endpoint before a batch's first run (docs/llm.md, Before the first run): the
+    address (http or https, a host), the key's variable set when the scenario names one, the server
+    reachable within :data:`PREFLIGHT_TIMEOUT_S` s, its list of models (``GET base_url/models``)
+    holding ``model`` when the server lists models. Returns the parameter at fault and what
+    failed, in a sentence, or None.
+    A ``base_url`` whose path does not end in ``/v1`` and that answers 404 is named as such."""
+    bad = url_fault(base_url)
+    if bad:
+        return "base_url", bad
+    key = os.environ.get(api_key_env)
+    if key_named and not key:
+        return "api_key_env", (f"api_key_env names the variable {api_key_env}, which is not set in this environment: export "
+                f"{api_key_env}=<your key> (or leave api_key_env out for a local server that takes no key)")
+    client = openai.OpenAI(base_url=base_url, api_key=key or NO_KEY, timeout=PREFLIGHT_TIMEOUT_S, max_retries=0)
+    at = base_url.rstrip("/") + "/models"
+    try:
+        listed = [str(getattr(m, "id", "")) for m in client.models.list().data]
+    except openai.APIStatusError as exc:
+        code = exc.status_code
+        if code in (401, 403):
+            why = (f"the variable {api_key_env} (api_key_env) is not set" if not key else
+                   f"the key in {api_key_env} (api_key_env) was refused")
+            return "base_url" if not key_named else "api_key_env", f"the server at {base_url} answered HTTP {code} (not authorised): {why}"
+        if code == 404 and not urlsplit(base_url).path.rstrip("/").endswith("/v1"):
+            return "base_url", (f"the server at {base_url} answered HTTP 404 at {at}: an OpenAI-compatible server serves under /v1, "
+                    f"and base_url does not end in /v1 (e.g. {base_url.rstrip('/')}/v1)")
+        if code in (404, 405, 501):  # a server that does not list its models: it answered, which is what can be checked
+            return None
+        return "base_url", f"the server at {base_url} answered HTTP {code} at {at}"
+    except openai.APITimeoutError:
+        return "base_url", f"no answer from {base_url} within {PREFLIGHT_TIMEOUT_S:g} s"
+    except openai.APIConnectionError as exc:
+        cause = exc.__cause__ or exc
+        return "base_url", f"no connection to {base_url} ({type(cause).__name__}: {str(cause)[:160]})"
+    except Exception:  # noqa: BLE001  (a reply that is not a list of models: the server answered, it lists nothing)
+        return None
+    if listed and model not in listed:
+        shown = ", ".join(listed[:10]) + (f" and {len(listed) - 10} more" if len(listed) > 10 else "")
+        return "model", f"the server at {base_url} does not serve the model {model!r}; it lists {shown}"
+    return None
 
 
 class Chat:

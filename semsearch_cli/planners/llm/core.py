@@ -11,6 +11,13 @@ Every call, reply and fallback is counted in the run's row (``llm_calls``, ``tok
 (:mod:`.transcript`). A run whose calls reach ``max_calls`` (or whose tokens reach
 ``max_run_tokens``) ends as ``budget``.
 
+A model that does not answer is never a result: a run whose first ``unavailable_after``
+decisions (3) all fell back (every call of each invalid), or more than ``max_fallback_share``
+(one half) of whose decisions fell back by its end, stops with :class:`~semsearch_cli.errors.Unavailable`
+(outcome ``error``, a message that starts ``unavailable:`` and says why; the same command runs it
+again). Before a batch's first run, :meth:`LlmCore.preflight` looks at the endpoint once
+(:func:`.client.preflight`).
+
 ``mode: estimator`` (door and object search): the model answers, as JSON, its probability
 ``p_i`` that the goal lies at (beyond) each choice ``i``, and the planner chooses by expected
 cost. With ``d_i`` the distance to choice ``i`` (m) and ``d_mean`` the mean over the choices
@@ -30,9 +37,10 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from ...errors import BudgetSpent, PlannerError, ScenarioError
+from ...errors import BudgetSpent, PlannerError, ScenarioError, Unavailable
 from ..base import COST_COLUMNS, Planner
-from .client import Chat, Reply, prompt_path, require_openai
+from . import client
+from .client import Chat, Reply, prompt_path, require_openai, url_fault
 from .replies import parse_number, parse_probabilities
 from .transcript import folder_text, header, index, read, replan_on_signs, run_key
 
@@ -87,6 +95,10 @@ class LlmParams(BaseModel):
     max_calls: int = Field(2000, ge=1, le=1_000_000, description="calls per run; then the run ends as budget")
     max_run_tokens: int | None = Field(None, ge=1, description="tokens in and out per run; then the run ends as budget")
     reasks: int = Field(2, ge=0, le=10, description="times an invalid reply is asked again before the fallback")
+    unavailable_after: int = Field(3, ge=0, le=1000, description="a run whose first this many decisions all fell back "
+                                   "ends error (unavailable); 0: never")
+    max_fallback_share: float = Field(0.5, ge=0.0, le=1.0, description="a run more of whose decisions fell back ends "
+                                      "error (unavailable); 1: never")
     max_targets: int = Field(16, ge=1, le=254, description="door search: frontier targets shown, nearest first")
     lattice: float = Field(0.5, ge=0.05, le=5.0, description="indirect search: m between the lattice points offered")
     max_concurrent: int = Field(4, ge=1, le=256, description="requests in flight to the endpoint from this machine")
@@ -138,6 +150,7 @@ class LlmCore(Planner):
         self.run: dict = {}
         self.transcript: list[dict] = []
         self.calls = self.tokens_in = self.tokens_out = self.invalid = self.fallbacks = 0
+        self.last_failure = ""  # why the last decision that fell back did
         self.llm_s = 0.0
         self.decision = 0
         self.spent = ""
@@ -163,6 +176,8 @@ class LlmCore(Planner):
         if params.replay is None and not params.model.strip():
             return "model", ("name the model the server serves (e.g. model: qwen2.5-7b-instruct), or replay "
                              "transcripts (replay: DIR)")
+        if params.replay is None and url_fault(params.base_url):
+            return "base_url", url_fault(params.base_url)
         if kind in MODES and params.mode not in MODES[kind]:
             return "mode", (f"{kind} search takes mode {' or '.join(MODES[kind])}: its choices are poses of a lattice, "
                             "not places a probability can be put on" if kind == "indirect" else
@@ -173,6 +188,17 @@ class LlmCore(Planner):
             except ScenarioError as exc:
                 return "prompt", f"{exc.file}: {exc.message}"
         return None
+
+    @classmethod
+    def preflight(cls, params: LlmParams) -> tuple[str, str] | None:
+        """Before a batch's first run: the ``openai`` package installed, and the endpoint answering
+        (:func:`.client.preflight`); nothing for a replay, which calls nothing."""
+        if params.replay is not None:
+            return None
+        if client.openai is None:
+            return "name", client.MISSING
+        fault = client.preflight(params.base_url, params.model, params.api_key_env, "api_key_env" in params.model_fields_set)
+        return fault
 
     @classmethod
     def inputs(cls, params: LlmParams) -> str:
@@ -248,7 +274,14 @@ class LlmCore(Planner):
                 "invalid_replies": self.invalid, "fallbacks": self.fallbacks, "llm_s": round(self.llm_s, 3)}
 
     def finish_run(self) -> None:
-        """A replay must use its transcript up: a run that asked fewer calls went another way."""
+        """A replay must use its transcript up: a run that asked fewer calls went another way. A
+        run more than ``max_fallback_share`` of whose decisions fell back is not the model's
+        (:class:`Unavailable`)."""
+        live = self._live
+        if self.decision and self.fallbacks > live.max_fallback_share * self.decision:
+            raise Unavailable(f"the llm planner's model failed: {self.fallbacks} of its {self.decision} decisions fell back "
+                              f"(more than max_fallback_share = {live.max_fallback_share:g}); the last failure: "
+                              f"{self.last_failure}")
         if self._replay is not None and self.calls < len(self._replay):
             raise PlannerError(f"replay of run {self.describe_run()}: the run ended after {self.calls} calls, and the "
                                f"transcript holds {len(self._replay)} (the run went another way: another budget or map?)")
@@ -291,7 +324,11 @@ class LlmCore(Planner):
                 return pick, {"attempts": attempt + 1}
             self.invalid += 1
         self.fallbacks += 1
+        self.last_failure = reason
         self.transcript.append({"type": "fallback", "decision": k, "choice": fallback, "reason": reason})
+        if live.unavailable_after and self.fallbacks == self.decision == live.unavailable_after:
+            raise Unavailable(f"the llm planner's model failed: every call of its first {self.decision} decisions was "
+                              f"invalid ({self.invalid} calls; the last: {reason})")
         return fallback, {"fallback": True}
 
     def check_budget(self) -> None:
