@@ -4,14 +4,16 @@ alone. A section a kind does not take is refused, naming it; a section a kind to
 without using it is ignored with a DeprecationWarning, and the scenario's fingerprint is the one
 0.2.0 gave (a results folder of 0.2.0 resumes)."""
 
+import re
 import subprocess
 import sys
 import warnings
 
 import pytest
 import yaml
+from packaging.version import Version  # matplotlib's dependency
 
-from semsearch_cli import api
+from semsearch_cli import __version__, api
 from semsearch_cli.config import KINDS, SIGN_SECTIONS, load_scenario
 from semsearch_cli.errors import ScenarioError
 from semsearch_cli.runner import Loaded
@@ -72,3 +74,14 @@ def test_the_command_line_shows_the_warning_on_one_line_naming_the_file(tmp_path
     line = next(ln for ln in res.stderr.splitlines() if "laser" in ln)
     assert line.startswith("DeprecationWarning: the laser section of a scenario of kind indirect (") and str(path) in line
     assert "specs.py" not in res.stderr  # semsearch's own line is not the user's business
+
+
+def test_a_deprecation_never_names_a_release_after_the_one_being_made(tmp_path):
+    """A warning says "deprecated since X": X is at most the release this version leads to (a
+    development version 0.3.0.dev0 leads to 0.3.0), so no user reads of a version they do not have."""
+    path = api.init("indirect_quick", tmp_path / "copy")[0]
+    path.write_text(path.read_text() + "laser:\n  range: 6.0\n")
+    with pytest.warns(DeprecationWarning) as caught:
+        load_scenario(path)
+    (since,) = {m.group(1) for w in caught if (m := re.search(r"deprecated since semsearch (\S+) ", str(w.message)))}
+    assert Version(since) <= Version(Version(__version__).base_version)
