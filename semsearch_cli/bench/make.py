@@ -26,6 +26,7 @@ from ..world.buildings.numbered import generate_building
 from ..world.buildings.office import random_office
 from ..world.rooms import generate_rooms, write_rooms
 from .predictability import predictability
+from .solvable import solvable_episodes
 from .suites import Suite, write_manifest
 
 DEFAULT_PLANNER = [{"name": "nsos", "alpha": 0.9}]  # what `semsearch run FLOOR/scenario.yaml` runs; a bench run sets its own
@@ -38,12 +39,14 @@ def floor_rng(salt: str, suite: str, split: str, i: int) -> np.random.Generator:
     return np.random.default_rng([int(w) for w in words])
 
 
-def freeze_episodes(scenario: Path, repeats: int) -> int:
+def freeze_episodes(scenario: Path, repeats: int, rng: np.random.Generator | None = None) -> int:
     """Draw (or take) the scenario's episodes, write them to ``episodes.csv`` beside it and make
-    the scenario read that file (``repeats`` runs of each): the floor's episodes frozen. Returns
-    their number."""
+    the scenario read that file (``repeats`` runs of each): the floor's episodes frozen. Every
+    episode is checked to be solvable (:mod:`.solvable`); a drawn one that is not is drawn again
+    by ``rng`` (the builder's own generator), a given one (or any, without ``rng``) is an error.
+    Returns their number."""
     loaded = Loaded.load(scenario)
-    eps = loaded.task.episodes
+    eps, _ = solvable_episodes(loaded.task, repeats, rng)
     rows = pd.DataFrame([loaded.task.episode_row(e) for e in eps], columns=EPISODE_COLUMNS)
     rows.to_csv(scenario.parent / "episodes.csv", index=False, lineterminator="\n")
     doc = yaml.safe_load(scenario.read_text())
@@ -125,7 +128,7 @@ def make_doors_v1(split: str, salt: str, out: Path) -> None:
             rest = [a for a in labels if str(a) not in {str(g) for g in doc["goals"]}]
             doc["goals"] += [int(a) if a.isdigit() else a for a in rng.choice(rest, 4 - len(doc["goals"]), replace=False)]
         path.write_text(path.read_text().split("\n", 1)[0] + "\n" + yaml.safe_dump(doc, sort_keys=False))
-        freeze_episodes(path, 1)
+        freeze_episodes(path, 1, rng)  # an unsolvable start drawn again, after every other draw of the floor's
         d = pd.read_csv(path.parent / "doors.csv", dtype={"number": str}, keep_default_na=False)
         p = predictability(d["number"].tolist(), d["x"], d["y"], d["facing"], fid)
         floors.append((fid, {"generator": "building", **r, "signs": len(d),
