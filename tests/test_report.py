@@ -42,8 +42,20 @@ def test_statistics_match_pandas():
             assert five.loc[("s", goal, stat), lab] == pytest.approx(want, abs=1e-3)
     pct = T.percent_of_optimal(runs)
     g = runs[(runs.goal == 54) & (runs.planner == "bvp")]
-    assert pct.loc[("s", 54), "bvp"] == pytest.approx(100 * g["distance_m"].mean() / 17.5, abs=0.01)
+    assert pct.loc[("s", 54), "bvp"] == pytest.approx(100 * g["distance_m"].mean() / 17.5, abs=0.01)  # one start: both readings agree
     assert list(five.columns) == ["greedy", "bvp", "nsos[alpha=0.9]"]
+
+
+def test_table_4_10_and_the_alpha_figure_show_one_ratio_the_mean_of_each_runs_own():
+    """From two starts of shortest paths 10 m and 40 m, runs of 20 m and 40 m: the ratios are 2
+    and 1, their mean 1.5 (150 %); the mean distance over the mean shortest path would be 30 / 25
+    = 120 %. Table 4.10 and the summary's mean_ratio (which the alpha figure draws) both give 150."""
+    rows = [{"scenario": "s", "planner": "greedy", "params": "{}", "goal": 7, "episode": e, "seed": 0, "outcome": "found",
+             "success": 1, "distance_m": d, "shortest_m": sp, "ratio": d / sp, "spl": sp / d, "steps": 1, "decisions": 1,
+             "navigator": "geodesic", "wall_s": 0.1} for e, d, sp in ((0, 20.0, 10.0), (1, 40.0, 40.0))]
+    runs = pd.DataFrame(rows, columns=COLUMNS)
+    assert T.percent_of_optimal(runs).loc[("s", 7), "greedy"] == 150.0
+    assert T.summarise(runs)["mean_ratio"].tolist() == [1.5]
 
 
 def test_significance_is_paired_on_shared_seeds():

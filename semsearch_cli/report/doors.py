@@ -53,7 +53,8 @@ def section(doc: Document, parts: list, out: Path, formats: set, replay: bool, n
     doc.para(f"{units}; n in brackets after each interval. The interval is a BCa bootstrap (9999 resamples, "
              "drawn as scipy.stats.bootstrap draws them) of the mean of the per-unit mean distances.")
     doc.table(tabs["mean_ci"])
-    doc.heading(3, "Mean as percent of the shortest path (Table 4.10)")
+    doc.heading(3, "Mean ratio to the shortest path, in percent (Table 4.10)")
+    doc.para(T.RATIO[0].upper() + T.RATIO[1:] + ", times 100.")
     doc.table(tabs["percent_of_optimal"], mark_rows=True)
     doc.heading(3, "Success rate and SPL")
     doc.para(f"success_lo-success_hi: the Wilson interval at the effective sample size n / deff, deff being Kish's "
@@ -105,7 +106,8 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
         if len(swept_values(sub)) >= 2:
             f = fdir / f"alpha_{scen}.png"
             plot_alpha_sweep(sub, f, formats=img, colors=colors)
-            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}, with 95% intervals over {unit}; "
+            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}, with 95% intervals over {unit} "
+                          f"({T.RATIO}; the figure's y axis as Table 4.10 gives it in percent); "
                           "dashed and shaded: greedy's mean and interval")
     for part in parts:
         loaded = part.loaded(notes, "Path figures and the replay")

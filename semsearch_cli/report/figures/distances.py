@@ -259,7 +259,7 @@ def plot_alpha_sweep(runs, out: Path, baseline: str | None = None, formats=("png
         if ax.get_subplotspec().is_last_row() or len(goals) - goals.index(g) <= 2:
             ax.set_xlabel(xlabel)
         if ax.get_subplotspec().is_first_col():
-            ax.set_ylabel("distance / shortest path")
+            ax.set_ylabel("mean of distance / shortest path")
     n_a = sorted(set(n_alpha.tolist()))
     n_b = sorted(set(n_base.tolist()))
     handles = [Line2D([], [], c="0.3", marker="o", mfc="0.6", mec="black", ms=4,
