@@ -24,7 +24,7 @@ from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points, planner_class
-from .planners.base import path_fields
+from .planners.base import load_planner_file, path_fields
 from .planners.llm import FirstPrompt
 from .plugins import load_kinds
 from .report import build as report_build
@@ -756,11 +756,15 @@ def planner_spec(text: str, module: str | Path | None = None) -> PlannerSpec:
         if not eq or not key.strip():
             raise ScenarioError("<command line>", "--planner", f"{text!r}: {item!r} is not key=value")
         params[key.strip()] = yaml.safe_load(value)
-    if module is not None:
+    if module is not None:  # the file's planners come from it; a built-in (or installed) planner beside them does not
         mod = Path(module)
         if not mod.is_file():
             raise ScenarioError(str(mod), "", "no such planner file (--planner-file)")
-        params["module"] = str(mod.resolve())
+        mine = load_planner_file(mod)
+        if m["name"] not in mine and m["name"] not in PLANNERS:
+            load_entry_points()  # a planner of an installed package, named beside the file's
+        if m["name"] in mine or m["name"] not in PLANNERS:
+            params["module"] = str(mod.resolve())
     cls = PLANNERS.get(m["name"])
     for k in path_fields(cls.Params) if cls is not None else ():  # a file named here is relative to this folder, not the floor's
         if isinstance(params.get(k), str) and not Path(params[k]).is_absolute():

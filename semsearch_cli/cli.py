@@ -268,6 +268,17 @@ def _warn_errors(runs) -> None:
                          f"{errors['planner'].iloc[0]}: {errors['message'].iloc[0]}", highlight=False)
 
 
+def _fallback_lines(runs) -> None:
+    """The batch's last lines: per planner that has a fallback (a language model's), the share of
+    its decisions that fell back (docs/llm.md)."""
+    from .metrics import FALLBACK_FLAG, fallback_shares
+
+    for label, n, asked in fallback_shares(runs):
+        share = n / asked if asked else 0.0
+        flag = f" (more than {FALLBACK_FLAG:.0%}: the bench board marks it)" if share > FALLBACK_FLAG else ""
+        out.print(f"fell back: {label}: {n} of {asked} decisions ({share:.1%}){flag}", highlight=False, soft_wrap=True)
+
+
 def _batch(call):
     """Run a batch with a progress bar, print its summary; bad input exits with status 2."""
     res = _with_progress(call)
@@ -276,6 +287,7 @@ def _batch(call):
     _warn_errors(res.runs)
     out.print(f"rows: {res.out / 'runs.csv'}  summary: {res.out / 'summary.csv'}  figures: {res.out / 'figures'}  "
                      f"report: {res.out / 'report.md'}")
+    _fallback_lines(res.runs)
     return res
 
 
@@ -659,7 +671,8 @@ def bench_run(
                                                     planner_file, progress=tick))
     runs = res.runs[res.runs["stage"] == ""]
     t = Table(title=f"{res.split.suite.name} {res.split.name}, numbering {res.numbering} ({len(res.floors)} floors; "
-                    f"hash {res.split.hash[:16]}{', official' if res.split.official else ''})")
+                    f"hash {res.split.hash[:16]}{', official' if res.split.official and not res.partial else ''}"
+                    f"{'; partial: not every run of the split is in the folder, never official' if res.partial else ''})")
     for col in ("planner", "runs", "success", "SPL", "mean distance m"):
         t.add_column(col, justify="left" if col == "planner" else "right")
     for label, g in runs.groupby("planner", sort=False):
@@ -667,6 +680,7 @@ def bench_run(
     out.print(t)
     _warn_errors(runs)
     out.print(f"results: {res.out} (verify: semsearch verify {res.out})")
+    _fallback_lines(runs)
 
 
 @bench_app.command("board")

@@ -30,6 +30,29 @@ def columns_for(kind_columns) -> list[str]:
     k = COLUMNS.index("navigator")
     return COLUMNS[:k] + extra + COLUMNS[k:]
 
+FALLBACK_FLAG = 0.05  # a share of a planner's decisions fallen back above this is marked (the bench board, docs/bench-board.md)
+
+
+def fallback_shares(rows) -> list[tuple[str, int, int]]:
+    """Per planner whose rows count fallbacks (a language model's: the ``fallbacks`` cost
+    column), in the rows' order: (label, decisions that fell back, decisions asked). A decision
+    ends in one valid reply or in the fallback, so the decisions asked are ``llm_calls -
+    invalid_replies + fallbacks`` (a decision cut short by the run's budget is not counted)."""
+    import pandas as pd
+
+    if not len(rows) or "fallbacks" not in rows.columns:
+        return []
+    out = []
+    for label, g in rows.groupby("planner", sort=False):
+        f = pd.to_numeric(g["fallbacks"], errors="coerce")
+        if not f.notna().any():
+            continue
+        valid = pd.to_numeric(g["llm_calls"], errors="coerce") - pd.to_numeric(g["invalid_replies"], errors="coerce")
+        n = int(f.sum())
+        out.append((str(label), n, int(valid.sum()) + n))
+    return out
+
+
 # the failure cause of each outcome (empty for a run that found its goal)
 CAUSES = {"found": "", "not_found": "explored", "stuck": "stuck", "budget": "budget", "error": "error",
           "timeout": "timeout"}

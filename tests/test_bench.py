@@ -216,7 +216,7 @@ def test_verify_fails_a_folder_that_is_no_floor_and_a_run_whose_record_was_taken
     assert "floor f000: 1 run(s): have no decisions record" in out.stdout
     board = api.bench_board([res.out], tmp_path / "site")  # the board reads the split's floors alone, and says it failed
     md = (tmp_path / "site" / "board.md").read_text()
-    assert "| greedy | 3 | 3 |" in md and "failed" in md and board
+    assert "| greedy | 3 of 800 | 3 |" in md and "failed" in md and board
 
 
 def test_a_folder_of_another_numbering_is_refused(tmp_path):
@@ -319,7 +319,7 @@ def test_the_board_opens_in_a_browser_and_sorts_by_a_column(tmp_path):
     api.verify(folders[0], workers=1)
     files = api.bench_board(folders, tmp_path / "site")
     md = (tmp_path / "site" / "board.md").read_text()
-    assert "| nsos[alpha=0.9] | 6 | 6 |" in md and "verified" in md and "not verified" in md
+    assert "| nsos[alpha=0.9] | 6 of 800 | 6 |" in md and "verified" in md and "not verified" in md
     assert "semantic gain" in md and "(n=6)" in md
     page = tmp_path / "probe.html"
     page.write_text((tmp_path / "site" / "index.html").read_text().replace("</body>", PROBE + "</body>"))
@@ -454,3 +454,88 @@ def test_the_objects_test_split_is_drawn_offices(tmp_path, monkeypatch):
     assert [f.id for f in sp.floors] == [f"o{i:03d}" for i in range(8)] and not sp.official
     shortest = pd.concat([pd.read_csv(f.scenario.parent / "episodes.csv") for f in sp.floors])["shortest_m"]
     assert len(shortest) == 8 * 13 and (shortest > 3.0).all()  # the mug never beside the start
+
+
+# -- the board is honest about what it shows --------------------------------------------------------
+
+def test_a_limit_run_is_partial_in_bench_json_and_on_the_board_never_official(tmp_path):
+    res = _run(tmp_path, "greedy", limit=3)
+    meta = json.loads((res.out / "bench.json").read_text())
+    assert res.partial and (meta["partial"], meta["limit"], meta["floors"]["f000"]["episodes"]) == (True, 3, 20)
+    out = runner.invoke(app, ["bench", "board", str(res.out), "--out", str(tmp_path / "site")])
+    assert out.exit_code == 0, out.output
+    md = (tmp_path / "site" / "board.md").read_text()
+    assert "| greedy | 3 of 800 | 3 |" in md and "| no (partial: 3 of 800 episodes, 3 of 800 runs) |" in md
+    assert "the split: 800 episodes (each planner's own count in its row)" in md
+    assert "the published hash, but partial" in md and "| yes |" not in md and "official (the published hash)" not in md
+    # the same rows, as a folder whose split were these 3 episodes: complete, hence official
+    meta["floors"] = {"f000": {**meta["floors"]["f000"], "episodes": 3}}
+    (res.out / "bench.json").write_text(json.dumps(meta))
+    api.bench_board([res.out], tmp_path / "site2")
+    md = (tmp_path / "site2" / "board.md").read_text()
+    assert "| greedy | 3 of 3 | 3 |" in md and md.rstrip().endswith("| yes |") and "official (the published hash)" in md
+
+
+def test_each_planner_says_its_own_episode_count(tmp_path):
+    a = _run(tmp_path, "greedy", limit=3).out
+    b = _run(tmp_path, "bvp", limit=1).out
+    api.bench_board([a, b], tmp_path / "site")
+    md = (tmp_path / "site" / "board.md").read_text()
+    assert "| greedy | 3 of 800 | 3 |" in md and "| bvp | 1 of 800 | 1 |" in md
+
+
+def test_a_planner_file_stands_beside_built_in_planners(tmp_path):
+    f = tmp_path / "mine.py"
+    f.write_text(USER_PLANNER)
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner-file", str(f), "--planner", "u_first_candidate",
+                              "--planner", "greedy", "--limit", "2", "--workers", "1", "--out", str(tmp_path / "both")])
+    assert res.exit_code == 0, res.output
+    runs = pd.read_csv(tmp_path / "both" / "f000" / "runs.csv")
+    assert sorted(runs["planner"].unique()) == ["greedy", "u_first_candidate"] and len(runs) == 4
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner-file", str(f), "--planner", "u_first_candidat",
+                              "--limit", "1", "--workers", "1", "--out", str(tmp_path / "typo")])
+    assert res.exit_code == 2 and "registers u_first_candidate, not 'u_first_candidat'" in " ".join(res.output.split())
+    # semsearch run: a scenario's own planner file beside built-in planners, one of them chosen with --planner
+    api.init("demo", tmp_path / "demo")
+    src = tmp_path / "demo" / "demo.yaml"
+    doc = __import__("yaml").safe_load(src.read_text())
+    doc["planners"] = [{"name": "greedy"}, {"name": "u_first_candidate", "module": str(f)}]
+    doc["goals"], doc["experiment"]["seeds"] = doc["goals"][:1], 1
+    sc = tmp_path / "demo" / "demo_mine.yaml"
+    sc.write_text(__import__("yaml").safe_dump(doc))
+    for chosen in (["greedy"], ["u_first_candidate"], ["greedy", "u_first_candidate"]):
+        out = tmp_path / ("run-" + "-".join(chosen))
+        res = runner.invoke(app, ["run", str(sc), "--out", str(out), "--workers", "1",
+                                  *[a for c in chosen for a in ("--planner", c)]])
+        assert res.exit_code == 0, res.output
+        assert sorted(pd.read_csv(out / "runs.csv")["planner"].unique()) == chosen
+
+
+def test_a_mistyped_numbering_is_named_with_the_nearest(tmp_path):
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner", "greedy", "--numbering", "shufled",
+                              "--out", str(tmp_path / "x")])
+    assert res.exit_code == 2
+    assert "unknown numbering 'shufled' (did you mean 'shuffled'?); valid: true, shuffled, parity-flipped, reversed" \
+        in " ".join(res.output.split())
+
+
+def test_a_gain_within_float_noise_is_shown_as_zero(tmp_path, monkeypatch):
+    from semsearch_cli.bench.board import paired_diff
+    from semsearch_cli.report.figures import bench as figures
+
+    units = [f"f{k}/0" for k in range(4)]
+    a = pd.DataFrame({"unit": units, "spl": [0.3, 0.5, 0.25, 0.7]})
+    b = a.assign(spl=a["spl"] - 2.8e-18 * np.array([1, 0, 1, 1]) - np.array([0, 5.6e-17, 0, 0]))
+    assert paired_diff(a, b) == (0.0, 0.0, 0.0, 4)
+    assert paired_diff(a, a.assign(spl=a["spl"] - 0.01))[0] == pytest.approx(0.01)  # a real gain stays
+    seen = []
+    monkeypatch.setattr(figures, "_save", lambda fig, out, formats: seen.append(fig) or [])
+    floors = pd.DataFrame({"planner": "nsos", "floor": ["a", "b", "c"], "convention": "loop",
+                           "predictability": [0.2, 0.5, 0.9], "gain": [2.8e-18, 2.8e-18, -1e-17]})
+    figures.plot_gain_vs_predictability(floors, tmp_path / "g.png")
+    ax = seen[0].axes[0]
+    seen[0].canvas.draw()
+    assert ax.yaxis.get_offset_text().get_text() == ""  # no 1e-18 over the axis
+    assert [float(y) for y in ax.collections[0].get_offsets()[:, 1]] == [0.0, 0.0, 0.0]
+    assert "gain +0.000 on every one of 3 floors" in [t.get_text() for t in ax.texts]
+    __import__("matplotlib.pyplot").pyplot.close(seen[0])

@@ -569,3 +569,26 @@ def test_without_openai_run_bench_and_dry_run_refuse_in_one_line(tmp_path):
         assert res.returncode == 2, (args, res.stderr)
         assert len(res.stderr.strip().splitlines()) == 1 and line in res.stderr and "Traceback" not in res.stderr, res.stderr
         assert not list(out.rglob("runs.csv")) or all(len(pd.read_csv(f)) == 0 for f in out.rglob("runs.csv"))
+
+
+def test_a_batch_and_the_board_say_the_share_of_decisions_that_fell_back(tmp_path):
+    # every fifth reply is prose: with no re-ask, about a fifth of the decisions fall back (the run is still the model's)
+    with ChatServer(lambda r, n: Answer("I am not sure.") if n % 5 == 4 else first_target(r, n), models=["scripted"]) as srv:
+        spec = f"llm[base_url={srv.base_url},model=scripted,reasks=0]"
+        res = CliRunner().invoke(app, ["bench", "run", "doors-classic-v1", "--planner", spec, "--planner", "greedy",
+                                       "--limit", "1", "--workers", "1", "--out", str(tmp_path / "b")])
+    assert res.exit_code == 0, res.output
+    runs = pd.concat([pd.read_csv(p) for p in (tmp_path / "b").glob("*/runs.csv")])
+    model = runs[runs["planner"] == spec]
+    assert (model["outcome"] == "found").all()
+    n, asked = int(model["fallbacks"].sum()), int(model["llm_calls"].sum())  # no re-asks: a call is a decision
+    assert 0.05 < n / asked < 0.5
+    last = res.output.strip().splitlines()[-1]
+    assert last == f"fell back: {spec}: {n} of {asked} decisions ({n / asked:.1%}) (more than 5%: the bench board marks it)"
+    assert "fell back: greedy" not in res.output  # a planner without a fallback has no line
+    api.bench_board([tmp_path / "b"], tmp_path / "site")
+    md = (tmp_path / "site" / "board.md").read_text()
+    row = next(line for line in md.splitlines() if line.startswith(f"| {spec} |"))
+    assert f"| {n / asked:.1%} of {asked:,} |" in row and f"| not verified, {n / asked:.1%} of decisions fell back |" in row
+    greedy = next(line for line in md.splitlines() if line.startswith("| greedy |"))
+    assert "fell back" not in greedy

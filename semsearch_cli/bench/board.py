@@ -22,11 +22,11 @@ import numpy as np
 import pandas as pd
 from scipy.stats import kendalltau, spearmanr
 
-from ..errors import ScenarioError
+from ..errors import UNAVAILABLE, ScenarioError
 from ..files import atomic_text, output_folder
-from ..metrics import COST_COLUMNS
+from ..metrics import COST_COLUMNS, FALLBACK_FLAG, fallback_shares
 from ..report.document import Document
-from ..report.figures.bench import plot_gain_vs_predictability
+from ..report.figures.bench import GAIN_FLOOR, plot_gain_vs_predictability
 from ..report.indirect import PAPER_SCALES, PAPER_TABLE3, claims_table
 from ..report.stats import mean_ci, rate_ci
 from ..runner import read_runs
@@ -72,7 +72,11 @@ def load(folders) -> pd.DataFrame:
     """Every row of the bench folders' floors (the floors bench.json lists; a row must name its
     folder's floor and the folder's numbering), with ``unit`` (floor/episode), ``verdict``,
     ``official`` (its suite hash is the published one) and each floor's convention and
-    predictability (bench.json, written at run time: the board needs no split at hand)."""
+    predictability (bench.json, written at run time: the board needs no split at hand), and what a
+    complete folder holds: ``split_episodes`` and ``split_runs`` (episodes x repeats; NaN when
+    bench.json is older than the count, then its ``partial`` is taken as given: ``partial_meta``).
+    Rows of runs that failed for a cause outside them (``unavailable:``, run again on resume)
+    are kept with ``unavailable`` True; the tables leave them out of every statistic."""
     frames = []
     for folder in folders:
         folder = Path(folder)
@@ -84,6 +88,8 @@ def load(folders) -> pd.DataFrame:
             raise ScenarioError(str(folder / BENCH_FILE), "floors", "lists no floors: written by an older semsearch; run the "
                                 "bench into a fresh folder")
         verdict = verdict_of(folder, meta["hash"])
+        counts = [(info or {}).get("episodes") for info in floors.values()]
+        episodes = float(sum(counts)) if counts and all(isinstance(c, int) for c in counts) else np.nan
         for fid, info in floors.items():
             f = folder / fid / "runs.csv"
             if not f.is_file():
@@ -96,7 +102,10 @@ def load(folders) -> pd.DataFrame:
             r = r.assign(verdict=verdict, official=r["suite_hash"].astype(str) == str(official), folder=str(folder),
                          unit=r["floor"].astype(str) + "/" + r["episode"].astype(str),
                          convention=str((info or {}).get("convention", fid)),
-                         predictability=float((info or {}).get("predictability") or np.nan))
+                         predictability=float((info or {}).get("predictability") or np.nan),
+                         split_episodes=episodes, split_runs=episodes * int(meta.get("repeats", 1)),
+                         partial_meta=bool(meta.get("partial", False)),
+                         unavailable=(r["outcome"].astype(str) == "error") & r["message"].astype(str).str.startswith(UNAVAILABLE))
             frames.append(r)
     if not frames:
         raise ScenarioError(str(folders[0]), "", "the bench folders hold no rows")
@@ -115,16 +124,37 @@ def paired_diff(a: pd.DataFrame, b: pd.DataFrame, value: str = "spl") -> tuple[f
     ma = a.groupby("unit")[value].mean()
     mb = b.groupby("unit")[value].mean()
     common = ma.index.intersection(mb.index)
-    d = (ma[common] - mb[common]).to_numpy(float)
+    d = (ma[common] - mb[common]).to_numpy(float, copy=True)
     if not len(d):
         return np.nan, np.nan, np.nan, 0
-    m, lo, hi = mean_ci(d, np.arange(len(d)))
+    d[np.abs(d) <= GAIN_FLOOR] = 0.0  # float noise between two equal SPLs is no difference (GAIN_FLOOR)
+    m, lo, hi = (0.0 if np.isfinite(x) and abs(x) <= GAIN_FLOOR else x for x in mean_ci(d, np.arange(len(d))))
     return m, lo, hi, len(d)
+
+
+def completeness(d: pd.DataFrame) -> tuple[bool, str]:
+    """Whether one planner's rows of the true numbering (``d``, unavailable runs left out) hold
+    every run of the split, and what the board says when they do not."""
+    want, eps = float(d["split_runs"].max()), float(d["split_episodes"].max())
+    if not np.isfinite(want):  # bench.json older than the count: as it said
+        return (not d["partial_meta"].any()), "partial (bench.json)"
+    runs, units = len(d.drop_duplicates(["unit", "seed"])), d["unit"].nunique()
+    return runs >= want, f"partial: {units} of {eps:.0f} episodes, {runs} of {want:.0f} runs"
+
+
+def fallback_note(d: pd.DataFrame) -> str:
+    """``, 12.3% of decisions fell back`` when more than FALLBACK_FLAG of a planner's decisions did."""
+    for _, n, asked in fallback_shares(d):
+        if asked and n / asked > FALLBACK_FLAG:
+            return f", {n / asked:.1%} of decisions fell back"
+    return ""
 
 
 def tables(rows: pd.DataFrame) -> dict:
     """The board's tables of one suite and split (keys: planners, conventions, numberings,
     floors)."""
+    gone = rows[rows["unavailable"]] if "unavailable" in rows.columns else rows.iloc[:0]
+    rows = rows[~rows["unavailable"]] if "unavailable" in rows.columns else rows
     true = rows[rows["numbering"] == "true"]
     planners = list(dict.fromkeys(true["planner"]))
     baseline = BASELINES.get(str(rows["kind"].iloc[0]), "")
@@ -132,7 +162,10 @@ def tables(rows: pd.DataFrame) -> dict:
     for lab in planners:
         d = true[true["planner"] == lab]
         s, slo, shi = rate_ci(d["success"].to_numpy(float), d["unit"].to_numpy())
-        row = {"planner": lab, "episodes": d["unit"].nunique(), "runs": len(d),
+        complete, why = completeness(d)
+        eps = float(d["split_episodes"].max())
+        row = {"planner": lab, "episodes": f"{d['unit'].nunique()}" + (f" of {eps:.0f}" if np.isfinite(eps) else ""),
+               "runs": len(d),
                "success": _ci(s, slo, shi), "SPL": _ci(*mean_ci(d["spl"].to_numpy(float), d["unit"].to_numpy())),
                "SoftSPL": _ci(*mean_ci(d["soft_spl"].to_numpy(float), d["unit"].to_numpy())),
                "distance m": _ci(*mean_ci(d["distance_m"].to_numpy(float), d["unit"].to_numpy()), fmt="{:.1f}")}
@@ -151,8 +184,12 @@ def tables(rows: pd.DataFrame) -> dict:
                 row[c] = f"{v.sum():.1f}" if c == "llm_s" else f"{int(v.sum()):,}"
                 if c == "llm_calls":
                     row["calls per run"] = f"{v.mean():.1f}"
-        row["verified"] = ", ".join(sorted(set(d["verdict"])))
-        row["official"] = "yes" if d["official"].all() else "no"
+        for _, n, asked in fallback_shares(d):  # a planner with a fallback: the share of its decisions that took it
+            row["fell back"] = f"{n / asked:.1%} of {asked:,}" if asked else "0"
+        lost = int((gone["planner"] == lab).sum()) if len(gone) else 0
+        row["verified"] = ", ".join(sorted(set(d["verdict"]))) + fallback_note(d) + \
+            (f", {lost} run(s) unavailable (left out; the same bench run runs them again)" if lost else "")
+        row["official"] = "yes" if d["official"].all() and complete else "no" + ("" if complete else f" ({why})")
         out.append(row)
     planners_df = pd.DataFrame(out)
     planners_df = planners_df.loc[:, [c for c in planners_df.columns if (planners_df[c].astype(str) != "").any()]]
@@ -215,6 +252,7 @@ def indirect_tables(rows: pd.DataFrame) -> dict:
     on rooms), the UIS calibration, the other methods at the calibrated budget beside the paper's
     Table 3 (their mean absolute difference and rank agreement), and the paper's claims at every
     budget."""
+    rows = rows[~rows["unavailable"]] if "unavailable" in rows.columns else rows
     true = rows[rows["numbering"] == "true"].assign(method=lambda d: d["planner"].astype(str).str.split("[").str[0],
                                                      scale=lambda d: d["goal"].astype(float))
     budgets = uis_budgets(true) if (true["method"] == "UIS").any() else {}
@@ -228,8 +266,9 @@ def indirect_tables(rows: pd.DataFrame) -> dict:
             row["success within the UIS budget"] = _ci(*rate_ci(at_budget(dc, budgets)["success"].to_numpy(float),
                                                                  dc["room"].to_numpy())) if len(dc) else ""
         row["SPL"] = _ci(*mean_ci(d["spl"].to_numpy(float), d["room"].to_numpy()))
-        row["verified"] = ", ".join(sorted(set(d["verdict"])))
-        row["official"] = "yes" if d["official"].all() else "no"
+        complete, why = completeness(d)
+        row["verified"] = ", ".join(sorted(set(d["verdict"]))) + fallback_note(d)
+        row["official"] = "yes" if d["official"].all() and complete else "no" + ("" if complete else f" ({why})")
         methods.append(row)
     cal, cells = [], []
     if budgets:
@@ -307,9 +346,14 @@ def board(folders, out: str | Path) -> list[Path]:
     written = []
     for (suite, split, hash_), g in rows.groupby(["suite", "split", "suite_hash"], sort=False):
         doc.heading(2, f"{suite} {split}" + ("" if g["official"].all() else f" ({hash_[:16]})"))
-        doc.para(f"suite hash {hash_[:16]}; {g['unit'].nunique()} episodes; numberings run: "
-                 f"{', '.join(sorted(set(g['numbering'])))}; "
-                 + ("official (the published hash)" if g["official"].all() else "not official (no published hash matches)"))
+        eps = float(g["split_episodes"].max())
+        done = g[~g["unavailable"] & (g["numbering"] == "true")]
+        whole = [completeness(d)[0] for _, d in done.groupby("planner")]
+        official = ("not official (no published hash matches)" if not g["official"].all() else
+                    "official (the published hash)" if whole and all(whole) else
+                    "the published hash, but partial: a planner lacks runs of the split (a --limit run), so not official")
+        doc.para(f"suite hash {hash_[:16]}; the split: {f'{eps:.0f} episodes' if np.isfinite(eps) else 'episodes unknown'} "
+                 f"(each planner's own count in its row); numberings run: {', '.join(sorted(set(g['numbering'])))}; {official}")
         if (g["kind"] == "indirect").all():
             _indirect_section(doc, g)
             continue

@@ -25,7 +25,7 @@ import yaml
 
 from ..config import PlannerSpec
 from ..config.base import sign_label
-from ..errors import ScenarioError
+from ..errors import UNAVAILABLE, ScenarioError, did_you_mean
 from ..files import atomic_text, output_folder
 from ..report.build import write_meta
 from ..runner import Batch, BatchOptions, Loaded, folder_lock, make_executor, read_runs
@@ -57,7 +57,7 @@ def materialise(split: Split, floor: Floor, numbering: str, dest: Path) -> Path:
     it names, the signs' labels (and the goals and episodes with them) permuted by
     :func:`~.numbering.relabel`. Returns the scenario's path."""
     if numbering not in NUMBERINGS:
-        raise ScenarioError("<command line>", "--numbering", f"unknown numbering {numbering!r}; valid: {', '.join(NUMBERINGS)}")
+        raise ScenarioError("<command line>", "--numbering", unknown_numbering(numbering))
     src = floor.scenario
     dest.mkdir(parents=True, exist_ok=True)
     doc = _copy_named(yaml.safe_load(src.read_text()), src.parent, dest)
@@ -89,6 +89,11 @@ def materialise(split: Split, floor: Floor, numbering: str, dest: Path) -> Path:
     return path
 
 
+def unknown_numbering(numbering: str) -> str:
+    """The message for a numbering that is not one of :data:`~.numbering.NUMBERINGS`, with the nearest named."""
+    return f"unknown numbering {numbering!r}{did_you_mean(numbering, NUMBERINGS)}; valid: {', '.join(NUMBERINGS)}"
+
+
 @dataclass
 class BenchOutput:
     out: Path
@@ -96,6 +101,7 @@ class BenchOutput:
     numbering: str
     runs: pd.DataFrame
     floors: list = field(default_factory=list)  # the floors run (their ids)
+    partial: bool = False  # some planner of the folder lacks some run of the split (a --limit run): never official
 
 
 def _check_bench_file(out: Path, split: Split, numbering: str, planners: list[str]) -> dict:
@@ -129,7 +135,7 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
     executor); decisions are always recorded. ``progress(row, done, total)`` after each run."""
     sp = open_split(suite, split, salt_file)
     if numbering not in NUMBERINGS:
-        raise ScenarioError("<command line>", "--numbering", f"unknown numbering {numbering!r}; valid: {', '.join(NUMBERINGS)}")
+        raise ScenarioError("<command line>", "--numbering", unknown_numbering(numbering))
     if limit is not None and limit < 1:
         raise ScenarioError("<command line>", "--limit", f"{limit}: give at least 1 episode")
     options = options.checked().replace(decisions=True, seeds=None, goals=None, planners=None)
@@ -152,7 +158,9 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
             raise ScenarioError("<command line>", "--planner", exc.message) from None
         labels = [v.label for v in first.task.variants()]
         meta = _check_bench_file(out, sp, numbering, labels)
-        meta["floors"] = {f.id: floor_info(sp, f) for f in sp.floors}
+        meta["floors"] = {f.id: {**floor_info(sp, f), "episodes": n} for f, n in zip(sp.floors, counts)}
+        meta["limit"] = limit
+        meta["partial"] = True  # until every run of the split is in the folder (below)
         atomic_text(out / BENCH_FILE, json.dumps(meta, indent=1) + "\n")
     total = sum(n for _, n in todo) * len(labels) * sp.suite.repeats
     stamp = {"suite": sp.suite.name, "split": sp.name, "suite_hash": sp.hash, "numbering": numbering}
@@ -166,7 +174,31 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
                                      {**stamp, "floor": f.id}, runner, progress, total, finished))
             finished += len(frames[-1])
     runs = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
-    return BenchOutput(out, sp, numbering, runs, [f.id for f, _ in todo])
+    with folder_lock(out):
+        meta = json.loads((out / BENCH_FILE).read_text())
+        meta["partial"] = bool(missing_runs(out, meta))
+        atomic_text(out / BENCH_FILE, json.dumps(meta, indent=1) + "\n")
+    return BenchOutput(out, sp, numbering, runs, [f.id for f, _ in todo], meta["partial"])
+
+
+def missing_runs(out: Path, meta: dict) -> dict[str, int]:
+    """Per planner of a bench folder (bench.json's ``planners``), the runs of its split it lacks:
+    its floors' episodes x the suite's repeats, less the rows it has (a row of a run that failed
+    for a cause outside it, ``unavailable:``, is no run). Planners lacking none are left out."""
+    want = {fid: int((info or {}).get("episodes", 0)) * int(meta.get("repeats", 1)) for fid, info in meta.get("floors", {}).items()}
+    lacking: dict[str, int] = {}
+    for lab in meta.get("planners", []):
+        have = 0
+        for fid in want:
+            f = out / fid / "runs.csv"
+            if f.is_file():
+                r = read_runs(f)
+                r = r[(r["stage"] == "") & (r["planner"].astype(str) == lab)]
+                r = r[~((r["outcome"] == "error") & r["message"].astype(str).str.startswith(UNAVAILABLE))]
+                have += len(r.drop_duplicates(["goal", "episode", "seed"]))
+        if have < sum(want.values()):
+            lacking[lab] = sum(want.values()) - have
+    return lacking
 
 
 def _run_floor(sp: Split, f: Floor, take: int, loaded, planners, numbering: str, out: Path, options: BatchOptions,
@@ -184,7 +216,12 @@ def _run_floor(sp: Split, f: Floor, take: int, loaded, planners, numbering: str,
             if progress:
                 progress(row, base + n, total)
 
-        rows = batch.run(tick, runner=runner)
+        try:
+            rows = batch.run(tick, runner=runner)
+        except ScenarioError as exc:  # a planner that cannot run (preflight): the command line named it
+            if not exc.field.startswith("planners"):
+                raise
+            raise ScenarioError("<command line>", "--planner", exc.message) from None
     own = rows[rows["stage"] == ""] if len(rows) else rows  # (a suite of chains would keep their stage rows too)
     mine = np.array([specs.has_key(k) for k in _keys(own)], bool)  # not the runs a longer run left here
     return own[mine] if len(own) else own

@@ -10,12 +10,16 @@ import pandas as pd
 from .common import COLUMN_IN, PALETTE, _paper, _save, plt
 
 
+GAIN_FLOOR = 1e-9  # SPL: a gain this close to 0 is float noise (two equal SPLs computed apart), shown as 0
+
+
 @_paper
 def plot_gain_vs_predictability(floors: pd.DataFrame, out: Path, formats=("png",), title: str = "") -> list[Path]:
     """One panel per planner: each floor's semantic gain (the mean over its episodes of SPL under
     its true numbering minus SPL under shuffled labels, paired episode by episode) against the
     floor's predictability, marked by its numbering convention, with the least-squares line over
     the floors. ``floors``: columns planner, floor, convention, predictability, gain."""
+    floors = floors.assign(gain=floors["gain"].where(~(floors["gain"].abs() <= GAIN_FLOOR), 0.0))  # noise is no gain
     planners = list(dict.fromkeys(floors["planner"]))
     conventions = sorted(set(floors["convention"]))
     marks = dict(zip(conventions, "os^vD<>pPX*h"))
@@ -31,7 +35,10 @@ def plot_gain_vs_predictability(floors: pd.DataFrame, out: Path, formats=("png",
             e = d[d["convention"] == c]
             ax.scatter(e["predictability"], e["gain"], s=14, marker=marks[c], color=colors[c], label=c, linewidths=0)
         ok = np.isfinite(d["predictability"]) & np.isfinite(d["gain"])
-        if ok.sum() >= 3:
+        if ok.sum() >= 3 and d.loc[ok, "gain"].nunique() == 1:  # no line through a constant (r undefined)
+            ax.text(0.02, 0.97, f"gain {d.loc[ok, 'gain'].iloc[0]:+.3f} on every one of {int(ok.sum())} floors",
+                    transform=ax.transAxes, va="top", fontsize=7)
+        elif ok.sum() >= 3:
             k, b = np.polyfit(d.loc[ok, "predictability"], d.loc[ok, "gain"], 1)
             x = np.linspace(d.loc[ok, "predictability"].min(), d.loc[ok, "predictability"].max(), 2)
             ax.plot(x, k * x + b, color="0.3", lw=0.8)
