@@ -189,20 +189,21 @@ def _rows_scenario(folder: Path, scenario: str | Path | None) -> tuple[Path, Loa
 
 
 def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | None = None,
-           scenario: str | Path | None = None) -> list:
+           scenario: str | Path | None = None, kept=None) -> list:
     """Every door-search run of a results folder recorded with ``--decisions`` (or the one named
     ``run``, its record's file stem) as a ROS 2 bag folder ``out/<run>`` (``fmt``: ``mcap`` or
     ``rosbag2``, SQLite 3), replayed from its decisions (:mod:`semsearch_cli.ros2`; the ``ros``
-    extra). Runs whose bag exists already are kept. Returns the
-    :class:`~semsearch_cli.ros2.Exported` runs."""
+    extra). Runs whose bag exists already are kept (``kept``, when given, is called with each one's
+    name). Returns the :class:`~semsearch_cli.ros2.Exported` runs."""
     if fmt not in ros2.FORMATS:
         raise ScenarioError("<command line>", "--format", f"{fmt!r} is not a bag format; use one of {', '.join(ros2.FORMATS)}")
     if not ros2.available():
         raise MissingExtra("semsearch export", "ros")
     folder = Path(folder)
     _, loaded = _rows_scenario(folder, scenario)
+    ros2.exportable(loaded)  # before the output folder is made
     with folder_lock(Path(out)):
-        return ros2.export_folder(loaded, folder, Path(out), fmt, run)
+        return ros2.export_folder(loaded, folder, Path(out), fmt, run, kept)
 
 
 def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | Path | None = None, fmt: str = "mcap",

@@ -417,14 +417,16 @@ def export(
     laser, path, signs read, frontier candidates and each decision's target, on the topics of
     docs/robot.md. Each run is replayed from its decisions; a bag already written is kept."""
 
+    kept: list[str] = []
     try:
-        done = api.export(folder, out_dir, fmt, run_id, scenario)
+        done = api.export(folder, out_dir, fmt, run_id, scenario, kept=kept.append)
     except ScenarioError as exc:
         _fail(exc)
     for d in done:
         out.print(f"{d.folder}: {d.outcome}, {d.distance_m:.1f} m, {d.decisions} decisions, {d.messages} messages, "
                   f"{d.size / 1e6:.2f} MB")
-    out.print(f"{len(done)} bag(s) written to {out_dir} ({fmt})")
+    there = f"; {len(kept)} kept as they were (their bags were there already)" if kept else ""
+    out.print(f"{len(done)} bag(s) written to {out_dir} ({fmt}){there}")
 
 
 ros_app = typer.Typer(no_args_is_help=True, help="Door planners over ROS 2 bags and on robots through rosbridge (the ros extra; "

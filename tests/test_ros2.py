@@ -161,7 +161,18 @@ def test_the_mcap_file_checks_out_with_the_mcap_library(recorded):
         assert {c.message_encoding for c in summary.channels.values()} == {"cdr"}
         assert {c.compression for c in summary.chunk_indexes} == {"zstd"}
     again = CliRunner().invoke(app, ["export", str(out / "results"), "--out", str(out / "all"), "--scenario", str(scenario)])
-    assert again.exit_code == 0 and "0 bag(s) written" in again.output  # kept, not written twice
+    said = " ".join(again.output.split())
+    assert again.exit_code == 0 and "0 bag(s) written" in said and "; 2 kept as they were (their bags were there already)" in said
+
+
+def test_export_of_another_kind_of_search_says_so_and_writes_nothing(tmp_path):
+    res = CliRunner().invoke(app, ["run", "office", "--seeds", "1", "--decisions", "--out", str(tmp_path / "r"), "--workers", "1",
+                                   "--planner", "lsos", "--goal", "Static.mug@12"])
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(app, ["export", str(tmp_path / "r"), "--out", str(tmp_path / "bags")])
+    said = " ".join(res.output.split())
+    assert res.exit_code == 2 and "field 'kind': is objects search: semsearch export writes door-search runs" in said, said
+    assert "do not replay" not in said and not (tmp_path / "bags").exists()
 
 
 def test_export_errors_name_the_flag_and_leave_no_bag(recorded, tmp_path):

@@ -5,7 +5,7 @@ websockets). See docs/robot.md."""
 
 from ..optional import installed
 from .bag import FORMATS, TOPICS
-from .export import BagRecorder, Exported, export_folder, export_run, recorded_runs
+from .export import BagRecorder, Exported, export_folder, export_run, exportable, recorded_runs
 from .live import Live, LiveRun
 from .loopback import Rosbridge, SimRobot
 from .replay import Replayed, recorded_scenario, replay_bag
@@ -17,5 +17,5 @@ def available() -> bool:
     return all(installed(name) for name in ("rosbags", "roslibpy", "websockets"))
 
 
-__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run",
+__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run", "exportable",
            "recorded_runs", "recorded_scenario", "replay_bag"]

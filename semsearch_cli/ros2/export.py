@@ -11,6 +11,7 @@ from __future__ import annotations
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -216,10 +217,21 @@ def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Pat
     return Exported(name, out, size, bag.count, rec.decisions, str(row["outcome"]), float(row["distance_m"]))
 
 
-def export_folder(loaded: Loaded, folder: Path, out: Path, fmt: str, run: str | None = None) -> list[Exported]:
+def exportable(loaded: Loaded) -> None:
+    """A :class:`ScenarioError` unless ``loaded`` is a door search (the kind a bag holds)."""
+    if not isinstance(loaded.task, DoorTask):
+        raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind} search: semsearch export writes door-search runs "
+                            "as bags (the robot's map, pose and signs); a results folder of door search exports")
+
+
+def export_folder(loaded: Loaded, folder: Path, out: Path, fmt: str, run: str | None = None,
+                  kept: Callable[[str], None] | None = None) -> list[Exported]:
     """Every recorded run of ``folder`` (or the one named ``run``: its decisions file's stem) as a
-    bag folder ``out/<run>``; runs whose bag exists already are left as they are. A run that does
-    not replay is named in a :class:`ScenarioError` raised once the others are written."""
+    bag folder ``out/<run>``; runs whose bag exists already are left as they are (``kept`` is
+    called with each one's name). Returns the runs exported. A run that does not replay is
+    named in a :class:`ScenarioError` raised once the others are written; a folder of another kind
+    of search is refused before anything is written."""
+    exportable(loaded)
     runs = recorded_runs(folder)
     if not runs:
         raise ScenarioError(str(folder / "decisions"), "", "no run of this folder has a decisions record: run it with "
@@ -240,6 +252,8 @@ def export_folder(loaded: Loaded, folder: Path, out: Path, fmt: str, run: str | 
     for name, row, f in runs:
         target = out / name
         if target.exists():
+            if kept is not None:
+                kept(name)
             continue
         try:
             done.append(export_run(loaded, name, row, f, target, fmt))
