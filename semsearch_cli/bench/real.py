@@ -113,7 +113,7 @@ def build_floor(floor: dict, files: dict[str, Path], out: Path) -> Path:
     doc["episodes"] = {"starts": DOORS_V1_STARTS, "seed": int(rng.integers(2**31)), "min_distance": DOORS_V1_MIN_DISTANCE}
     doc["planners"] = DEFAULT_PLANNER
     path.write_text(path.read_text().split("\n", 1)[0] + "\n" + yaml.safe_dump(doc, sort_keys=False))
-    freeze_episodes(path, 1)
+    freeze_episodes(path, 1, rng)  # an unsolvable start drawn again by the floor's generator
     return path
 
 
