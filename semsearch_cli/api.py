@@ -24,6 +24,7 @@ from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points, planner_class
+from .planners.llm import client as llm_client
 from .planners.base import load_planner_file, path_fields
 from .planners.llm import FirstPrompt
 from .plugins import load_kinds
@@ -133,11 +134,9 @@ def first_prompt(scenario: str | Path, options: BatchOptions = BatchOptions()) -
 def _package_fault(variant) -> tuple[str, str] | None:
     """A missing package a planner that calls a language model needs (the llm planner's ``openai``),
     as its preflight names it; the endpoint itself is not looked at (a dry run calls nothing)."""
-    from .planners.llm import client
-
     params = variant.resolved(planner_class(variant))
-    if getattr(params, "replay", None) is None and client.openai is None:
-        return "name", client.MISSING
+    if getattr(params, "replay", None) is None and llm_client.openai is None:
+        return "name", llm_client.MISSING
     return None
 
 

@@ -24,7 +24,8 @@ from .provenance import version_line
 from .runner import BatchOptions
 from .config.base import MAX_SEEDS, sign_label
 from .kernels import announce_compiling
-from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated, did_you_mean
+from .errors import DISK_FULL, UNAVAILABLE, BatchStopped, ScenarioError, Terminated, did_you_mean
+from .metrics import FALLBACK_FLAG, fallback_shares
 from .report.build import console_tables
 from .files import output_folder
 
@@ -199,6 +200,7 @@ def sweep(
     _print_table(f"sweep of {name}: ratio to the shortest path", res.table)
     _warn_errors(res.runs)
     out.print(f"table: {res.out / 'sweep.csv'}  plot: {res.out / 'sweep.png'}  rows: {res.out}/{name}=*/runs.csv")
+    _fallback_lines(res.runs)
 
 
 def _run_name(row: dict) -> str:
@@ -270,13 +272,19 @@ def _warn_errors(runs) -> None:
 
 def _fallback_lines(runs) -> None:
     """The batch's last lines: per planner that has a fallback (a language model's), the share of
-    its decisions that fell back (docs/llm.md)."""
-    from .metrics import FALLBACK_FLAG, fallback_shares
-
+    its decisions that fell back (docs/llm.md); then, when runs could not run for a cause outside
+    them (a model that did not answer, a missing package), how many, and status 1: they are no
+    result, and the same command runs them again (docs/usage.md)."""
     for label, n, asked in fallback_shares(runs):
         share = n / asked if asked else 0.0
         flag = f" (more than {FALLBACK_FLAG:.0%}: the bench board marks it)" if share > FALLBACK_FLAG else ""
         out.print(f"fell back: {label}: {n} of {asked} decisions ({share:.1%}){flag}", highlight=False, soft_wrap=True)
+    outside = runs[(runs["outcome"] == "error") & runs["message"].astype(str).str.startswith(UNAVAILABLE)]
+    if len(outside):
+        err.print(f"{len(outside)} run(s) could not run, for a cause outside them (e.g. {outside['planner'].iloc[0]}: "
+                  f"{outside['message'].iloc[0]}): they are not results; once the cause is fixed, the same command runs "
+                  "them again", highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
 
 
 def _batch(call):

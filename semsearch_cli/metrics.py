@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 import math
 
+import pandas as pd
+
 from .planners.base import COST_COLUMNS  # noqa: F401  (the rows' cost columns, read with the others from here)
 
 # the columns of runs.csv as 0.2.0 wrote them, for every kind: the ones every kind writes, and the
@@ -38,8 +40,6 @@ def fallback_shares(rows) -> list[tuple[str, int, int]]:
     column), in the rows' order: (label, decisions that fell back, decisions asked). A decision
     ends in one valid reply or in the fallback, so the decisions asked are ``llm_calls -
     invalid_replies + fallbacks`` (a decision cut short by the run's budget is not counted)."""
-    import pandas as pd
-
     if not len(rows) or "fallbacks" not in rows.columns:
         return []
     out = []

@@ -14,9 +14,11 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from typer.testing import CliRunner
 
 from semsearch_cli.config.base import sign_label
 from semsearch_cli.planners import register_planner
+from semsearch_cli.cli import app
 from semsearch_cli.runner import BatchOptions, Loaded, expand, run_batch
 
 # labels a spreadsheet or a person writes that a CSV reader takes for numbers or for missing values
@@ -134,7 +136,7 @@ from semsearch_cli.planners import register_planner
 from semsearch_cli.planners.doors.greedy import Greedy
 
 
-@register_planner("u_service")
+@register_planner({svc!r})
 class Service(Greedy):
     """Greedy behind a service that is down while the file DOWN exists."""
 
@@ -144,7 +146,7 @@ class Service(Greedy):
         return super().choose(ctx, cands)
 
 
-@register_planner("u_broken")
+@register_planner({broken!r})
 class Broken(Greedy):
     """A planner that fails on its own: its exception is its result."""
 
@@ -153,17 +155,24 @@ class Broken(Greedy):
 '''
 
 
-def test_resume_runs_again_what_failed_for_a_cause_outside_the_run_and_keeps_what_failed_on_its_own(demo_dir, tmp_path):
+def _failing(demo_dir, tmp_path, svc="u_service", broken="u_broken"):
+    """The demo building with planners ``svc`` (down while DOWN exists) and ``broken`` (a name
+    registers once per process); (scenario, DOWN)."""
     for f in ("map.png", "doors.csv"):
         shutil.copy(demo_dir / f, tmp_path / f)
     down = tmp_path / "DOWN"
     down.touch()
-    (tmp_path / "mine.py").write_text(FAILING.format(down=str(down)))
+    (tmp_path / "mine.py").write_text(FAILING.format(down=str(down), svc=svc, broken=broken))
     sc = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
     sc.update(map={**sc["map"], "image": "map.png"}, doors="doors.csv", goals=["304"], experiment={"seeds": 1, "max_distance": 120.0},
-              planners=[{"name": "u_service", "module": "mine.py"}, {"name": "u_broken", "module": "mine.py"}])
+              planners=[{"name": svc, "module": "mine.py"}, {"name": broken, "module": "mine.py"}])
     path = tmp_path / "scenario.yaml"
     path.write_text(yaml.safe_dump(sc))
+    return path, down
+
+
+def test_resume_runs_again_what_failed_for_a_cause_outside_the_run_and_keeps_what_failed_on_its_own(demo_dir, tmp_path):
+    path, down = _failing(demo_dir, tmp_path)
     out = tmp_path / "out"
     loaded = Loaded.load(path)
     run_batch(loaded, expand(loaded, 1), out, BatchOptions(workers=1))
@@ -182,3 +191,15 @@ def test_resume_runs_again_what_failed_for_a_cause_outside_the_run_and_keeps_wha
     # kept as it was, not run again (a missing number reads back missing: nan then, empty once rows were moved aside)
     assert kept.replace("nan", "").to_dict() == was.replace("nan", "").to_dict()
     assert _text(out / "runs.superseded.csv")["planner"].tolist() == ["u_service", "u_service"]
+
+
+def test_a_batch_with_runs_that_could_not_run_ends_with_status_1_saying_so(demo_dir, tmp_path):
+    path, down = _failing(demo_dir, tmp_path, "u_service2", "u_broken2")
+    res = CliRunner().invoke(app, ["run", str(path), "--workers", "1", "--out", str(tmp_path / "out")])
+    said = " ".join(res.output.split())
+    assert res.exit_code == 1, said
+    assert ("1 run(s) could not run, for a cause outside them (e.g. u_service2: unavailable: the service at 127.0.0.1:9 did "
+            "not answer): they are not results; once the cause is fixed, the same command runs them again") in said
+    down.unlink()
+    res = CliRunner().invoke(app, ["run", str(path), "--workers", "1", "--out", str(tmp_path / "out")])
+    assert res.exit_code == 0 and "could not run" not in res.output, res.output
