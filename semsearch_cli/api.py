@@ -16,7 +16,7 @@ import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .config.base import sign_label
-from .errors import MissingExtra, ScenarioError
+from .errors import MissingExtra, ScenarioError, did_you_mean
 from .world.ground_truth import DuplicateSigns
 from .world.buildings import numbered
 from .world.importers import kth, mobilesim, ros
@@ -285,7 +285,10 @@ def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, pe
         raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: the stand-in robot searches for door signs")
     goal = _label(goal)
     if loaded.world.signs.index_of(goal) < 0:
-        raise ScenarioError(str(loaded.path), "--goal", f"no door sign carries {goal!r} in this scenario")
+        goals = ", ".join(str(g) for g in loaded.goals)
+        raise ScenarioError(str(loaded.path), "--goal", f"no door sign carries {goal!r} in this scenario"
+                            f"{did_you_mean(goal, [str(n) for n in loaded.world.signs.number])}; its goals: {goals} "
+                            f"(any of its {len(loaded.world.signs.number)} signs may be one)")
     bridge = ros2.Rosbridge(port=port)
     try:
         bridge.start()

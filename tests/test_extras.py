@@ -2,6 +2,7 @@
 fresh ``pip install .``) the CLI starts, and each command that needs an extra refuses in one line
 naming it, exit 2, before it writes anything."""
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -9,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from semsearch_cli.errors import MissingExtra
+from semsearch_cli.kernels import COMPILING
 from semsearch_cli.optional import installed, lazy_module
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -61,3 +63,30 @@ def test_a_command_that_needs_an_extra_refuses_in_one_line_naming_it(tmp_path, a
     res = bare(*args, cwd=tmp_path)
     assert res.returncode == 2 and res.stderr.strip() == line, res.stderr
     assert not (tmp_path / "r").exists() and not (tmp_path / "bags").exists() and not (tmp_path / "o").exists()
+
+
+NOTE_BATCH = """
+import sys
+from semsearch_cli.kernels import announce_compiling
+from semsearch_cli.runner import BatchOptions, Loaded, expand, run_batch
+from semsearch_cli.shipped import path
+announce_compiling()
+loaded = Loaded.load(path("demo"))
+run_batch(loaded, expand(loaded, 2, None, ["greedy"]), __import__("pathlib").Path(sys.argv[1]), BatchOptions(workers=2, start_method="spawn",
+          executor=sys.argv[2]))
+"""
+
+
+@pytest.mark.parametrize("executor", ["processes", "dask"])
+def test_the_compiling_note_is_said_once_per_batch_not_once_per_worker(tmp_path, executor):
+    """A cold numba cache (a folder of its own) and workers that start afresh (spawn; a Dask local
+    cluster): each of them compiles, and the note is said once; with the cache warm, not at all."""
+    if executor == "dask":
+        pytest.importorskip("distributed")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}  # this checkout's code
+    cmd = [sys.executable, "-c", NOTE_BATCH]
+    res = subprocess.run([*cmd, str(tmp_path / "r"), executor], capture_output=True, text=True, cwd=tmp_path, env=env, timeout=600)
+    assert res.returncode == 0, res.stderr
+    assert res.stderr.count(COMPILING) == 1, res.stderr
+    res = subprocess.run([*cmd, str(tmp_path / "r2"), executor], capture_output=True, text=True, cwd=tmp_path, env=env, timeout=600)
+    assert res.returncode == 0 and COMPILING not in res.stderr, res.stderr

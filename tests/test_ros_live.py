@@ -246,6 +246,8 @@ def test_ros_sim_refuses_what_it_cannot_be(demo_dir):
     for args in (["--goal", "304", "--port", "99999"], ["--goal", "304", "--seed", "-1"]):
         r = runner.invoke(app, sim + args)
         assert r.exit_code == 2 and "Invalid value" in r.output, (args, r.output)
+    said = " ".join(runner.invoke(app, sim + ["--goal", "3044"]).output.split())
+    assert "no door sign carries 3044 in this scenario (did you mean '304'?); its goals: 304, 452 (any of its 24 signs" in said, said
 
 
 def test_the_loopback_server_speaks_rosbridge_v2(robot, demo_loaded):

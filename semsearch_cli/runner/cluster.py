@@ -13,14 +13,18 @@ from __future__ import annotations
 
 import asyncio
 import itertools
+import os
 import re
+import shutil
 import socket
+import tempfile
 import threading
 import time
 from pathlib import Path
 from typing import Iterable, Iterator
 
 from ..errors import MissingExtra, ScenarioError
+from ..kernels import share_compiling_note
 from ..optional import lazy_module
 from .execution import Executor, Watch, execute
 from .executors import register_executor
@@ -35,8 +39,11 @@ dask = lazy_module("dask", "dask")  # imported at first use (the dask extra; Non
 distributed = lazy_module("distributed", "dask")
 
 
-def _run_chunk(loaded: Loaded, specs: list[RunSpec], watch: Watch) -> list[tuple]:
-    """On a worker: (spec stem, rows, result) of each run of a chunk."""
+def _run_chunk(loaded: Loaded, specs: list[RunSpec], watch: Watch, note: str | None = None) -> list[tuple]:
+    """On a worker: (spec stem, rows, result) of each run of a chunk. ``note``: the batch's
+    compiling-note file (:func:`~semsearch_cli.kernels.share_compiling_note`; on another machine it
+    is not there, and each worker says the note once in its own log)."""
+    share_compiling_note(note)
     out = []
     for spec in specs:
         rows, res = execute(loaded, spec, watch)
@@ -93,17 +100,21 @@ class DaskExecutor(Executor):
     def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
         owned = self._kept is None
         client, cluster = self._client() if owned else self._kept
+        note = os.path.join(tempfile.mkdtemp(prefix="semsearch-note-"), "said")
+        share_compiling_note(note)
         try:
             shared = client.scatter(loaded, broadcast=True)  # once per worker, not with every run
             try:
-                yield from self._stream(client, shared, iter(specs), out, watch)
+                yield from self._stream(client, shared, iter(specs), out, watch, note)
             finally:
                 shared.release()  # a kept cluster serves the next batch without this one's scenario
         finally:
+            share_compiling_note(None)
+            shutil.rmtree(os.path.dirname(note), ignore_errors=True)
             if owned:
                 _close(client, cluster)
 
-    def _stream(self, client, shared, specs: Iterator[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
+    def _stream(self, client, shared, specs: Iterator[RunSpec], out: Path, watch: Watch, note: str | None = None) -> Iterator[list[dict]]:
         pending = distributed.as_completed(loop=client.loop)
         ahead = 2 * max(1, sum(client.nthreads().values()))
 
@@ -112,7 +123,7 @@ class DaskExecutor(Executor):
                 part = list(itertools.islice(specs, self.chunk))
                 if not part:
                     return
-                pending.add(client.submit(_run_chunk, shared, part, watch, pure=False))
+                pending.add(client.submit(_run_chunk, shared, part, watch, note, pure=False))
 
         try:
             submit(ahead)

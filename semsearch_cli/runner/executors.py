@@ -7,7 +7,9 @@ from __future__ import annotations
 import itertools
 import multiprocessing
 import os
+import shutil
 import signal
+import tempfile
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -16,6 +18,7 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from ..errors import BatchStopped, ScenarioError, did_you_mean
+from ..kernels import share_compiling_note
 from ..registry import Registry
 from .execution import Executor, Watch, run_and_save
 from .specs import Loaded, RunSpec
@@ -35,7 +38,8 @@ class SerialExecutor(Executor):
 _CACHE: dict = {}  # the batch's Loaded scenario, handed to each worker process once
 
 
-def _worker_init(loaded: Loaded) -> None:
+def _worker_init(loaded: Loaded, note: str | None = None) -> None:
+    share_compiling_note(note)  # the compiling note, once for the whole pool
     # Ctrl-C reaches every process of the terminal's group: the batch (the parent) handles it and
     # stops the workers, which would otherwise each print a KeyboardInterrupt traceback
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -76,27 +80,33 @@ class ProcessExecutor(Executor):
     def rows(self, loaded: Loaded, specs: Iterable[RunSpec], out: Path, watch: Watch) -> Iterator[list[dict]]:
         specs = iter(specs)
         ahead = 2 * self.workers
-        pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=self.context, initializer=_worker_init,
-                                   initargs=(loaded,))
-        running = {pool.submit(_worker_run, s, str(out), watch) for s in itertools.islice(specs, ahead)}
+        note = os.path.join(tempfile.mkdtemp(prefix="semsearch-note-"), "said")
+        share_compiling_note(note)
         try:
-            while running:
-                finished, running = wait(running, return_when=FIRST_COMPLETED)
-                broken = [f for f in finished if isinstance(f.exception(), BrokenProcessPool)]
-                for f in finished:  # the runs that did finish are kept, even beside a dead worker
-                    if f not in broken:
-                        yield f.result()
-                if broken:
-                    raise broken[0].exception()
-                running |= {pool.submit(_worker_run, s, str(out), watch) for s in itertools.islice(specs, len(finished))}
-        except BrokenProcessPool:
-            self._stop(pool, running)
-            raise BatchStopped("a worker process died (killed by a signal, or by the system for lack of memory), "
-                               "and the pool cannot go on") from None
-        except BaseException:
-            self._stop(pool, running)
-            raise
-        pool.shutdown()
+            pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=self.context, initializer=_worker_init,
+                                       initargs=(loaded, note))
+            running = {pool.submit(_worker_run, s, str(out), watch) for s in itertools.islice(specs, ahead)}
+            try:
+                while running:
+                    finished, running = wait(running, return_when=FIRST_COMPLETED)
+                    broken = [f for f in finished if isinstance(f.exception(), BrokenProcessPool)]
+                    for f in finished:  # the runs that did finish are kept, even beside a dead worker
+                        if f not in broken:
+                            yield f.result()
+                    if broken:
+                        raise broken[0].exception()
+                    running |= {pool.submit(_worker_run, s, str(out), watch) for s in itertools.islice(specs, len(finished))}
+            except BrokenProcessPool:
+                self._stop(pool, running)
+                raise BatchStopped("a worker process died (killed by a signal, or by the system for lack of memory), "
+                                   "and the pool cannot go on") from None
+            except BaseException:
+                self._stop(pool, running)
+                raise
+            pool.shutdown()
+        finally:
+            share_compiling_note(None)
+            shutil.rmtree(os.path.dirname(note), ignore_errors=True)
 
     @staticmethod
     def _stop(pool: ProcessPoolExecutor, running) -> None:
