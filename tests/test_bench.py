@@ -486,24 +486,24 @@ def test_each_planner_says_its_own_episode_count(tmp_path):
 
 def test_a_planner_file_stands_beside_built_in_planners(tmp_path):
     f = tmp_path / "mine.py"
-    f.write_text(USER_PLANNER)
-    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner-file", str(f), "--planner", "u_first_candidate",
+    f.write_text(USER_PLANNER.replace("u_first_candidate", "u_beside"))  # a name registers once per process
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner-file", str(f), "--planner", "u_beside",
                               "--planner", "greedy", "--limit", "2", "--workers", "1", "--out", str(tmp_path / "both")])
     assert res.exit_code == 0, res.output
     runs = pd.read_csv(tmp_path / "both" / "f000" / "runs.csv")
-    assert sorted(runs["planner"].unique()) == ["greedy", "u_first_candidate"] and len(runs) == 4
-    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner-file", str(f), "--planner", "u_first_candidat",
+    assert sorted(runs["planner"].unique()) == ["greedy", "u_beside"] and len(runs) == 4
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner-file", str(f), "--planner", "u_besid",
                               "--limit", "1", "--workers", "1", "--out", str(tmp_path / "typo")])
-    assert res.exit_code == 2 and "registers u_first_candidate, not 'u_first_candidat'" in " ".join(res.output.split())
+    assert res.exit_code == 2 and "registers u_beside, not 'u_besid'" in " ".join(res.output.split())
     # semsearch run: a scenario's own planner file beside built-in planners, one of them chosen with --planner
     api.init("demo", tmp_path / "demo")
     src = tmp_path / "demo" / "demo.yaml"
     doc = __import__("yaml").safe_load(src.read_text())
-    doc["planners"] = [{"name": "greedy"}, {"name": "u_first_candidate", "module": str(f)}]
+    doc["planners"] = [{"name": "greedy"}, {"name": "u_beside", "module": str(f)}]
     doc["goals"], doc["experiment"]["seeds"] = doc["goals"][:1], 1
     sc = tmp_path / "demo" / "demo_mine.yaml"
     sc.write_text(__import__("yaml").safe_dump(doc))
-    for chosen in (["greedy"], ["u_first_candidate"], ["greedy", "u_first_candidate"]):
+    for chosen in (["greedy"], ["u_beside"], ["greedy", "u_beside"]):
         out = tmp_path / ("run-" + "-".join(chosen))
         res = runner.invoke(app, ["run", str(sc), "--out", str(out), "--workers", "1",
                                   *[a for c in chosen for a in ("--planner", c)]])
