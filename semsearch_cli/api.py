@@ -248,7 +248,7 @@ def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | Non
     ``experiment.max_distance`` unless ``max_distance`` is; ``margin`` metres of grid surround the
     robot's first map; a run that does not find the goal leaves a repro bag at ``repro``. ``log``
     takes a line of progress. Returns the :class:`~semsearch_cli.ros2.LiveRun`."""
-    if not ros2.available():
+    if not ros2.available("rosbags", "roslibpy"):  # rosbags: the repro bag
         raise MissingExtra("semsearch ros live", "ros")
     _margin(margin)
     if max_distance is not None and not max_distance > 0:
@@ -274,7 +274,7 @@ def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, pe
     (0.2: a step of 0.1 m at 0.5 m/s); with ``follow``, it also drives to each PoseStamped a
     client publishes on that topic (``--publish-only``'s goals). Returns the started
     :class:`~semsearch_cli.ros2.loopback.SimRobot`; ``robot.bridge.stop()`` ends it."""
-    if not ros2.available():
+    if not ros2.available("rosbags", "websockets"):  # rosbags: its messages
         raise MissingExtra("semsearch ros sim", "ros")
     if not 0 < period < math.inf:
         raise ScenarioError("<command line>", "--period", f"{period:g} s: give a number of seconds over 0")

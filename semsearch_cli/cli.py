@@ -24,8 +24,8 @@ from .provenance import version_line
 from .runner import BatchOptions
 from .config.base import MAX_SEEDS, sign_label
 from .kernels import announce_compiling
-from .errors import DISK_FULL, UNAVAILABLE, BatchStopped, ScenarioError, Terminated, did_you_mean
-from .metrics import FALLBACK_FLAG, fallback_shares
+from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated, did_you_mean
+from .metrics import FALLBACK_FLAG, fallback_shares, outside_the_run
 from .report.build import console_tables
 from .files import output_folder
 
@@ -279,7 +279,7 @@ def _fallback_lines(runs) -> None:
         share = n / asked if asked else 0.0
         flag = f" (more than {FALLBACK_FLAG:.0%}: the bench board marks it)" if share > FALLBACK_FLAG else ""
         out.print(f"fell back: {label}: {n} of {asked} decisions ({share:.1%}){flag}", highlight=False, soft_wrap=True)
-    outside = runs[(runs["outcome"] == "error") & runs["message"].astype(str).str.startswith(UNAVAILABLE)]
+    outside = runs[outside_the_run(runs)]
     if len(outside):
         err.print(f"{len(outside)} run(s) could not run, for a cause outside them (e.g. {outside['planner'].iloc[0]}: "
                   f"{outside['message'].iloc[0]}): they are not results; once the cause is fixed, the same command runs "

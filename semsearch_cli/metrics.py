@@ -7,6 +7,7 @@ import math
 
 import pandas as pd
 
+from .errors import UNAVAILABLE
 from .planners.base import COST_COLUMNS  # noqa: F401  (the rows' cost columns, read with the others from here)
 
 # the columns of runs.csv as 0.2.0 wrote them, for every kind: the ones every kind writes, and the
@@ -32,6 +33,15 @@ def columns_for(kind_columns) -> list[str]:
     k = COLUMNS.index("navigator")
     return COLUMNS[:k] + extra + COLUMNS[k:]
 
+def outside_the_run(rows: pd.DataFrame) -> pd.Series:
+    """Which rows are of runs that could not run for a cause outside them (outcome ``error``, a
+    message starting with :data:`~semsearch_cli.errors.UNAVAILABLE`): no result, run again on
+    resume, left out of a board's statistics."""
+    if not len(rows):
+        return pd.Series(False, index=rows.index, dtype=bool)
+    return (rows["outcome"].astype(str) == "error") & rows["message"].astype(str).str.startswith(UNAVAILABLE)
+
+
 FALLBACK_FLAG = 0.05  # a share of a planner's decisions fallen back above this is marked (the bench board, docs/bench-board.md)
 
 
@@ -39,9 +49,12 @@ def fallback_shares(rows) -> list[tuple[str, int, int]]:
     """Per planner whose rows count fallbacks (a language model's: the ``fallbacks`` cost
     column), in the rows' order: (label, decisions that fell back, decisions asked). A decision
     ends in one valid reply or in the fallback, so the decisions asked are ``llm_calls -
-    invalid_replies + fallbacks`` (a decision cut short by the run's budget is not counted)."""
+    invalid_replies + fallbacks`` (a decision cut short by the run's budget is not counted). A
+    chain's stage rows repeat their run's costs: only a run's own row counts."""
     if not len(rows) or "fallbacks" not in rows.columns:
         return []
+    if "stage" in rows.columns:
+        rows = rows[rows["stage"].fillna("").astype(str) == ""]
     out = []
     for label, g in rows.groupby("planner", sort=False):
         f = pd.to_numeric(g["fallbacks"], errors="coerce")

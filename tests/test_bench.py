@@ -14,17 +14,20 @@ import subprocess
 import threading
 import urllib.parse
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli import api, bench
-from semsearch_cli.bench.board import at_budget, uis_budgets
+from semsearch_cli.bench.board import at_budget, paired_diff, uis_budgets
 from semsearch_cli.bench.predictability import predictability
 from semsearch_cli.bench.suites import build, read_split
 from semsearch_cli.cli import app
 from semsearch_cli.planners import PLANNERS, Variant
+from semsearch_cli.report.figures import bench as figures
 from semsearch_cli.runner import BatchOptions, Loaded
 from semsearch_cli.shipped import scenario_file
 from semsearch_cli.world.buildings.numbered import generate_building
@@ -484,6 +487,18 @@ def test_each_planner_says_its_own_episode_count(tmp_path):
     assert "| greedy | 3 of 800 | 3 |" in md and "| bvp | 1 of 800 | 1 |" in md
 
 
+def test_a_planner_none_of_whose_runs_could_run_has_a_row_saying_so_and_no_statistic(tmp_path):
+    res = _run(tmp_path, "greedy", limit=1)
+    f = res.out / "f000" / "runs.csv"
+    rows = pd.read_csv(f, dtype=str, keep_default_na=False)
+    rows["outcome"], rows["message"] = "error", "unavailable: the model's endpoint did not answer"
+    rows.to_csv(f, index=False)  # as a language model's run that could not run is recorded
+    api.bench_board([res.out], tmp_path / "site")
+    md = (tmp_path / "site" / "board.md").read_text()
+    assert "| greedy | 0 | 0 |" in md and "1 run(s) unavailable (left out; the same bench run runs them again)" in md
+    assert "no (no run of it could run)" in md and "official (the published hash)" not in md
+
+
 def test_a_planner_file_stands_beside_built_in_planners(tmp_path):
     f = tmp_path / "mine.py"
     f.write_text(USER_PLANNER.replace("u_first_candidate", "u_beside"))  # a name registers once per process
@@ -498,11 +513,11 @@ def test_a_planner_file_stands_beside_built_in_planners(tmp_path):
     # semsearch run: a scenario's own planner file beside built-in planners, one of them chosen with --planner
     api.init("demo", tmp_path / "demo")
     src = tmp_path / "demo" / "demo.yaml"
-    doc = __import__("yaml").safe_load(src.read_text())
+    doc = yaml.safe_load(src.read_text())
     doc["planners"] = [{"name": "greedy"}, {"name": "u_beside", "module": str(f)}]
     doc["goals"], doc["experiment"]["seeds"] = doc["goals"][:1], 1
     sc = tmp_path / "demo" / "demo_mine.yaml"
-    sc.write_text(__import__("yaml").safe_dump(doc))
+    sc.write_text(yaml.safe_dump(doc))
     for chosen in (["greedy"], ["u_beside"], ["greedy", "u_beside"]):
         out = tmp_path / ("run-" + "-".join(chosen))
         res = runner.invoke(app, ["run", str(sc), "--out", str(out), "--workers", "1",
@@ -520,9 +535,6 @@ def test_a_mistyped_numbering_is_named_with_the_nearest(tmp_path):
 
 
 def test_a_gain_within_float_noise_is_shown_as_zero(tmp_path, monkeypatch):
-    from semsearch_cli.bench.board import paired_diff
-    from semsearch_cli.report.figures import bench as figures
-
     units = [f"f{k}/0" for k in range(4)]
     a = pd.DataFrame({"unit": units, "spl": [0.3, 0.5, 0.25, 0.7]})
     b = a.assign(spl=a["spl"] - 2.8e-18 * np.array([1, 0, 1, 1]) - np.array([0, 5.6e-17, 0, 0]))
@@ -538,4 +550,4 @@ def test_a_gain_within_float_noise_is_shown_as_zero(tmp_path, monkeypatch):
     assert ax.yaxis.get_offset_text().get_text() == ""  # no 1e-18 over the axis
     assert [float(y) for y in ax.collections[0].get_offsets()[:, 1]] == [0.0, 0.0, 0.0]
     assert "gain +0.000 on every one of 3 floors" in [t.get_text() for t in ax.texts]
-    __import__("matplotlib.pyplot").pyplot.close(seen[0])
+    plt.close(seen[0])

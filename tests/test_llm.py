@@ -9,6 +9,9 @@ import os
 import random
 import re
 import shutil
+import socket
+import subprocess
+import sys
 import uuid
 from collections import Counter
 from pathlib import Path
@@ -455,26 +458,40 @@ def test_a_report_never_calls_the_model(tmp_path):
 # ---- a model that does not answer is never a result ---------------------------------------------
 def closed_port() -> int:
     """A loopback port nothing listens on (bound, then let go)."""
-    import socket
-
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
 
 
 def refused(tmp_path: Path, entry: dict, env: dict | None = None) -> str:
-    """``semsearch run`` of the demo with greedy and ``entry``: exit 2 before any row, in under 10 s;
-    its output."""
-    import time
-
+    """``semsearch run`` of the demo with greedy and ``entry``: exit 2 with nothing written; its
+    output. Fast failure is the look's own (one request, no retries,
+    PREFLIGHT_TIMEOUT_S): the tests count the requests rather than time them."""
     sc = scenario(tmp_path, [{"name": "greedy"}, entry], seeds=1)
-    t0 = time.monotonic()
     res = CliRunner().invoke(app, ["run", str(sc), "--out", str(tmp_path / "out"), "--workers", "1"], env=env)
     assert res.exit_code == 2, res.output
-    assert time.monotonic() - t0 < 10.0  # fails fast: no retries, a short timeout
-    assert not (tmp_path / "out" / "runs.csv").exists() or len(pd.read_csv(tmp_path / "out" / "runs.csv")) == 0
+    assert not [p for p in (tmp_path / "out").rglob("*")]  # nothing written (the folder itself is made as --out is read)
     assert "Traceback" not in res.output and res.output.startswith("error: ")
     return " ".join(res.output.split())
+
+
+def test_a_refused_endpoint_on_resume_moves_no_row_and_bench_run_writes_nothing(tmp_path):
+    """A folder whose llm runs could not run, resumed while the endpoint is still down: refused
+    before the folder is touched (its rows stay where they are); a bench run likewise writes no
+    bench.json nor floor."""
+    with ChatServer(lambda r, n: Answer(status=500), models=["scripted"]) as srv:
+        sc = scenario(tmp_path, [llm(srv, retries=0)], seeds=1, goals=[452])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+    before = (tmp_path / "out" / "runs.csv").read_bytes()
+    assert b"unavailable: " in before
+    res = CliRunner().invoke(app, ["run", str(sc), "--out", str(tmp_path / "out"), "--workers", "1"])  # the server is gone
+    assert res.exit_code == 2 and "no connection to" in " ".join(res.output.split()), res.output
+    assert (tmp_path / "out" / "runs.csv").read_bytes() == before and not (tmp_path / "out" / "runs.superseded.csv").exists()
+    url = f"http://127.0.0.1:{closed_port()}/v1"
+    res = CliRunner().invoke(app, ["bench", "run", "doors-v1", "--planner", f"llm[base_url={url},model=m]", "--limit", "1",
+                                   "--workers", "1", "--out", str(tmp_path / "bench")])
+    assert res.exit_code == 2 and "field '--planner'" in res.output and "no connection to" in " ".join(res.output.split())
+    assert not (tmp_path / "bench").exists()
 
 
 def test_a_server_that_answers_500_is_refused_before_the_first_run(tmp_path):
@@ -554,9 +571,6 @@ def test_a_run_whose_model_fails_ends_error_unavailable_not_found(tmp_path):
 
 
 def test_without_openai_run_bench_and_dry_run_refuse_in_one_line(tmp_path):
-    import subprocess
-    import sys
-
     sc = scenario(tmp_path, [{"name": "greedy"}, {"name": "llm", "base_url": "http://127.0.0.1:9/v1", "model": "m"}], seeds=1)
     no_openai = "import sys; sys.modules['openai'] = None; from semsearch_cli.cli import main; sys.argv[0] = 'semsearch'; main()"
     line = "the llm planner needs the llm extra: pip install 'semsearch[llm]'"

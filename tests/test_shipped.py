@@ -5,6 +5,7 @@ import os
 import shutil
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -132,8 +133,6 @@ def test_the_wheel_holds_every_data_file_the_code_opens(wheel, tmp_path, monkeyp
     commit it was built from), and every file that the commands which read package data open there
     (an audit hook records each open) is in the wheel: a glob in pyproject.toml that leaves a
     file out fails here, not on a user's machine."""
-    import zipfile
-
     wheel, _ = wheel
     held = {n.removeprefix("semsearch_cli/data/") for n in zipfile.ZipFile(wheel).namelist() if n.startswith("semsearch_cli/data/")}
     data = ROOT / "semsearch_cli" / "data"

@@ -22,9 +22,9 @@ import numpy as np
 import pandas as pd
 from scipy.stats import kendalltau, spearmanr
 
-from ..errors import UNAVAILABLE, ScenarioError
+from ..errors import ScenarioError
 from ..files import atomic_text, output_folder
-from ..metrics import COST_COLUMNS, FALLBACK_FLAG, fallback_shares
+from ..metrics import COST_COLUMNS, FALLBACK_FLAG, fallback_shares, outside_the_run
 from ..report.document import Document
 from ..report.figures.bench import GAIN_FLOOR, plot_gain_vs_predictability
 from ..report.indirect import PAPER_SCALES, PAPER_TABLE3, claims_table
@@ -105,7 +105,7 @@ def load(folders) -> pd.DataFrame:
                          predictability=float((info or {}).get("predictability") or np.nan),
                          split_episodes=episodes, split_runs=episodes * int(meta.get("repeats", 1)),
                          partial_meta=bool(meta.get("partial", False)),
-                         unavailable=(r["outcome"].astype(str) == "error") & r["message"].astype(str).str.startswith(UNAVAILABLE))
+                         unavailable=outside_the_run(r))
             frames.append(r)
     if not frames:
         raise ScenarioError(str(folders[0]), "", "the bench folders hold no rows")
@@ -153,14 +153,21 @@ def fallback_note(d: pd.DataFrame) -> str:
 def tables(rows: pd.DataFrame) -> dict:
     """The board's tables of one suite and split (keys: planners, conventions, numberings,
     floors)."""
+    kind = str(rows["kind"].iloc[0])
+    planners = list(dict.fromkeys(rows.loc[rows["numbering"] == "true", "planner"]))  # a planner all of whose runs could not run too
     gone = rows[rows["unavailable"]] if "unavailable" in rows.columns else rows.iloc[:0]
     rows = rows[~rows["unavailable"]] if "unavailable" in rows.columns else rows
     true = rows[rows["numbering"] == "true"]
-    planners = list(dict.fromkeys(true["planner"]))
-    baseline = BASELINES.get(str(rows["kind"].iloc[0]), "")
+    baseline = BASELINES.get(kind, "")
     out = []
     for lab in planners:
         d = true[true["planner"] == lab]
+        if not len(d):  # every run of it could not run (a model that did not answer): no statistic, said so
+            lost = int(((gone["planner"] == lab) & (gone["numbering"] == "true")).sum())
+            out.append({"planner": lab, "episodes": "0", "runs": 0,
+                        "verified": f"{lost} run(s) unavailable (left out; the same bench run runs them again)",
+                        "official": "no (no run of it could run)"})
+            continue
         s, slo, shi = rate_ci(d["success"].to_numpy(float), d["unit"].to_numpy())
         complete, why = completeness(d)
         eps = float(d["split_episodes"].max())
@@ -348,7 +355,8 @@ def board(folders, out: str | Path) -> list[Path]:
         doc.heading(2, f"{suite} {split}" + ("" if g["official"].all() else f" ({hash_[:16]})"))
         eps = float(g["split_episodes"].max())
         done = g[~g["unavailable"] & (g["numbering"] == "true")]
-        whole = [completeness(d)[0] for _, d in done.groupby("planner")]
+        ran = set(g.loc[g["numbering"] == "true", "planner"])  # a planner none of whose runs could run is not whole either
+        whole = [completeness(d)[0] for _, d in done.groupby("planner")] + [False] * len(ran - set(done["planner"]))
         official = ("not official (no published hash matches)" if not g["official"].all() else
                     "official (the published hash)" if whole and all(whole) else
                     "the published hash, but partial: a planner lacks runs of the split (a --limit run), so not official")

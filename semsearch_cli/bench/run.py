@@ -25,9 +25,11 @@ import yaml
 
 from ..config import PlannerSpec
 from ..config.base import sign_label
-from ..errors import UNAVAILABLE, ScenarioError, did_you_mean
+from ..errors import ScenarioError, did_you_mean
 from ..files import atomic_text, output_folder
 from ..report.build import write_meta
+from ..metrics import outside_the_run
+from ..planners.base import expand_variants, preflight
 from ..runner import Batch, BatchOptions, Loaded, folder_lock, make_executor, read_runs
 from ..runner.specs import RunList
 from ..runner.verify import Verdict, verify_folder
@@ -139,6 +141,11 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
     if limit is not None and limit < 1:
         raise ScenarioError("<command line>", "--limit", f"{limit}: give at least 1 episode")
     options = options.checked().replace(decisions=True, seeds=None, goals=None, planners=None)
+    try:
+        variants = expand_variants(planners, "<command line>")
+    except ScenarioError:
+        variants = []  # a planner the command line names wrong: said of --planner below, with the floor loaded
+    preflight(variants, "<command line>", "--planner")  # before the folder, bench.json or a floor is written
     out = output_folder(out)
     counts = [len(pd.read_csv(f.scenario.parent / "episodes.csv", usecols=["goal"])) for f in sp.floors]
     todo, left = [], limit
@@ -194,7 +201,7 @@ def missing_runs(out: Path, meta: dict) -> dict[str, int]:
             if f.is_file():
                 r = read_runs(f)
                 r = r[(r["stage"] == "") & (r["planner"].astype(str) == lab)]
-                r = r[~((r["outcome"] == "error") & r["message"].astype(str).str.startswith(UNAVAILABLE))]
+                r = r[~outside_the_run(r)]
                 have += len(r.drop_duplicates(["goal", "episode", "seed"]))
         if have < sum(want.values()):
             lacking[lab] = sum(want.values()) - have

@@ -40,7 +40,7 @@ import numpy as np
 
 from ..errors import ScenarioError
 from ..tasks.doors import DoorSearch, DoorTask
-from ..tasks.episodes import Episode, draw_starts, episode_seed, region_mask
+from ..tasks.episodes import Episode, draw_starts, episode_seed
 
 REDRAWS = 100  # draws of a new start for one unsolvable episode before the builder gives up
 
@@ -127,7 +127,7 @@ def solvable_episodes(task, repeats: int, rng: np.random.Generator | None) -> tu
         raise ScenarioError(task.file, "episodes", f"episode {ep.index} (goal {ep.goal}) cannot be solved: {why}"
                             f"{'' if len(bad) == 1 else f' ({len(bad)} episodes cannot)'}")
     w = task.world
-    stand = w.reach & (w.clearance >= spec.clearance) & region_mask(w.free, w.frame.res, spec.where, spec.corridor_width)
+    stand = task.start_cells(spec)
     moved = []
     for ep, why in bad:
         ok = stand.copy()
@@ -148,7 +148,7 @@ def solvable_episodes(task, repeats: int, rng: np.random.Generator | None) -> tu
             else:
                 got = []
         finally:
-            task._fields.pop(str(ep.goal), None)
+            task.forget_field(ep.goal)
         if not got:
             raise ScenarioError(task.file, "episodes", f"episode {ep.index} (goal {ep.goal}) cannot be solved ({why}), "
                                 f"and {REDRAWS} starts drawn again could not either")

@@ -190,8 +190,8 @@ def percent_of_optimal(runs: pd.DataFrame, summary: pd.DataFrame | None = None) 
     shortest path; from drawn starts each run is measured against its own start's shortest path
     (not the mean distance over the mean shortest path, which weighs long episodes more).
 
-    ``summary`` is taken for the signature's sake: the percentages come from the rows' own
-    ratios, unrounded (a summary's mean_ratio is rounded to 3 decimals)."""
+    ``summary`` is no longer read (kept for the signature): the percentages come from the rows' own
+    ratios (4 decimals), not from a summary's mean_ratio (rounded to 3)."""
     s = runs.assign(pct=100.0 * pd.to_numeric(runs["ratio"], errors="coerce"))
     t = s.pivot_table(index=["scenario", "goal"], columns="planner", values="pct", aggfunc="mean").round(2)
     return in_goal_order(t.reindex(columns=planner_order(t.columns)))

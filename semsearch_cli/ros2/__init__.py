@@ -11,10 +11,11 @@ from .loopback import Rosbridge, SimRobot
 from .replay import Replayed, recorded_scenario, replay_bag
 
 
-def available() -> bool:
-    """Whether the ros extra is installed (rosbags writes the bags; roslibpy speaks to rosbridge;
-    websockets serves the stand-in robot)."""
-    return all(installed(name) for name in ("rosbags", "roslibpy", "websockets"))
+def available(*packages: str) -> bool:
+    """Whether the ros extra's ``packages`` are installed (default: rosbags, which writes and reads
+    the bags and their messages); ``ros live`` also needs roslibpy (rosbridge's client), ``ros sim``
+    websockets (the stand-in robot's server)."""
+    return all(installed(name) for name in (packages or ("rosbags",)))
 
 
 __all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run", "exportable",

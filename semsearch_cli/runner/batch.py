@@ -11,9 +11,9 @@ from typing import Callable, Sequence
 
 import pandas as pd
 
-from ..errors import DISK_FULL, UNAVAILABLE, BatchStopped, ScenarioError
+from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
-from ..metrics import columns_for
+from ..metrics import columns_for, outside_the_run
 from ..planners import code_of, planner_class
 from ..planners.base import has_preflight, preflight
 from .execution import Executor, Watch
@@ -63,7 +63,7 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
                        f"were made by other code ({names}: the planner's file or semsearch changed since)")
             done = run_rows(read_runs(runs_csv, as_written=True))
     if len(done):
-        outside = (done["outcome"].astype(str) == "error") & done["message"].astype(str).str.startswith(UNAVAILABLE)
+        outside = outside_the_run(done)
         if outside.any():  # a cause outside the run (a missing package, a model that did not answer): not done
             keys = set(zip(*(done.loc[outside, c].astype(str) for c in ("planner", "goal", "episode", "seed"))))
             _supersede(out, lambda rows: pd.Series([k in keys for k in zip(*(rows[c].astype(str) for c in ("planner", "goal", "episode", "seed")))],
@@ -196,6 +196,9 @@ class Batch:
         self._stack: ExitStack | None = None
 
     def __enter__(self) -> "Batch":
+        # a planner that cannot run at all (a language model's endpoint that does not answer, a
+        # package it needs): refused before the folder is made, locked or touched
+        preflight(_pending(self.variants, self.specs, _have(self.out / "runs.csv")), str(self.loaded.path))
         with ExitStack() as stack:
             stack.enter_context(folder_lock(self.out))
             self.done = check_folder(self.loaded, self.out, self.options.force, self.codes)
@@ -225,8 +228,6 @@ class Batch:
         todo = (s for s in specs if s.key not in have)
         if total >= MANY_RUNS:
             print(f"runs: {total:,} to do ({len(self.variants):,} planner variant(s) x goals, episodes and seeds)", file=sys.stderr)
-        if total:  # a planner that cannot run at all (a language model's endpoint that does not answer): refused here
-            preflight(_pending(self.variants, specs, have), str(loaded.path))
         if total and executor == "processes" and runner is None:
             check_memory(loaded, max(1, min(workers, total)))
         if runner is None:
@@ -258,6 +259,20 @@ class Batch:
             except OSError:
                 pass
         return read_runs(runs_csv)
+
+
+def _have(runs_csv: Path) -> set:
+    """The (planner, goal, episode, seed) keys of runs.csv's runs that are done, read without the
+    folder's lock and changing nothing (a run that could not run, ``unavailable:``, is not done;
+    a file that is not a runs.csv: none, and :func:`check_folder` says why)."""
+    try:
+        done = run_rows(read_runs(runs_csv, as_written=True))
+    except ScenarioError:
+        return set()
+    if not len(done):
+        return set()
+    done = done[~outside_the_run(done)]
+    return {(str(p), str(g), int(e), int(s)) for p, g, e, s in zip(done["planner"], done["goal"], done["episode"], done["seed"])}
 
 
 def _pending(variants, specs, have: set) -> list:

@@ -212,7 +212,7 @@ def _close(client, cluster) -> None:
         cluster.close()
 
 
-def require() -> None:
+def require_dask() -> None:
     """:class:`MissingExtra` unless the dask extra (``distributed``) is installed."""
     if distributed is None:
         raise MissingExtra("--executor dask", "dask")
@@ -221,7 +221,7 @@ def require() -> None:
 @register_executor("dask")
 def dask_executor(workers: int, start_method: str | None, address: str | None, chunk: int) -> DaskExecutor:
     """The Dask scheduler at ``address``, or a local cluster of ``workers`` processes."""
-    require()
+    require_dask()
     if address:
         check_address(address)  # a malformed address is refused before a client is made
     return DaskExecutor(workers, address, chunk)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ScenarioError
-from .cluster import check_address, require
+from .cluster import check_address, require_dask
 from .executors import check_kind
 
 MAX_WORKERS = 512  # even with --oversubscribe
@@ -58,7 +58,7 @@ class BatchOptions:
         ``workers`` is not checked."""
         check_kind(self.executor)
         if self.executor == "dask":
-            require()  # its package, before anything is written
+            require_dask()  # its package, before anything is written
         if self.scheduler is not None and self.executor != "dask":
             raise ScenarioError("<command line>", "--scheduler", "a scheduler address goes with --executor dask")
         if self.scheduler is not None and not self.scheduler.strip():

@@ -509,10 +509,20 @@ class OnMapTask(Task):
         raise ScenarioError(e["file"], e["field"], f"goal {e['goal']} is not one of the scenario's goals "
                             f"({', '.join(map(str, self.goals))})")
 
+    def forget_field(self, goal) -> None:
+        """Drop ``goal``'s distance field (:meth:`goal_field` holds it only while episodes are drawn)."""
+        self._fields.pop(str(goal), None)
+
+    def start_cells(self, spec) -> np.ndarray:
+        """(H, W) bool: the cells a start of the episode set ``spec`` may be drawn on: reachable,
+        ``spec.clearance`` m or more from walls, in ``spec.where``."""
+        w = self.world
+        return w.reach & (w.clearance >= spec.clearance) & region_mask(w.free, w.frame.res, spec.where, spec.corridor_width)
+
     def draw_episodes(self, spec) -> list[dict]:
         """``spec.starts`` drawn starts per goal (or shared by every goal), as in :mod:`.episodes`."""
         w = self.world
-        stand = w.reach & (w.clearance >= spec.clearance) & region_mask(w.free, w.frame.res, spec.where, spec.corridor_width)
+        stand = self.start_cells(spec)
         where = "" if spec.where == "anywhere" else f" in {spec.where}"
         band = f"between {spec.min_distance:g} and {spec.max_distance:g} m" if spec.max_distance else f"at least {spec.min_distance:g} m"
         out = []
@@ -530,7 +540,7 @@ class OnMapTask(Task):
                 out += [dict(goal=g, x=x, y=y, heading=h, file=self.file, field="episodes", shortest=self.shortest_from(g, x, y))
                         for x, y, h in starts]
                 if not spec.shared:
-                    self._fields.pop(str(g), None)
+                    self.forget_field(g)
         if spec.shared:  # goal by goal, as when drawn per goal
             out.sort(key=lambda e: [str(g) for g in self.goals].index(str(e["goal"])))
         return out

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import urlsplit
 
-from ...errors import ScenarioError
+from ...errors import MissingExtra
 from ...files import cache_dir
 from ...optional import lazy_module
 
@@ -35,7 +35,7 @@ openai = lazy_module("openai", "llm")  # optional: pip install 'semsearch[llm]'
 NO_KEY = "not-needed"  # what the client sends when api_key_env is unset (local servers ignore the key)
 SLOT_WAIT_S = 0.01  # s between looks for a free request slot
 PREFLIGHT_TIMEOUT_S = 5.0  # s the check of an endpoint before a batch waits for the server (no retries)
-MISSING = "the llm planner needs the llm extra: pip install 'semsearch[llm]'"  # the openai package, not installed
+MISSING = str(MissingExtra("the llm planner", "llm"))  # the openai package, not installed
 
 
 @dataclass
@@ -84,10 +84,12 @@ class Slots:
             fh.close()
 
 
-def require_openai(where: str, field: str = "name") -> None:
-    """A :class:`ScenarioError` naming ``where`` when the ``openai`` package is not installed."""
+def require_openai() -> None:
+    """:class:`~semsearch_cli.errors.MissingExtra` when the ``openai`` package is not installed
+    (a batch refuses before its first run; a worker without it records the run as one that could
+    not run, which the same command runs again)."""
     if openai is None:
-        raise ScenarioError(where, field, MISSING)
+        raise MissingExtra("the llm planner", "llm")
 
 
 def url_fault(base_url: str) -> str | None:
@@ -150,7 +152,7 @@ class Chat:
 
     def __init__(self, base_url: str, model: str, api_key_env: str, temperature: float, max_tokens: int, timeout_s: float,
                  retries: int, max_concurrent: int):
-        require_openai("<llm planner>")
+        require_openai()
         self.model, self.temperature, self.max_tokens = model, temperature, max_tokens
         self.client = openai.OpenAI(base_url=base_url, api_key=os.environ.get(api_key_env) or NO_KEY, timeout=timeout_s,
                                     max_retries=retries)

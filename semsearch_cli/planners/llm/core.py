@@ -163,7 +163,7 @@ class LlmCore(Planner):
             fault = self.fault(params)
             if fault:
                 raise PlannerError(f"llm: {fault[0]}: {fault[1]}")
-            require_openai("<llm planner>")
+            require_openai()
         else:  # the re-plan cadence the transcripts were made with, known before a run starts (a policy's env_kwargs)
             made = replan_on_signs(Path(params.replay), params.replay_planner)
             if len(made) == 1:
@@ -238,7 +238,9 @@ class LlmCore(Planner):
             raise PlannerError(f"replay of {where}: {found[0][1]} is the transcript of a {head.get('kind')} search, "
                                f"not of a {self.kind} one")
         try:
-            self._live = LlmParams(**{**head["params"], "replay": self.params.replay})
+            # a transcript made before the rules that stop a failing model ran without them: so does its replay
+            before = {"unavailable_after": 0, "max_fallback_share": 1.0}
+            self._live = LlmParams(**{**before, **head["params"], "replay": self.params.replay})
         except (TypeError, ValueError) as exc:
             raise PlannerError(f"transcript {found[0][1]}: its parameters do not read ({str(exc)[:200]})") from None
         self.replan_on_signs = self._live.replan_on_signs
