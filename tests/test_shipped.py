@@ -153,7 +153,7 @@ def test_the_wheel_holds_every_data_file_the_code_opens(wheel, tmp_path, monkeyp
                  ["bench", "run", "doors-v1", "--planner", "learned", "--limit", "1", "--out", "b"]):
         res = runner.invoke(app, args)
         assert res.exit_code == 0, (args, res.output)
-    assert opened and {"bench/doors-real-v1/sources.json", "models/learned-doors-v1.json"} <= opened
+    assert "bench/doors-real-v1/sources.json" in opened  # what 0.2.0's wheel lacked (a model read before the hook is cached)
     assert sorted(opened - held) == []
 
 
