@@ -24,7 +24,6 @@ from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points, planner_class
-from .planners.llm import client as llm_client
 from .planners.base import load_planner_file, path_fields
 from .planners.llm import FirstPrompt
 from .plugins import load_kinds
@@ -116,7 +115,8 @@ def first_prompt(scenario: str | Path, options: BatchOptions = BatchOptions()) -
     if not variants:
         raise ScenarioError(str(loaded.path), "planners", "no planner of this scenario calls a language model (llm); "
                             "--dry-run prints the first prompt such a planner would send")
-    fault = _package_fault(variants[0])
+    cls = planner_class(variants[0])
+    fault = cls.missing(variants[0].resolved(cls))
     if fault:  # what a real batch refuses before its first run, a dry run refuses too (it calls no server)
         raise ScenarioError(str(loaded.path), f"planners.{fault[0]}", f"{variants[0].label}: {fault[1]}")
     goals = set(map(str, options.goals or ()))
@@ -129,15 +129,6 @@ def first_prompt(scenario: str | Path, options: BatchOptions = BatchOptions()) -
             return stop.text()
     raise ScenarioError(str(loaded.path), "planners", f"{variants[0].label} was asked nothing on these episodes (each "
                         "found its goal before a decision)")
-
-
-def _package_fault(variant) -> tuple[str, str] | None:
-    """A missing package a planner that calls a language model needs (the llm planner's ``openai``),
-    as its preflight names it; the endpoint itself is not looked at (a dry run calls nothing)."""
-    params = variant.resolved(planner_class(variant))
-    if getattr(params, "replay", None) is None and llm_client.openai is None:
-        return "name", llm_client.MISSING
-    return None
 
 
 def report(folders, out: str | Path | None = None, formats=("md", "csv", "png", "html"), replay: bool | str = True) -> list[Path]:

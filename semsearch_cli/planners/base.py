@@ -216,13 +216,20 @@ class Planner:
         return ""
 
     @classmethod
+    def missing(cls, params: BaseModel) -> tuple[str, str] | None:
+        """A package the planner needs that is not installed (the field to name, the message), or
+        None (the default). A dry run looks at this alone (it calls no service);
+        :meth:`preflight` looks at it first."""
+        return None
+
+    @classmethod
     def preflight(cls, params: BaseModel) -> tuple[str, str] | None:
         """What stops the planner from running at all (the field to name, the message), looked
         at once per batch, before its first run, in the process that starts the batch: a package
         it needs, a service it answers through that does not answer (the llm planner's endpoint,
-        docs/llm.md). None when nothing does (the default): a batch then refuses to start rather
-        than record runs that could not be the planner's."""
-        return None
+        docs/llm.md). None when nothing does; the default looks at :meth:`missing` alone. A batch
+        refuses to start rather than record runs that could not be the planner's."""
+        return cls.missing(params)
 
 
 class DoorPlanner(Planner):
@@ -667,8 +674,9 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
 
 
 def has_preflight(cls: type[Planner]) -> bool:
-    """Whether a planner class looks before it runs (overrides :meth:`Planner.preflight`)."""
-    return getattr(cls.preflight, "__func__", None) is not Planner.preflight.__func__
+    """Whether a planner class looks before it runs (overrides :meth:`Planner.preflight` or
+    :meth:`Planner.missing`)."""
+    return any(getattr(getattr(cls, m), "__func__", None) is not getattr(Planner, m).__func__ for m in ("preflight", "missing"))
 
 
 def preflight(variants, file: str, field: str | None = None) -> None:

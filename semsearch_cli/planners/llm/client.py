@@ -84,6 +84,11 @@ class Slots:
             fh.close()
 
 
+def openai_installed() -> bool:
+    """Whether the ``openai`` package (the llm extra) is installed."""
+    return openai is not None
+
+
 def require_openai() -> None:
     """:class:`~semsearch_cli.errors.MissingExtra` when the ``openai`` package is not installed
     (a batch refuses before its first run; a worker without it records the run as one that could

@@ -39,8 +39,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ...errors import BudgetSpent, PlannerError, ScenarioError, Unavailable
 from ..base import COST_COLUMNS, Planner
-from . import client
-from .client import Chat, Reply, prompt_path, require_openai, url_fault
+from .client import MISSING, Chat, Reply, openai_installed, prompt_path, require_openai, url_fault
+from .client import preflight as look_at_endpoint
 from .replies import parse_number, parse_probabilities
 from .transcript import folder_text, header, index, read, replan_on_signs, run_key
 
@@ -195,10 +195,15 @@ class LlmCore(Planner):
         (:func:`.client.preflight`); nothing for a replay, which calls nothing."""
         if params.replay is not None:
             return None
-        if client.openai is None:
-            return "name", client.MISSING
-        fault = client.preflight(params.base_url, params.model, params.api_key_env, "api_key_env" in params.model_fields_set)
-        return fault
+        return cls.missing(params) or look_at_endpoint(params.base_url, params.model, params.api_key_env,
+                                                       "api_key_env" in params.model_fields_set)
+
+    @classmethod
+    def missing(cls, params: LlmParams) -> tuple[str, str] | None:
+        """The ``openai`` package, unless the planner replays transcripts (which calls nothing)."""
+        if params.replay is None and not openai_installed():
+            return "name", MISSING
+        return None
 
     @classmethod
     def inputs(cls, params: LlmParams) -> str:
