@@ -215,7 +215,8 @@ def _run_floor(sp: Split, f: Floor, take: int, loaded, planners, numbering: str,
     if loaded is None:
         loaded = Loaded.load(materialise(sp, f, numbering, dest / "scenario")).with_planners(planners)
     specs = RunList(loaded.task.episodes[:take], loaded.task.variants(), sp.suite.repeats)
-    with Batch(loaded, specs, dest, options, stamp=stamp, own=("decisions_sha256",)) as batch:
+    # the planners were looked at once for every floor (run_bench's preflight)
+    with Batch(loaded, specs, dest, options, stamp=stamp, own=("decisions_sha256",), looked=True) as batch:
         write_meta(dest, loaded)
         base = finished + sum(1 for k in _keys(batch.done) if specs.has_key(k))  # this floor's runs already there
 
@@ -223,12 +224,7 @@ def _run_floor(sp: Split, f: Floor, take: int, loaded, planners, numbering: str,
             if progress:
                 progress(row, base + n, total)
 
-        try:
-            rows = batch.run(tick, runner=runner)
-        except ScenarioError as exc:  # a planner that cannot run (preflight): the command line named it
-            if not exc.field.startswith("planners"):
-                raise
-            raise ScenarioError("<command line>", "--planner", exc.message) from None
+        rows = batch.run(tick, runner=runner)
     own = rows[rows["stage"] == ""] if len(rows) else rows  # (a suite of chains would keep their stage rows too)
     mine = np.array([specs.has_key(k) for k in _keys(own)], bool)  # not the runs a longer run left here
     return own[mine] if len(own) else own

@@ -184,11 +184,14 @@ class Batch:
     ``stamp``: columns written with the same value on every row (a bench run's suite, split,
     hash, numbering and floor: :data:`~semsearch_cli.metrics.BENCH_COLUMNS`); ``own``: columns
     each run's rows bring themselves, written in this folder (a bench run's ``decisions_sha256``).
+    Entering it looks at the planners with runs left (:meth:`~semsearch_cli.planners.Planner.preflight`)
+    before the folder is touched, unless ``looked`` (the caller did, once for several batches).
     """
 
     def __init__(self, loaded: Loaded, specs: Sequence[RunSpec], out: Path, options: BatchOptions = BatchOptions(),
-                 stamp: dict | None = None, own: tuple = ()):
+                 stamp: dict | None = None, own: tuple = (), looked: bool = False):
         self.loaded, self.specs, self.out, self.options = loaded, specs, Path(out), options
+        self.looked = looked  # the caller looked at the planners already (Planner.preflight): not again
         self.stamp, self.own = dict(stamp or {}), tuple(own)
         self.variants = specs.variants if hasattr(specs, "variants") else list(dict.fromkeys(s.variant for s in specs))
         self.codes = {v.label: code_of(v)["hash"] for v in self.variants}
@@ -198,7 +201,8 @@ class Batch:
     def __enter__(self) -> "Batch":
         # a planner that cannot run at all (a language model's endpoint that does not answer, a
         # package it needs): refused before the folder is made, locked or touched
-        preflight(_pending(self.variants, self.specs, _have(self.out / "runs.csv")), str(self.loaded.path))
+        if not self.looked:
+            preflight(_pending(self.variants, self.specs, _have(self.out / "runs.csv")), str(self.loaded.path))
         with ExitStack() as stack:
             stack.enter_context(folder_lock(self.out))
             self.done = check_folder(self.loaded, self.out, self.options.force, self.codes)
