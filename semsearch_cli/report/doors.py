@@ -106,9 +106,9 @@ def _figures(doc, runs, parts, fdir: Path, replay, notes: list, formats=("png",)
         if len(swept_values(sub)) >= 2:
             f = fdir / f"alpha_{scen}.png"
             plot_alpha_sweep(sub, f, formats=img, colors=colors)
-            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}, with 95% intervals over {unit} "
-                          f"({T.RATIO}; the figure's y axis as Table 4.10 gives it in percent); "
-                          "dashed and shaded: greedy's mean and interval")
+            doc.figure(f, f"Mean ratio to the shortest path against alpha, {scen}, with 95% intervals over {unit}; "
+                          "dashed and shaded: greedy's mean and interval. The ratio is each run's distance over its own "
+                          "episode's shortest path, averaged over the runs: Table 4.10 gives the same numbers in percent.")
     for part in parts:
         loaded = part.loaded(notes, "Path figures and the replay")
         if loaded is None:

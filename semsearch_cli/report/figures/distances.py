@@ -259,14 +259,15 @@ def plot_alpha_sweep(runs, out: Path, baseline: str | None = None, formats=("png
         if ax.get_subplotspec().is_last_row() or len(goals) - goals.index(g) <= 2:
             ax.set_xlabel(xlabel)
         if ax.get_subplotspec().is_first_col():
-            ax.set_ylabel("mean of distance / shortest path")
+            ax.set_ylabel("mean ratio to shortest")
     n_a = sorted(set(n_alpha.tolist()))
     n_b = sorted(set(n_base.tolist()))
     handles = [Line2D([], [], c="0.3", marker="o", mfc="0.6", mec="black", ms=4,
                       label=f"{swept_name} (n={'/'.join(map(str, n_a))} per {param})")]
     if len(n_b):
         handles.append(Line2D([], [], c=colors.get(baseline, "black"), ls="--", label=f"{baseline} (n={'/'.join(map(str, n_b))})"))
-    handles.append(Patch(color="0.6", alpha=0.4, label=f"95% CI over {stats.unit_kind(runs)}"))
+    band = colors.get(baseline, "0.6") if len(n_b) else "0.6"
+    handles.append(Patch(color=band, alpha=0.3, label=f"95% CI over {stats.unit_kind(runs)} (bars{f'; band: {baseline}' if len(n_b) else ''})"))
     handles.append(Line2D([], [], c="0.5", lw=0.6, label="the shortest path (ratio 1)"))
     _legend(fig, axes, handles, ncol=4, handlelength=1.6, columnspacing=1.0)
     return _common._save(fig, out, formats)
