@@ -35,18 +35,17 @@ def plot_gain_vs_predictability(floors: pd.DataFrame, out: Path, formats=("png",
             e = d[d["convention"] == c]
             ax.scatter(e["predictability"], e["gain"], s=14, marker=marks[c], color=colors[c], label=c, linewidths=0)
         ok = np.isfinite(d["predictability"]) & np.isfinite(d["gain"])
+        fit = ""  # under the panel's title, never over its points
         if ok.sum() >= 3 and d.loc[ok, "gain"].nunique() == 1:  # no line through a constant (r undefined)
-            ax.text(0.02, 0.97, f"gain {d.loc[ok, 'gain'].iloc[0]:+.3f} on every one of {int(ok.sum())} floors",
-                    transform=ax.transAxes, va="top", fontsize=7)
+            fit = f"gain {d.loc[ok, 'gain'].iloc[0]:+.3f} on every one of {int(ok.sum())} floors"
         elif ok.sum() >= 3:
             k, b = np.polyfit(d.loc[ok, "predictability"], d.loc[ok, "gain"], 1)
             x = np.linspace(d.loc[ok, "predictability"].min(), d.loc[ok, "predictability"].max(), 2)
             ax.plot(x, k * x + b, color="0.3", lw=0.8)
             r = float(np.corrcoef(d.loc[ok, "predictability"], d.loc[ok, "gain"])[0, 1])
-            ax.text(0.02, 0.97, f"slope {k:+.2f}, r = {r:+.2f}, {int(ok.sum())} floors", transform=ax.transAxes,
-                    va="top", fontsize=7)
+            fit = f"slope {k:+.2g}, r = {r:+.2f}, {int(ok.sum())} floors"  # .2g: a slope of 5e-4 is not -0.00
         ax.axhline(0.0, color="0.6", lw=0.6, ls=":")
-        ax.set_title(lab)
+        ax.set_title(lab + (f"\n{fit}" if fit else ""), fontsize=None if not fit else 8)
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
     for ax in axes[-1]:
