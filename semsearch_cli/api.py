@@ -289,8 +289,9 @@ def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, pe
 
 
 def _margin(margin: float) -> None:
-    if not 0 <= margin < math.inf:
-        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 or more metres")
+    if not 0 <= margin <= ros2.MAX_MARGIN:
+        raise ScenarioError("<command line>", "--margin", f"{margin:g} m: give 0 to {ros2.MAX_MARGIN:g} metres of grid around "
+                            "the first map")
 
 
 def _label(goal) -> str | int:

@@ -469,6 +469,8 @@ def ros_replay(
         _fail(exc)
     out.print(f"{res.folder}: {len(res.decisions)} decisions of {planner} over {bag} "
               f"({'the goal was read in the bag' if res.found else 'the goal was never read in the bag'})")
+    if res.dropped:
+        out.print(f"not taken from the bag: {res.dropped}")
 
 
 @ros_app.command("live")
@@ -504,6 +506,8 @@ def ros_live(
     sent = "targets published on /semsearch/goal" if publish_only else f"{res.goals} goals sent to Nav2 (one a re-plan)"
     out.print(f"{res.outcome}: {res.message}; {res.distance:.1f} m along {res.poses} poses, {n} decision{'s' * (n != 1)}, "
               f"{sent}")
+    if res.dropped:
+        out.print(f"not taken from the robot: {res.dropped}")
     if res.repro is not None:
         size = sum(p.stat().st_size for p in res.repro.rglob("*") if p.is_file())
         if res.poses == 0:

@@ -292,13 +292,13 @@ def test_json_messages_round_trip_and_maps_fold_into_a_grid_with_a_margin():
     assert (frame.height, frame.width, frame.origin_x, frame.origin_y) == (9, 10, pytest.approx(-1.3), pytest.approx(1.7))
     task = RobotTask(frame)
     b = task.new_belief()
-    assert fold_map(b, grid) is False
+    assert fold_map(b, grid).clipped is False
     assert b.seen[3:6, 3:7].tolist() == (states >= 0).tolist() and b.free[3:6, 3:7].tolist() == (states == 0).tolist()
     assert not b.seen[:3].any() and not b.seen[6:].any()
     # a map that outgrew the grid: the cells beyond it are left out, and said to be
     small = RobotTask(map_frame(grid)).new_belief()
     grid.info.origin.position.x = -1.2
-    assert fold_map(small, grid) is True
+    assert fold_map(small, grid).clipped is True
     assert small.seen[:, :2].tolist() == (states[:, 2:] >= 0).tolist() and not small.seen[:, 2:].any()  # 2 cells to the left
 
 

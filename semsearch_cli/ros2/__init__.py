@@ -9,6 +9,7 @@ from .export import BagRecorder, Exported, export_folder, export_run, exportable
 from .live import Live, LiveRun
 from .loopback import Rosbridge, SimRobot
 from .replay import Replayed, recorded_scenario, replay_bag
+from .robot import MAX_MARGIN
 
 
 def available(*packages: str) -> bool:
@@ -18,5 +19,5 @@ def available(*packages: str) -> bool:
     return all(installed(name) for name in (packages or ("rosbags",)))
 
 
-__all__ = ["FORMATS", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run", "exportable",
+__all__ = ["FORMATS", "MAX_MARGIN", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run", "exportable",
            "recorded_runs", "recorded_scenario", "replay_bag"]

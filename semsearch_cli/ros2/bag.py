@@ -251,31 +251,91 @@ def to_json(msg) -> dict:
     return out
 
 
-_BASE = {"bool": bool, "string": str, "float32": float, "float64": float}
+_FLOATS = ("float32", "float64")
+_INTS = {f"{u}int{n}": (0, 2**n - 1) if u else (-(2**(n - 1)), 2**(n - 1) - 1) for u in ("", "u") for n in (8, 16, 32, 64)}
+_INTS.update(byte=(0, 255), char=(0, 255), octet=(0, 255))
 
 
-def from_json(ts, msgtype: str, d: dict):
+def _base(desc: str, v, where: str):
+    """A JSON value as a message's base field of type ``desc``, checked as ROS checks it: a bool is
+    true or false, a number is a number (not text) and an integer fits its type; a ValueError
+    naming the field otherwise."""
+    if v is None:
+        return {"bool": False, "string": ""}.get(desc, 0.0 if desc in _FLOATS else 0)
+    if desc == "bool":
+        if isinstance(v, bool):
+            return v
+    elif desc == "string":
+        if isinstance(v, str):
+            return v
+    elif desc in _FLOATS:
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            return float(v)
+    elif desc in _INTS:
+        lo, hi = _INTS[desc]
+        if isinstance(v, int) and not isinstance(v, bool) and lo <= v <= hi:
+            return v
+        if isinstance(v, float) and v.is_integer() and lo <= v <= hi:
+            return int(v)
+    raise ValueError(f"{where} is {str(v)[:40]!r}, not a {desc}")
+
+
+def _array(desc: str, v, count: int, where: str) -> np.ndarray:
+    """A JSON list as a message's array of base type ``desc`` (``count``: a fixed length, 0 for a
+    sequence), each value checked as :func:`_base` checks it, at numpy's speed."""
+    if v is None:
+        v = [0] * count
+    if not isinstance(v, list) or (count and len(v) != count):
+        raise ValueError(f"{where} is not a list{f' of {count}' if count else ''}")
+    if desc == "bool":
+        if not all(isinstance(e, bool) for e in v):
+            raise ValueError(f"{where} holds a value that is not true or false")
+        return np.asarray(v, bool)
+    try:
+        a = np.asarray(v) if v else np.zeros(0)
+    except (TypeError, ValueError):  # ragged
+        raise ValueError(f"{where} is not a list of numbers") from None
+    if a.ndim != 1 or a.dtype.kind not in "iuf":  # text, lists, objects, integers past int64
+        raise ValueError(f"{where} is not a list of numbers")
+    if desc in _FLOATS:
+        return a.astype(desc)
+    lo, hi = _INTS[desc] if desc in _INTS else (None, None)
+    if lo is None or not (np.all(np.isfinite(a)) and np.all(a == np.round(a)) and (not len(a) or (a.min() >= lo and a.max() <= hi))):
+        raise ValueError(f"{where} holds a value that is not a {desc}")
+    return np.asarray(v, desc)
+
+
+def from_json(ts, msgtype: str, d: dict, where: str = ""):
     """A rosbridge JSON message of type ``msgtype`` as rosbags' dataclass (:func:`to_json`'s
     inverse), through the typestore's field definitions; a field the JSON leaves out takes its
-    zero value, as a ROS message's default."""
-    d = d or {}
+    zero value, as a ROS message's default. A value that is not of its field's type (text for a
+    number, 200 for an int8, a list for a message) is a ValueError naming the field."""
+    d = {} if d is None else d
+    if not isinstance(d, dict):
+        raise ValueError(f"{where or msgtype} is {type(d).__name__}, not a {msgtype} object")
     _, fields = ts.fielddefs[msgtype]
     values = {}
     for name, (node, desc) in fields:
-        v = d.get(name)
+        v, at = d.get(name), f"{where}.{name}" if where else name
         if node == interfaces.Nodetype.NAME:
-            values[name] = from_json(ts, desc, v)
+            values[name] = from_json(ts, desc, v, at)
         elif node == interfaces.Nodetype.BASE:
-            cast = _BASE.get(desc[0], int)
-            values[name] = cast(v) if v is not None else cast()
+            values[name] = _base(desc[0], v, at)
         else:
             (sub, subdesc), count = desc  # count: an array's fixed length (0: a sequence)
             if sub == interfaces.Nodetype.NAME:
-                values[name] = [from_json(ts, subdesc, e) for e in (v or [])]
+                if v is not None and not isinstance(v, list):
+                    raise ValueError(f"{at} is not a list")
+                values[name] = [from_json(ts, subdesc, e, f"{at}[{i}]") for i, e in enumerate(v or [])]
             elif subdesc[0] == "string":
-                values[name] = [str(e) for e in (v or [])]
+                if v is not None and not (isinstance(v, list) and all(isinstance(e, str) for e in v)):
+                    raise ValueError(f"{at} is not a list of text")
+                values[name] = list(v or [])
             elif subdesc[0] in ("uint8", "char") and isinstance(v, str):
-                values[name] = np.frombuffer(base64.b64decode(v), np.uint8).copy()
+                try:
+                    values[name] = np.frombuffer(base64.b64decode(v, validate=True), np.uint8).copy()
+                except ValueError:
+                    raise ValueError(f"{at} is text that is not base64") from None
             else:
-                values[name] = np.asarray(v if v is not None else [0] * count, bool if subdesc[0] == "bool" else subdesc[0])
+                values[name] = _array(subdesc[0], v, count, at)
     return ts.types[msgtype](**values)

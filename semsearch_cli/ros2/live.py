@@ -27,6 +27,7 @@ replays to the same re-plans.
 from __future__ import annotations
 
 import contextlib
+from collections import Counter
 import logging
 import math
 import queue
@@ -41,7 +42,7 @@ from ..errors import ScenarioError
 from ..optional import lazy_module
 from .bag import BagWriter, Messages, drop_bag, from_json, to_json
 from .robot import (ABORTED, DETECTIONS, GOAL_STATUS, MAP, NAVIGATE_ACTION, POSE_TYPES, RESUME, SUCCEEDED, GoalWriter,
-                    RobotSession, RobotTask, goal_ended, map_frame)
+                    RobotSession, RobotTask, goal_ended, map_frame, refusal)
 
 roslibpy = lazy_module("roslibpy", "ros")  # optional: pip install 'semsearch[ros]'
 
@@ -82,6 +83,7 @@ class LiveRun:
     goals: int = 0
     message: str = ""
     repro: Path | None = None
+    dropped: str = ""  # the robot's messages not taken as they came, by reason (RobotSession.dropped_text)
 
 
 class _Repro:
@@ -110,17 +112,32 @@ class _Repro:
         drop_bag(self.writer, self.work)
 
 
+def rosbridge_address(url: str) -> tuple[str, int, bool]:
+    """(host, port, secure) of a rosbridge WebSocket address ``ws://HOST[:PORT]`` or ``wss://...``
+    (port 9090 when left out), or a ScenarioError naming ``--rosbridge``."""
+    hint = "give ws://HOST:PORT (rosbridge_server listens on 9090)"
+    try:
+        u = urlparse(url)
+        port = u.port  # a ValueError for a port past 65535 or not a number
+    except ValueError as exc:
+        raise ScenarioError("<command line>", "--rosbridge", f"{url!r} is not a WebSocket address ({exc}): {hint}") from None
+    if u.scheme not in ("ws", "wss") or not u.hostname:
+        raise ScenarioError("<command line>", "--rosbridge", f"{url!r} is not a WebSocket address: {hint}")
+    if u.username or u.password:
+        raise ScenarioError("<command line>", "--rosbridge", "a rosbridge address carries no credentials (rosbridge has none to "
+                            f"take): {hint}")
+    if port == 0:
+        raise ScenarioError("<command line>", "--rosbridge", f"{url!r}: port 0 is no server's; {hint}")
+    return u.hostname, port or 9090, u.scheme == "wss"
+
+
 class Live:
     """One live run (see the module's text): :meth:`run` connects, explores and returns a
     :class:`LiveRun`."""
 
     def __init__(self, url: str, variant, goal, sc=None, publish_only: bool = False, repro: Path | None = None,
                  margin: float = 10.0, max_distance: float | None = None, silence: float = 30.0, log=None):
-        u = urlparse(url)
-        if u.scheme not in ("ws", "wss") or not u.hostname:
-            raise ScenarioError("<command line>", "--rosbridge", f"{url!r} is not a WebSocket address: give ws://HOST:PORT "
-                                "(rosbridge_server listens on 9090)")
-        self.host, self.port, self.secure = u.hostname, u.port or 9090, u.scheme == "wss"
+        self.host, self.port, self.secure = rosbridge_address(url)
         self.variant, self.goal, self.sc = variant, goal, sc
         self.publish_only, self.margin, self.silence = publish_only, margin, silence
         self.max_distance = max_distance if max_distance is not None else math.inf
@@ -142,6 +159,7 @@ class Live:
         self.sent_at = 0.0  # when the goal under way was sent (time.monotonic)
         self.aborts = 0
         self.clipped = False
+        self.dropped_early: Counter = Counter()  # messages dropped before the first map made the session
 
     # -- the connection ---------------------------------------------------------------
     def run(self) -> LiveRun:
@@ -266,7 +284,13 @@ class Live:
                 return self._result("stuck", f"the robot gave up on {ABORTS} goals in a row")
             topic, msg = GOAL_STATUS, goal_ended(self.m, k, status)
         else:
-            msg = from_json(self.m.ts, INPUTS[topic], payload)
+            try:
+                msg = from_json(self.m.ts, INPUTS[topic], payload)
+            except (ValueError, TypeError, RecursionError) as exc:  # not a message of its type: dropped, counted
+                return self._drop(topic, f"not a {INPUTS[topic]}: {str(exc)[:80]}")
+            why = refusal(topic, msg)
+            if why:
+                return self._drop(topic, why)
             if topic in POSE_TYPES:
                 if self.pose_topic is None:
                     self.pose_topic = topic
@@ -275,6 +299,16 @@ class Live:
                     return None
                 self.stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec  # a goal carries its pose's stamp
         return self._feed(topic, msg)
+
+    def _drop(self, topic: str, why: str) -> None:
+        """A robot's message that is not taken (not written to the repro bag either: it cannot be
+        written as its type, or replays as dropped): counted, and said the first time for each
+        reason."""
+        counts = self.session.dropped if self.session is not None else self.dropped_early
+        if not counts[(topic, why)]:
+            self.log(f"dropped a message on {topic}: {why} (counted; the run goes on)")
+        counts[(topic, why)] += 1
+        return None
 
     def _feed(self, topic: str, msg) -> LiveRun | None:
         self.repro.write(topic, msg)
@@ -285,10 +319,11 @@ class Live:
                 return None
             try:
                 frame = map_frame(msg, self.margin)
-            except ValueError as exc:
-                raise ScenarioError(MAP, "info.origin", str(exc)) from None
+            except ValueError as exc:  # checked before (a margin too wide for this map): the next map may do
+                return self._drop(topic, str(exc))
             self.out = GoalWriter(self._publish, self.m, frame)
             s = self.session = RobotSession(RobotTask(frame, self.sc), self.variant.build(), self.goal, self.out, self.pose_topic)
+            s.dropped.update(self.dropped_early)
             self.log(f"map: {frame.width} x {frame.height} cells at {frame.res:g} m (the first map and {self.margin:g} m "
                      "around it)")
             for t, m in self.early:
@@ -344,8 +379,10 @@ class Live:
     def _result(self, outcome: str, message: str) -> LiveRun:
         s = self.session
         if s is None:
-            return LiveRun(outcome, 0.0, 0, [], len(self._goal_ids), message)
-        return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, len(self._goal_ids), message)
+            early = "; ".join(f"{n} {topic} ({why})" for (topic, why), n in self.dropped_early.items())
+            return LiveRun(outcome, 0.0, 0, [], len(self._goal_ids), message, dropped=early)
+        return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, len(self._goal_ids), message,
+                       dropped=s.dropped_text())
 
 
 def _status(res) -> int:

@@ -22,6 +22,7 @@ where it would go, and its answers are written to a new bag (``/semsearch/goal``
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from collections import deque
 from dataclasses import dataclass
@@ -38,7 +39,11 @@ from ..tasks.base import RobotState
 from ..tasks.decisions import set_rng
 from ..tasks.doors import DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
-from .robot import BASE_FRAMES, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree, drive, map_frame
+from .robot import (BASE_FRAMES, MAX_COORD, MAX_MAP_CELLS, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree, drive,
+                    map_frame, refusal)
+
+
+MAX_MESSAGE_BYTES = 64 << 20  # one message of a bag: a map of MAX_MAP_CELLS int8 cells is 25 MB
 
 
 class BagStream:
@@ -59,11 +64,25 @@ class BagStream:
 
     def _decode(self, item):
         conn, t, raw = item
-        return conn.topic, t, self.m.ts.deserialize_cdr(raw, conn.msgtype)
+        if len(raw) > MAX_MESSAGE_BYTES:
+            raise ScenarioError(str(self.path), conn.topic, f"holds a message of {len(raw):,} bytes, more than any a search "
+                                f"reads ({MAX_MESSAGE_BYTES:,}: a map of {MAX_MAP_CELLS:,} cells and its header)")
+        try:
+            return conn.topic, t, self.m.ts.deserialize_cdr(raw, conn.msgtype)
+        except Exception as exc:  # noqa: BLE001  bytes that are not a message of the connection's type
+            raise ScenarioError(str(self.path), conn.topic, f"holds a message that is not a {conn.msgtype} (at {t} ns; "
+                                f"{type(exc).__name__}: {str(exc)[:120]}): the bag is damaged") from None
 
     def peek(self):
+        """The next message (topic, stamp, message), or None at the bag's end; a damaged bag (a
+        chunk that does not decompress, a message that does not decode) is a ScenarioError
+        naming it."""
         if not self._ahead:
-            nxt = next(self._it, None)
+            try:
+                nxt = next(self._it, None)
+            except Exception as exc:  # noqa: BLE001  rosbags' and its storage's errors (ZstdError, a truncated chunk, ...)
+                raise ScenarioError(str(self.path), "", f"is damaged: its messages cannot be read on ({type(exc).__name__}: "
+                                    f"{str(exc)[:160]})") from None
             if nxt is None:
                 return None
             self._ahead.append(self._decode(nxt))
@@ -142,11 +161,12 @@ class ReplaySearch(DoorSearch):
 @dataclass
 class Replayed:
     """What a replay gave: the output bag folder, the decisions [{step, target_cell, target}],
-    and whether the goal's sign was read in the bag."""
+    whether the goal's sign was read in the bag, and what of a robot's bag was not taken."""
 
     folder: Path
     decisions: list
     found: bool
+    dropped: str = ""  # a robot's bag: its messages not taken, by reason (RobotSession.dropped_text)
 
 
 def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fmt: str = "mcap", goal=None,
@@ -186,7 +206,7 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
         writer = None
         try:
             writer = BagWriter(work / out.name, fmt, msgs)
-            found, rows = run(task, variant, goal, stream, writer, frame, rng_inc)
+            found, rows, dropped = run(task, variant, goal, stream, writer, frame, rng_inc)
             writer.close()
         except BaseException as exc:
             drop_bag(writer, work)
@@ -200,7 +220,7 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
         work.rmdir()
     finally:
         stream.close()
-    return Replayed(out, rows, found)
+    return Replayed(out, rows, found, dropped)
 
 
 def recorded_scenario(bag: Path) -> str | None:
@@ -220,12 +240,29 @@ def recorded_scenario(bag: Path) -> str | None:
         stream.close()
 
 
+SETUP_KEYS = {"fingerprint": str, "goal": (str, int), "rng_inc": int}  # what a replay reads of /semsearch/setup
+
+
 def _setup(stream: BagStream, bag: Path) -> dict:
+    """The bag's /semsearch/setup (its first message), checked: a JSON object with
+    :data:`SETUP_KEYS` of their types."""
     item = stream.peek()
     if item is None or item[0] != "/semsearch/setup":
         raise ScenarioError(str(bag), "/semsearch/setup", "is not the bag's first message: not a bag `semsearch export` wrote")
     stream.next()
-    return json.loads(item[2].data)
+    try:
+        setup = json.loads(item[2].data)
+    except (ValueError, RecursionError):
+        setup = None
+    if not isinstance(setup, dict):
+        raise ScenarioError(str(bag), "/semsearch/setup", "is not a JSON object: not a setup `semsearch export` wrote")
+    for key, kind in SETUP_KEYS.items():
+        if not isinstance(setup.get(key), kind) or isinstance(setup.get(key), bool):
+            raise ScenarioError(str(bag), f"/semsearch/setup.{key}", f"is {setup.get(key)!r}: not a setup `semsearch export` "
+                                "wrote")
+    if not 0 <= setup["rng_inc"] < 2**128:
+        raise ScenarioError(str(bag), "/semsearch/setup.rng_inc", f"{setup['rng_inc']} is not a generator's increment (0 to 2**128)")
+    return setup
 
 
 def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc: int) -> tuple[bool, list]:
@@ -252,7 +289,7 @@ def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_i
                 ev = _fold(search, st, item)
                 if ev is not None and ev["event"] == "plan":
                     break
-    return search.found, out.rows
+    return search.found, out.rows, ""
 
 
 def _fold(search: ReplaySearch, st: RobotState, item) -> dict | None:
@@ -283,13 +320,13 @@ def _robot_frame(bag: Path, msgs: Messages, margin: float) -> GridFrame:
             raise ScenarioError(str(bag), "/map", "a robot's bag needs /map (nav_msgs/OccupancyGrid) and a pose on one of "
                                 f"{', '.join(POSE_TOPICS)} or /tf (map to {' or '.join(BASE_FRAMES)}); or it is a bag of "
                                 "`semsearch export`, with /semsearch/events")
-        item = stream.next()
-        if item is None:
-            raise ScenarioError(str(bag), "/map", "holds no message")
-        try:
-            return map_frame(item[2], margin)
-        except ValueError as exc:
-            raise ScenarioError(str(bag), "/map", str(exc)) from None
+        first = None  # why the first map could not be read
+        while (item := stream.next()) is not None:  # the first map that can be read (as ros live drops the others)
+            try:
+                return map_frame(item[2], margin)
+            except ValueError as exc:
+                first = first or str(exc)
+        raise ScenarioError(str(bag), "/map", f"no map of the bag can be read (the first: {first})" if first else "holds no message")
     finally:
         stream.close()
 
@@ -304,12 +341,23 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
         topic, t, msg = item
         out.t = t
         if session.pose_topic is None and topic in ("/tf", "/tf_static"):
+            why = refusal(topic, msg)
+            if why:
+                session.drop(topic, why)
+                continue
             pose = next(filter(None, map(tf.pose, BASE_FRAMES)), None) if tf.add(msg) & set(BASE_FRAMES) else None
-            what = "plan" if pose is not None and session.pose(*pose) else None
+            what = "plan" if pose is not None and _finite_pose(pose) and session.pose(*pose) else None
         else:
             what = session.take(topic, msg)
         if what == "found":
             break
         if what == "plan":
             session.plan()
-    return session.found, out.rows
+    return session.found, out.rows, session.dropped_text()
+
+
+def _finite_pose(pose) -> bool:
+    """A pose composed from /tf is within the bounds a pose message is held to (a chain of
+    transforms each within them can add up past them)."""
+    x, y, yaw = pose
+    return all(math.isfinite(v) for v in pose) and abs(x) <= MAX_COORD and abs(y) <= MAX_COORD

@@ -20,13 +20,20 @@ live bridge made on it:
   ``replan_every`` metres (``navigation.replan: periodic``) or when the map loses a free cell
   (``events``), and when a sign is read ``min_reads`` times for planners that re-plan on signs;
 - the robot senses for itself: a re-plan that would turn on the spot to look (no frontier yet, a
-  wall face reached) sees nothing new, since the robot is not asked to turn.
+  wall face reached) sees nothing new, since the robot is not asked to turn;
+- every message is checked as it enters (:func:`refusal`, against the bounds below): one that a
+  robot's stack could send but no search can take (a NaN pose, a map of resolution 0 or of more
+  cells than :data:`MAX_MAP_CELLS`, a stamp past ``builtin_interfaces/Time``) is dropped and
+  counted by its reason (:attr:`RobotSession.dropped`), and the run goes on; a map at another
+  resolution than the grid's is re-gridded onto it, map cells outside -1..100 are unknown
+  (docs/robot.md, "What a robot may send").
 """
 
 from __future__ import annotations
 
 import json
 import math
+from collections import Counter
 from dataclasses import dataclass
 from types import SimpleNamespace
 
@@ -36,6 +43,7 @@ from ..belief import DoorBelief
 from ..config import BeliefSpec, DoorCameraSpec, NavigationSpec, RobotSpec
 from ..config.base import sign_label
 from ..geometry import GridFrame
+from ..world.images import MAX_CELLS
 from ..tasks.base import Observer, RobotState
 from ..tasks.doors import DoorDecision, DoorSearch
 
@@ -50,6 +58,15 @@ POSE_TYPES = {"/semsearch/pose": "geometry_msgs/msg/PoseStamped", "/amcl_pose": 
 POSE_TOPICS = tuple(POSE_TYPES)
 BASE_FRAMES = ("base_link", "base_footprint")  # the robot's frame in /tf, the first that reaches map
 FREE_BELOW = 20  # OccupancyGrid values under it are free (map_saver's 0.196); from it, seen and not free
+
+# What a robot's message may claim (docs/robot.md, "What a robot may send"); past these it is dropped and counted
+MAX_MAP_CELLS = MAX_CELLS  # cells of one map, and of the belief's grid (the first map and its margin): 5000 x 5000
+RESOLUTIONS = (0.001, 10.0)  # m per cell, from 1 mm to 10 m
+MAX_COORD = 100_000.0  # m: a pose or a map origin farther than 100 km from the map frame's origin is no robot's
+MAX_MARGIN = 1000.0  # m of grid around the first map (--margin)
+MAX_DETECTION_BYTES = 4096  # a detection's JSON text
+MAX_LIST = 1000  # goal statuses of one GoalStatusArray, transforms of one TFMessage
+INT32 = 2**31
 
 
 class _NoSigns:
@@ -96,36 +113,159 @@ def map_resolution(info) -> float:
 
 def map_frame(msg, margin: float = 0.0) -> GridFrame:
     """The grid of an OccupancyGrid's cells, grown by ``margin`` metres (whole cells) on every
-    side; a ValueError for a map rotated in its frame."""
+    side; a ValueError for a map :func:`map_refusal` refuses or a grid of more than
+    :data:`MAX_MAP_CELLS` cells."""
+    why = map_refusal(msg)
+    if why:
+        raise ValueError(why)
     info = msg.info
+    res = map_resolution(info)
+    if not (math.isfinite(margin) and 0 <= margin <= MAX_MARGIN):
+        raise ValueError(f"a margin of {margin:g} m: give one from 0 to {MAX_MARGIN:g} m")
+    k = int(math.ceil(margin / res - 1e-9)) if margin > 0 else 0
+    h, w = int(info.height) + 2 * k, int(info.width) + 2 * k
+    if h * w > MAX_MAP_CELLS:
+        raise ValueError(f"the first map and a margin of {margin:g} m around it make a grid of {w:,} x {h:,} cells at "
+                         f"{res:g} m, more than {MAX_MAP_CELLS:,}: give a smaller --margin")
+    return GridFrame(res, float(info.origin.position.x) - k * res, float(info.origin.position.y) - k * res, h, w)
+
+
+def map_refusal(msg) -> str:
+    """Why an OccupancyGrid cannot be folded into a grid ("" when it can): its resolution outside
+    :data:`RESOLUTIONS`, its size past :data:`MAX_MAP_CELLS` or not that of its data, its origin
+    not finite or past :data:`MAX_COORD`, or the map rotated in its frame."""
+    info = msg.info
+    res = float(info.resolution)
+    if not (math.isfinite(res) and RESOLUTIONS[0] <= res <= RESOLUTIONS[1]):
+        return f"a map at {res:g} m per cell (from {RESOLUTIONS[0]:g} to {RESOLUTIONS[1]:g} m are read)"
+    h, w = int(info.height), int(info.width)
+    if h * w > MAX_MAP_CELLS:
+        return f"a map of {w:,} x {h:,} cells (at most {MAX_MAP_CELLS:,})"
+    if len(msg.data) != h * w:
+        return f"a map of {w} x {h} cells holding {len(msg.data)} values"
+    o = info.origin.position
+    if not all(math.isfinite(v) and abs(v) <= MAX_COORD for v in (float(o.x), float(o.y))):
+        return f"a map whose origin ({float(o.x):g}, {float(o.y):g}) is not within {MAX_COORD:g} m"
     q = info.origin.orientation
     if abs(q.z) > 1e-6 or abs(q.x) > 1e-6 or abs(q.y) > 1e-6:
-        raise ValueError("a map rotated in its frame (origin orientation not 0) is not read")
-    res = map_resolution(info)
-    k = int(math.ceil(margin / res - 1e-9)) if margin > 0 else 0
-    return GridFrame(res, float(info.origin.position.x) - k * res, float(info.origin.position.y) - k * res,
-                     int(info.height) + 2 * k, int(info.width) + 2 * k)
+        return "a map rotated in its frame (origin orientation not 0)"
+    return ""
 
 
-def fold_map(belief, msg) -> bool:
-    """Fold a robot's OccupancyGrid (placed by its origin in the belief's grid, at the grid's
-    resolution) into the belief: -1 unknown, below ``FREE_BELOW`` free, else seen and not free.
-    Cells outside the grid are left out; returns whether some were."""
+def map_values(msg) -> tuple[np.ndarray, int]:
+    """A map's values (h, w) int8 in the simulator's row order (row 0 at the top), a value outside
+    -1..100 made unknown (-1); and how many were."""
+    info = msg.info
+    values = np.asarray(msg.data).astype(np.int16, copy=False).reshape(int(info.height), int(info.width))[::-1]
+    odd = (values < -1) | (values > 100)
+    n = int(odd.sum())
+    return np.where(odd, -1, values).astype(np.int8), n
+
+
+@dataclass
+class Folded:
+    """What :func:`fold_map` did: whether some of the map fell outside the grid (``clipped``),
+    whether it was re-gridded from another resolution, and its cells outside -1..100 (taken as
+    unknown)."""
+
+    clipped: bool = False
+    regridded: bool = False
+    odd_cells: int = 0
+
+
+def fold_map(belief, msg) -> Folded:
+    """Fold a robot's OccupancyGrid (placed by its origin in the belief's grid) into the belief:
+    -1 unknown, below ``FREE_BELOW`` free, else seen and not free. A map at another resolution
+    than the grid's is re-gridded onto it (each grid cell takes the map cell under its centre);
+    cells outside the grid are left out. The map must pass :func:`map_refusal`."""
     fr, info = belief.frame, msg.info
-    if abs(map_resolution(info) - fr.res) > 1e-9:
-        raise ValueError(f"a map at {info.resolution} m per cell, the belief's grid is at {fr.res} m")
-    h, w = int(info.height), int(info.width)
-    c0 = int(round((float(info.origin.position.x) - fr.origin_x) / fr.res))
-    y0 = int(round((float(info.origin.position.y) - fr.origin_y) / fr.res))
-    r0 = fr.height - y0 - h  # the map's top row in the simulator's rows (row 0 at the top)
-    values = np.asarray(msg.data, np.int8).reshape(h, w)[::-1]
-    top, left = max(r0, 0), max(c0, 0)
-    bottom, right = min(r0 + h, fr.height), min(c0 + w, fr.width)
-    if bottom <= top or right <= left:
-        return h * w > 0
-    values = values[top - r0:bottom - r0, left - c0:right - c0]
-    belief.fold_grid(top, left, values >= 0, (values >= 0) & (values < FREE_BELOW))
-    return values.size < h * w
+    values, odd = map_values(msg)
+    h, w = values.shape
+    res = map_resolution(info)
+    ox, oy = float(info.origin.position.x), float(info.origin.position.y)
+    if abs(res - fr.res) <= 1e-9:
+        c0 = int(round((ox - fr.origin_x) / fr.res))
+        y0 = int(round((oy - fr.origin_y) / fr.res))
+        r0 = fr.height - y0 - h  # the map's top row in the simulator's rows (row 0 at the top)
+        top, left = max(r0, 0), max(c0, 0)
+        bottom, right = min(r0 + h, fr.height), min(c0 + w, fr.width)
+        if bottom <= top or right <= left:
+            return Folded(h * w > 0, False, odd)
+        values = values[top - r0:bottom - r0, left - c0:right - c0]
+        belief.fold_grid(top, left, values >= 0, (values >= 0) & (values < FREE_BELOW))
+        return Folded(values.size < h * w, False, odd)
+    # another resolution (a SLAM node that re-grids): the map cell under each grid cell's centre
+    cols = np.arange(fr.width)
+    rows = np.arange(fr.height)
+    mc = np.floor((fr.origin_x + (cols + 0.5) * fr.res - ox) / res).astype(np.int64)
+    mr = np.floor((oy + h * res - (fr.origin_y + (fr.height - rows - 0.5) * fr.res)) / res).astype(np.int64)  # from the top
+    cin, rin = np.flatnonzero((mc >= 0) & (mc < w)), np.flatnonzero((mr >= 0) & (mr < h))
+    covered = (ox >= fr.origin_x - 1e-9 and oy >= fr.origin_y - 1e-9 and ox + w * res <= fr.origin_x + fr.width * fr.res + 1e-9
+               and oy + h * res <= fr.origin_y + fr.height * fr.res + 1e-9)
+    if not len(cin) or not len(rin):
+        return Folded(h * w > 0, True, odd)
+    top, left = int(rin[0]), int(cin[0])
+    window = values[np.ix_(mr[rin[0]:rin[-1] + 1], mc[cin[0]:cin[-1] + 1])]
+    belief.fold_grid(top, left, window >= 0, (window >= 0) & (window < FREE_BELOW))
+    return Folded(not covered, True, odd)
+
+
+def _finite(*values, bound: float = MAX_COORD) -> bool:
+    return all(math.isfinite(v) and abs(v) <= bound for v in values)
+
+
+def stamp_refusal(stamp) -> str:
+    """Why a builtin_interfaces/Time is not one ("" when it is): seconds past int32, nanoseconds
+    outside 0..999,999,999."""
+    sec, nsec = int(stamp.sec), int(stamp.nanosec)
+    if not (-INT32 <= sec < INT32 and 0 <= nsec < 1_000_000_000):
+        return f"a stamp of {sec} s {nsec} ns (not a builtin_interfaces/Time)"
+    return ""
+
+
+def pose_refusal(msg) -> str:
+    """Why a PoseStamped or PoseWithCovarianceStamped is not a pose a search can take ("" when it
+    is): its stamp, a coordinate not finite or past :data:`MAX_COORD`, an orientation that is
+    not a rotation (not finite, or of norm 0)."""
+    why = stamp_refusal(msg.header.stamp)
+    if why:
+        return why
+    pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
+    p, q = pose.position, pose.orientation
+    if not _finite(float(p.x), float(p.y)):
+        return f"a pose at ({float(p.x):g}, {float(p.y):g}), not within {MAX_COORD:g} m"
+    quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+    if not _finite(*quat, bound=1e6) or math.hypot(*quat) < 1e-9:
+        return f"a pose whose orientation {quat} is not a rotation"
+    return ""
+
+
+def refusal(topic: str, msg) -> str:
+    """Why a robot's message on ``topic`` is dropped ("" when it is taken): the check of each
+    input topic (docs/robot.md, "What a robot may send")."""
+    if topic == MAP:
+        return map_refusal(msg)
+    if topic in POSE_TYPES:
+        return pose_refusal(msg)
+    if topic == DETECTIONS:
+        if len(msg.data) > MAX_DETECTION_BYTES:
+            return f"a detection of {len(msg.data):,} characters (at most {MAX_DETECTION_BYTES:,})"
+        return "" if detection_label(msg.data) is not None else 'not a detection (JSON {"label": ...} of a sign label)'
+    if topic == RESUME:
+        return "" if isinstance(msg.data, (bool, np.bool_)) else f"a resume of {msg.data!r}, not true or false"
+    if topic == GOAL_STATUS:
+        if len(msg.status_list) > MAX_LIST:
+            return f"a status array of {len(msg.status_list):,} goals (at most {MAX_LIST:,})"
+        return next(filter(None, (stamp_refusal(g.goal_info.stamp) for g in msg.status_list)), "")
+    if topic in ("/tf", "/tf_static"):
+        if len(msg.transforms) > MAX_LIST:
+            return f"a TFMessage of {len(msg.transforms):,} transforms (at most {MAX_LIST:,})"
+        for tr in msg.transforms:
+            t, q = tr.transform.translation, tr.transform.rotation
+            quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+            if not _finite(float(t.x), float(t.y)) or not _finite(*quat, bound=1e6) or math.hypot(*quat) < 1e-9:
+                return f"a transform to {tr.child_frame_id!r} that is not finite, within {MAX_COORD:g} m and a rotation"
+    return ""
 
 
 EIGHTH = math.pi / 4
@@ -183,7 +323,7 @@ def detection_label(data: str):
     message that is not one."""
     try:
         return sign_label(json.loads(data)["label"])
-    except (ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError, IndexError, RecursionError):  # not JSON, not an object, not a label
         return None
 
 
@@ -235,22 +375,33 @@ class RobotSession:
         self.have_map = self.posed = self.paused = self.clipped = False
         self.since, self.event, self.done = 0.0, False, True  # done: the last goal ended (none yet at the start)
         self.ended: set = set()  # the goals whose end was taken (their UUIDs)
+        self.dropped: Counter = Counter()  # (topic, reason) -> messages dropped (:func:`refusal`)
+        self.regridded = self.odd_cells = 0  # maps re-gridded from another resolution; map cells outside -1..100
 
     @property
     def found(self) -> bool:
         return self.search.found
+
+    def drop(self, topic: str, why: str) -> None:
+        """Count a message of ``topic`` that is not taken, by its reason."""
+        self.dropped[(topic, why)] += 1
 
     def take(self, topic: str, msg) -> str | None:
         """One message of the robot's (rosbags' message): ``"found"`` when it reads the goal's
         sign, ``"plan"`` when a re-plan is due now, else None. Topics: ``/map``, the pose
         (:attr:`pose_topic`), ``/semsearch/detections``, ``/explore/resume`` (False pauses the
         re-plans, True re-plans at once) and :data:`GOAL_STATUS` (a goal reached or given up on
-        is a path done)."""
+        is a path done). A message :func:`refusal` refuses is dropped and counted."""
+        if topic in POSE_TYPES and (self.pose_topic or topic) != topic:
+            return None  # another pose topic than the one in use
+        why = refusal(topic, msg)
+        if why:
+            self.drop(topic, why)
+            return None
         if topic == MAP:
             self.map(msg)
         elif topic == DETECTIONS:
-            label = detection_label(msg.data)  # None: not a detection, skipped as a stray message
-            if label is not None and self.detection(label):
+            if self.detection(detection_label(msg.data)):
                 return "found"
         elif topic == RESUME:
             self.paused = not msg.data
@@ -265,15 +416,27 @@ class RobotSession:
                 self.ended.add(uuid)
                 self.done = True
                 return "plan" if self.due() else None
-        elif topic in POSE_TYPES and (self.pose_topic or topic) == topic:
+        elif topic in POSE_TYPES:
             self.pose_topic = topic
             return "plan" if self.pose(*pose_of(msg)) else None
         return None
 
     def map(self, msg) -> None:
         """Fold in a map (:attr:`clipped` tells whether some of a map fell outside the grid)."""
-        self.clipped = fold_map(self.st.belief, msg) or self.clipped
+        folded = fold_map(self.st.belief, msg)
+        self.clipped = folded.clipped or self.clipped
+        self.regridded += folded.regridded
+        self.odd_cells += folded.odd_cells
         self.have_map = True
+
+    def dropped_text(self) -> str:
+        """What was not taken as it came, in a sentence ("" when everything was)."""
+        parts = [f"{n} {topic} ({why})" for (topic, why), n in sorted(self.dropped.items(), key=lambda kv: -kv[1])]
+        if self.regridded:
+            parts.append(f"{self.regridded} maps re-gridded to {self.task.world.frame.res:g} m")
+        if self.odd_cells:
+            parts.append(f"{self.odd_cells} map cells outside -1..100 taken as unknown")
+        return "; ".join(parts)
 
     def detection(self, label) -> bool:
         """Take a label read; whether it is the goal's (the search is over)."""
