@@ -372,7 +372,7 @@ class RobotSession:
         self.search = RobotSearch(task, planner, self.goal, np.random.default_rng(0), observer)
         self.pose_topic = pose_topic  # None: the first of POSE_TOPICS that speaks
         self.pending: list = []  # labels read since the last pose
-        self.have_map = self.posed = self.paused = self.clipped = False
+        self.have_map = self.posed = self.paused = self.clipped = self.inside = False
         self.since, self.event, self.done = 0.0, False, True  # done: the last goal ended (none yet at the start)
         self.ended: set = set()  # the goals whose end was taken (their UUIDs)
         self.dropped: Counter = Counter()  # (topic, reason) -> messages dropped (:func:`refusal`)
@@ -459,7 +459,8 @@ class RobotSession:
         st.steps += self.posed  # the first pose is step 0
         st.x, st.y, st.heading, self.posed = x, y, yaw, True
         v, u, r, c = fr.point_to_cell(x, y)
-        if not (0 <= r < fr.height and 0 <= c < fr.width):
+        self.inside = 0 <= r < fr.height and 0 <= c < fr.width
+        if not self.inside:  # off the grid (past the first map and its margin): travel counts, no re-plan from here
             return False
         b = st.belief
         for label in self.pending:
@@ -471,7 +472,7 @@ class RobotSession:
         return self.due()
 
     def due(self) -> bool:
-        return (self.have_map and self.posed and not self.paused
+        return (self.have_map and self.posed and self.inside and not self.paused
                 and self.search.replan_due(self.done, self.since, self.event))
 
     def plan(self):
