@@ -16,6 +16,7 @@ import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .config.base import sign_label
+from .credentials import WHERE_THE_KEY_GOES, credential_in, redact, url_credential
 from .errors import MissingExtra, ScenarioError, did_you_mean
 from .world.ground_truth import DuplicateSigns
 from .world.buildings import numbered
@@ -24,7 +25,7 @@ from .world.rooms import generate_rooms as make_rooms, write_rooms
 from .belief.presence import presence_scores, read_counts
 from .config.indirect import IndirectSpec
 from .planners import PLANNERS, expand_variants, load_entry_points, planner_class
-from .planners.base import load_planner_file, path_fields
+from .planners.base import check_params, load_planner_file, parse_entry, path_fields
 from .planners.llm import FirstPrompt
 from .plugins import load_kinds
 from .report import build as report_build
@@ -393,7 +394,11 @@ def _typed(param: str, value, loaded: Loaded) -> None:
 
 
 def parse_param(text: str) -> tuple[str, list]:
-    """``SECTION.FIELD=V1,V2,...`` -> (dotted name, values read as YAML scalars)."""
+    """``SECTION.FIELD=V1,V2,...`` -> (dotted name, values read as YAML scalars); an address
+    holding a credential is refused, never shown (its value would name a folder)."""
+    secret = credential_in(text)
+    if secret:
+        raise ScenarioError("<command line>", "--param", f"{redact(text)!r} holds {secret}: {WHERE_THE_KEY_GOES}")
     name, eq, vals = text.partition("=")
     items = [v.strip() for v in vals.split(",") if v.strip()]
     if not eq or not name.strip() or not items:
@@ -416,7 +421,7 @@ def _load_value(path: Path, data: dict, param: str, value) -> Loaded:
         own = exc.field == param or exc.field.startswith(param + ".") or (  # a section's field, or a planner's parameter
             exc.field.startswith("planners[") and exc.field.split(".")[-1] == param.split(".")[-1])
         if exc.file == str(path) and own:
-            raise ScenarioError("<command line>", "--param", f"{param}={str(value).lower() if isinstance(value, bool) else value} "
+            raise ScenarioError("<command line>", "--param", f"{param}={str(value).lower() if isinstance(value, bool) else redact(value)} "
                                 f"({exc.field} of the scenario): {exc.message}") from None
         raise
 
@@ -734,23 +739,13 @@ def _verify_bench(folder: Path, salt_file=None, progress=None, workers: int | No
     return VerifyOutput(folder, f"{split.suite.name} {split.name}, hash {split.hash[:16]}", v)
 
 
-_PLANNER = re.compile(r"(?P<name>[A-Za-z_][\w.-]*)(?:\[(?P<params>[^\[\]]*)\])?")
-
-
 def planner_spec(text: str, module: str | Path | None = None) -> PlannerSpec:
     """A planner given on the command line, ``NAME`` or ``NAME[key=value,...]`` (as rows label
     it: ``nsos[alpha=0.9]``), registered by ``module`` (a user's Python file) when given. A
     parameter that names a file (the llm planner's ``prompt``, ``replay``) is taken relative to the
     working folder, and written absolute."""
-    m = _PLANNER.fullmatch(text.strip())
-    if m is None:
-        raise ScenarioError("<command line>", "--planner", f"{text!r}: give NAME or NAME[key=value,...], e.g. nsos[alpha=0.9]")
-    params = {}
-    for item in filter(None, (p.strip() for p in (m["params"] or "").split(","))):
-        key, eq, value = item.partition("=")
-        if not eq or not key.strip():
-            raise ScenarioError("<command line>", "--planner", f"{text!r}: {item!r} is not key=value")
-        params[key.strip()] = yaml.safe_load(value)
+    name, params = parse_entry(text)  # its form, and no key in an address (refused, never shown)
+    m = {"name": name}
     if module is not None:  # the file's planners come from it; a built-in (or installed) planner beside them does not
         mod = Path(module)
         if not mod.is_file():
@@ -761,6 +756,13 @@ def planner_spec(text: str, module: str | Path | None = None) -> PlannerSpec:
         if m["name"] in mine or m["name"] not in PLANNERS:
             params["module"] = str(mod.resolve())
     cls = PLANNERS.get(m["name"])
+    if cls is not None:  # a parameter its planner refuses, named: 'nsos[alpha=2]': alpha must be at most 1
+        try:
+            fault = check_params(cls, name, {k: v for k, v in params.items() if k != "module"})
+        except (Exception, SystemExit):  # a user's validator that raises: expand_variants names its line
+            fault = None
+        if fault:
+            raise ScenarioError("<command line>", "--planner", fault[1])
     for k in path_fields(cls.Params) if cls is not None else ():  # a file named here is relative to this folder, not the floor's
         if isinstance(params.get(k), str) and not Path(params[k]).is_absolute():
             params[k] = str(Path(params[k]).resolve())
@@ -819,6 +821,10 @@ def bench_fetch(suite: str, from_dirs=(), mirror: str | None = None, partial: bo
     for d in from_dirs:
         if not Path(d).is_dir():
             raise ScenarioError(str(d), "--from", "no such folder")
+    secret = url_credential(mirror)
+    if secret:  # a fetch's messages name the address it fetched
+        raise ScenarioError("<command line>", "--mirror", f"{redact(mirror)!r} holds {secret}: a mirror is fetched without "
+                            "credentials; serve it where none is needed, or copy the files and give --from DIR")
     return bench.real.fetch(s, [Path(d) for d in from_dirs], mirror, partial, progress)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import os
 import shlex
+import re
 import signal
 import sys
 import time
@@ -66,10 +67,11 @@ def _finite(value: Optional[float]) -> Optional[float]:
 def _split(values: Optional[List[str]], flag: str, labels: bool = True) -> Optional[list]:
     """Repeated or comma-separated values of ``flag``, None when not given: sign labels in their
     canonical form (:func:`~semsearch_cli.config.base.sign_label`: ``148`` and ``148.0`` are the
-    number 148) when ``labels``, else text (planner labels, case names)."""
+    number 148) when ``labels``, else text (planner labels, case names). A comma inside brackets
+    separates a label's parameters, not two values (``nsos[alpha=0.9,w_g=4]`` is one label)."""
     if values is None or values == []:
         return None
-    items = [v.strip() for s in values for v in s.split(",") if v.strip()]
+    items = [v.strip() for s in values for v in re.split(r",(?![^\[]*\])", s) if v.strip()]
     if not items:
         raise ScenarioError("<command line>", flag, f"no values in {' '.join(map(repr, values))}; give one or more, comma-separated")
     if not labels:

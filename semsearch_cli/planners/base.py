@@ -33,10 +33,12 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
+import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..belief import DoorBelief, Candidates
 from .. import __version__, deprecation
+from ..credentials import WHERE_THE_KEY_GOES, credential_in, looks_like_key, redact, url_credential
 from ..errors import PlannerError, ScenarioError, did_you_mean
 from ..files import user_file
 from ..provenance import code_hash, files_hash
@@ -537,9 +539,13 @@ class Variant:
 
     @property
     def label(self) -> str:
+        """``name[key=value,...]``; a credential in a value (an address's ``user:key@``, a key such
+        as ``sk-...``; :mod:`~semsearch_cli.credentials`) shows masked. Such a value is refused
+        where it is given (:func:`expand_variants`, the planner's own checks); this is the last
+        guard, for a variant built by hand, since rows, reports and file names carry the label."""
         if not self.params:
             return self.name
-        return f"{self.name}[" + ",".join(f"{k}={v}" for k, v in self.params) + "]"
+        return f"{self.name}[" + ",".join(f"{k}={shown(v)}" for k, v in self.params) + "]"
 
     def build(self) -> Planner:
         cls = planner_class(self)
@@ -554,6 +560,170 @@ class Variant:
             if params.get(k) is not None and self.base is not None:
                 params[k] = str(Path(self.base) / str(params[k]))
         return cls.Params(**params)
+
+
+def shown(value) -> str:
+    """A parameter's value as a label writes it: ``str(value)``, with a credential in it masked."""
+    return redact(value) if url_credential(value) or looks_like_key(value) else str(value)
+
+
+def param_entry(name: str, key: str, value) -> str:
+    """The planner entry an error about parameter ``key`` names: ``'nsos[alpha=2]'`` (that
+    parameter alone, as a label writes it; a parameter whose name says it holds a key shows
+    ``***``)."""
+    secretish = any(w in key.lower() for w in ("key", "token", "secret", "password"))
+    return repr(f"{name}[{key}={'***' if secretish else shown(value)}]")
+
+
+def _bound(v) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def param_message(name: str, error: dict, params: dict) -> tuple[str, str]:
+    """(the parameter, a sentence naming the entry and the parameter) of one pydantic error of a
+    planner's ``Params``: ``'nsos[alpha=2]': alpha must be at most 1``. The parameter is ``""``
+    for an error of the parameters together (a model validator)."""
+    loc = ".".join(str(x) for x in error.get("loc", ()))
+    key = str(error["loc"][0]) if error.get("loc") else ""
+    ctx, kind = error.get("ctx") or {}, error.get("type", "")
+    if not key:
+        entry = repr(f"{name}[" + ",".join(f"{k}={shown(v)}" for k, v in sorted(params.items())) + "]") if params else repr(name)
+        return "", f"{entry}: {error['msg'].removeprefix('Value error, ')}"
+    value = params.get(key, error.get("input"))
+    what = {
+        "greater_than": lambda: f"must be more than {_bound(ctx['gt'])}",
+        "greater_than_equal": lambda: f"must be at least {_bound(ctx['ge'])}",
+        "less_than": lambda: f"must be less than {_bound(ctx['lt'])}",
+        "less_than_equal": lambda: f"must be at most {_bound(ctx['le'])}",
+        "finite_number": lambda: "must be a finite number",
+        "float_parsing": lambda: "must be a number",
+        "float_type": lambda: "must be a number",
+        "int_parsing": lambda: "must be a whole number",
+        "int_type": lambda: "must be a whole number",
+        "int_from_float": lambda: "must be a whole number",
+        "int_parsing_size": lambda: "must be a whole number of at most 4,300 digits",
+        "bool_parsing": lambda: "must be true or false",
+        "bool_type": lambda: "must be true or false",
+        "string_type": lambda: "must be text",
+        "literal_error": lambda: f"must be one of {ctx.get('expected', '')}",
+        "enum": lambda: f"must be one of {ctx.get('expected', '')}",
+        "missing": lambda: "is required",
+    }.get(kind)
+    if what is None:
+        msg = error["msg"].removeprefix("Value error, ")
+        text = msg if msg.startswith(loc + " ") else f"{loc}: {msg}"
+    else:
+        text = f"{loc} {what()}"
+        if kind in ("float_type", "int_type", "bool_type", "string_type") and value is None:
+            text += " (it is empty)"
+    return key, f"{param_entry(name, key, value)}: {text}"
+
+
+def check_params(cls: type[Planner], name: str, params: dict) -> tuple[str, str] | None:
+    """What is wrong with ``params`` as planner ``name``'s (:class:`Planner` ``cls``) takes them,
+    checked one way for a scenario's entry, ``--planner`` and ``sweep --param``: (the parameter,
+    a sentence naming the entry and the parameter, :func:`param_message`), or None.
+
+    - a text value that is an address holding a credential (:func:`~semsearch_cli.credentials.url_credential`,
+      any planner: the label would carry it), before anything else, the key never shown;
+    - a parameter the planner does not take, with the nearest valid name;
+    - what its ``Params`` model refuses (out of range, the wrong type, not one of its choices);
+    - a number that is not finite (NaN, inf, also written as text: ``inf``, ``1e999``), which a
+      model's float field would otherwise take; true or false for a number (read as 1 or 0)."""
+    for k, v in params.items():
+        secret = url_credential(v)
+        if secret:
+            return k, f"{param_entry(name, k, v)}: {k} holds {secret}: {WHERE_THE_KEY_GOES}"
+    fields = cls.Params.model_fields
+    for k, v in params.items():
+        if (isinstance(v, float) or (isinstance(v, str) and k in fields and _takes_number(fields[k].annotation))) \
+                and not _finite_text(v):
+            return k, f"{param_entry(name, k, v)}: {k} must be a finite number"
+        if isinstance(v, bool) and k in fields and not _takes_bool(fields[k].annotation):
+            return k, f"{param_entry(name, k, v)}: {k} must be a number, not true or false"
+    try:
+        model = cls.Params(**params)
+    except ValidationError as exc:
+        e = exc.errors()[0]
+        if e["type"] == "extra_forbidden":
+            k = str(e["loc"][0])
+            return k, (f"{param_entry(name, k, params.get(k))}: {name!r} has no parameter {k!r}"
+                       f"{did_you_mean(k, cls.Params.model_fields)}; {_parameters(cls)}")
+        return param_message(name, e, params)
+    for k in params:
+        v = getattr(model, k, None)
+        if isinstance(v, float) and not math.isfinite(v):
+            return k, f"{param_entry(name, k, params[k])}: {k} must be a finite number"
+    return None
+
+
+def _takes_number(annotation) -> bool:
+    """Whether a field of this annotation takes a number (``float``, ``int``, or either or None)."""
+    return annotation in (float, int) or bool({float, int} & set(typing.get_args(annotation)))
+
+
+def _finite_text(v) -> bool:
+    """False for a number, or text a number field reads as one, that is not finite (``nan``,
+    ``inf``, ``-Infinity``, ``1e999``); True for anything else (a wrong type is the model's to say)."""
+    try:
+        return math.isfinite(float(v))
+    except (TypeError, ValueError, OverflowError):
+        return True
+
+
+def _takes_bool(annotation) -> bool:
+    """Whether a field of this annotation takes True or False as such (pydantic would read them
+    as 1 and 0 in a number field)."""
+    return annotation is bool or bool in typing.get_args(annotation) or annotation in (typing.Any, object)
+
+
+ENTRY = re.compile(r"(?P<name>[A-Za-z0-9_][\w.+-]*)(?:\[(?P<params>[^\[\]]*)\])?")  # NAME or NAME[key=value,...]
+
+
+def parse_entry(text: str, flag: str = "--planner") -> tuple[str, dict]:
+    """(name, parameters) of a planner given on the command line as a label writes it,
+    ``NAME`` or ``NAME[key=value,...]``, each value read as a YAML scalar (``0.9``, ``true``,
+    ``text``); a :class:`ScenarioError` naming ``flag`` for any other form, a parameter given
+    twice or with no value, and for an address holding a credential (the key never shown)."""
+    secret = credential_in(text)
+    if secret:
+        raise ScenarioError("<command line>", flag, f"{redact(text.strip())!r} holds {secret}: {WHERE_THE_KEY_GOES}")
+    m = ENTRY.fullmatch(text.strip())
+    if m is None:
+        raise ScenarioError("<command line>", flag, f"{_short(text.strip(), 120)}: give NAME or NAME[key=value,...], e.g. "
+                            "nsos[alpha=0.9]")
+    params: dict = {}
+    for item in filter(None, (p.strip() for p in (m["params"] or "").split(","))):
+        key, eq, value = (x.strip() for x in item.partition("="))
+        if not eq or not key:
+            raise ScenarioError("<command line>", flag, f"{text.strip()!r}: {item!r} is not key=value")
+        if key in params:
+            raise ScenarioError("<command line>", flag, f"{text.strip()!r}: {key} is given twice; give each parameter once")
+        if not value:
+            raise ScenarioError("<command line>", flag, f"{text.strip()!r}: {key} has no value; give one ({key}=VALUE), or "
+                                "leave the parameter out for its default")
+        try:
+            params[key] = yaml.safe_load(value)
+        except yaml.YAMLError:
+            raise ScenarioError("<command line>", flag, f"{text.strip()!r}: cannot read the value of {key}, {value!r} (a "
+                                "number, true or false, or text)") from None
+    return m["name"], params
+
+
+def check_entry(text: str, flag: str = "--planner") -> None:
+    """Refuse, naming ``flag``, a planner given on the command line whose parameters its planner
+    would refuse (:func:`check_params`: ``'nsos[alpha=2]': alpha must be at most 1``); a name
+    this process has not registered is left to the caller (it may be a user's planner)."""
+    name, params = parse_entry(text, flag)
+    cls = PLANNERS.get(name)
+    if cls is None or not params:
+        return
+    try:
+        fault = check_params(cls, name, {k: v for k, v in params.items() if k != "module"})
+    except (Exception, SystemExit):  # a user's validator that raises: expand_variants names its line
+        return
+    if fault:
+        raise ScenarioError("<command line>", flag, fault[1])
 
 
 def path_fields(params: type[BaseModel]) -> tuple[str, ...]:
@@ -629,23 +799,12 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
         values = [v if isinstance(v, list) else [v] for v in (params[k] for k in keys)]
         for k, vs in zip(keys, values):
             if not vs:
-                raise ScenarioError(file, f"planners[{i}].{k}", "an empty list: give one value, or a list of values to "
-                                    "sweep")
-            bad = [v for v in vs if isinstance(v, float) and not math.isfinite(v)]
-            if bad:
-                raise ScenarioError(file, f"planners[{i}].{k}", f"expected a finite number, got {bad[0]!r}")
+                raise ScenarioError(file, f"planners[{i}].{k}", f"{name}'s {k} is an empty list: give one value, or a list "
+                                    "of values to sweep")
         for combo in itertools.product(*values):
             p = tuple(zip(keys, combo))
             try:
-                PLANNERS[name].Params(**dict(p))
-            except ValidationError as exc:
-                e = exc.errors()[0]
-                loc = ".".join(str(x) for x in e["loc"])
-                if e["type"] == "extra_forbidden":
-                    raise ScenarioError(file, f"planners[{i}].{loc}", f"{name!r} has no parameter {loc!r}"
-                                        f"{did_you_mean(loc, PLANNERS[name].Params.model_fields)}; "
-                                        f"{_parameters(PLANNERS[name])}") from None
-                raise ScenarioError(file, f"planners[{i}].{loc}", e["msg"]) from None
+                fault = check_params(PLANNERS[name], name, dict(p))
             except (Exception, SystemExit) as exc:  # a validator of the planner's that raises something else
                 src, _ = _source(PLANNERS[name])
                 line = _user_line(exc, src)
@@ -653,6 +812,8 @@ def expand_variants(specs, file: str = "<scenario>", task: str | None = None, ba
                 raise ScenarioError(file, f"planners[{i}]", f"planner {name!r} with "
                                     f"{', '.join(f'{k}={v!r}' for k, v in p) or 'its defaults'}: its Params raised "
                                     f"{type(exc).__name__}: {exc}{at}") from None
+            if fault:
+                raise ScenarioError(file, f"planners[{i}].{fault[0]}" if fault[0] else f"planners[{i}]", fault[1])
             paths = path_fields(PLANNERS[name].Params)
             for k, value in p:
                 if k in paths and value is not None and not ((base or Path(".")) / str(value)).exists():

@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 from typing import Iterable, Iterator
 
+from ..credentials import redact, url_credential
 from ..errors import MissingExtra, ScenarioError
 from ..kernels import share_compiling_note
 from ..optional import lazy_module
@@ -144,6 +145,11 @@ def check_address(address: str) -> tuple[str, str, int]:
     default; an IPv6 host in brackets); a :class:`ScenarioError` naming ``--scheduler`` for any
     other form, an unknown scheme or a port outside 1-65535. Only the form is checked here."""
     text = str(address).strip()
+    secret = url_credential(text, bare=True)
+    if secret:  # Dask's own credentials are TLS certificates in its configuration, never in the address
+        raise ScenarioError("<command line>", "--scheduler", f"{redact(text)!r} holds {secret}: a scheduler address is "
+                            "tcp://HOST:PORT alone; a cluster's credentials are TLS certificates in Dask's configuration "
+                            "(distributed.comm.tls), given with tls://HOST:PORT")
     m = _ADDRESS.fullmatch(text)
     if m is None:
         raise ScenarioError("<command line>", "--scheduler", f"{address!r} is not a scheduler address; give "

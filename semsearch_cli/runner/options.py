@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ScenarioError
+from ..planners.base import check_entry
 from .cluster import check_address, require_dask
 from .executors import check_kind
 
@@ -53,10 +54,13 @@ class BatchOptions:
 
     def checked(self) -> "BatchOptions":
         """These options with the worker count decided: a :class:`ScenarioError` for an unknown
-        executor, a scheduler given to the process pool, or more workers than the CPUs without
-        ``oversubscribe``. With a scheduler the cluster's own workers run the batch, and
+        executor, a scheduler given to the process pool, more workers than the CPUs without
+        ``oversubscribe``, or a planner label whose parameters its planner refuses
+        (:func:`~semsearch_cli.planners.base.check_entry`). With a scheduler the cluster's own workers run the batch, and
         ``workers`` is not checked."""
         check_kind(self.executor)
+        for entry in self.planners or ():  # a label no variant could have: its parameter named, a key never shown
+            check_entry(str(entry))
         if self.executor == "dask":
             require_dask()  # its package, before anything is written
         if self.scheduler is not None and self.executor != "dask":

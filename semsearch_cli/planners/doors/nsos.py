@@ -138,13 +138,16 @@ def closeness(D: np.ndarray) -> np.ndarray:
 
 
 # ---- the planner ------------------------------------------------------------------------------
+MAX_BINS = 3600  # bins of a heading histogram (0.1 degrees each over 360): a histogram of 10**9 bins would take 8 GB
+
+
 class NSOSParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
     alpha: float = Field(0.9, ge=0.0, le=1.0, description="weight of the semantic factor, Eq. 4.7")
     w_g: float = Field(8.0, gt=0.0, description="signs needed for full growing-direction confidence, Eq. 4.9")
     w_p: float = Field(8.0, gt=0.0, description="signs needed for full parity confidence, Eq. 4.12")
-    door_bins: int = Field(4, ge=1, description="bins of H_d over 180 degrees")
-    robot_bins: int = Field(18, ge=1, description="bins of H_r over 360 degrees")
+    door_bins: int = Field(4, ge=1, le=MAX_BINS, description="bins of H_d over 180 degrees")
+    robot_bins: int = Field(18, ge=1, le=MAX_BINS, description="bins of H_r over 360 degrees")
     lambda_d: int = Field(6000, ge=1, description="sign reads kept for H_d")
     lambda_r: int = Field(600000, ge=1, description="poses kept for H_r")
     min_reads: int | None = Field(None, ge=1, description="reads before a sign counts (default: belief.min_reads)")
@@ -292,8 +295,8 @@ class NSOS(KeepTarget):
 
 class GeometricParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
-    door_bins: int = Field(4, ge=1)
-    robot_bins: int = Field(18, ge=1)
+    door_bins: int = Field(4, ge=1, le=MAX_BINS)
+    robot_bins: int = Field(18, ge=1, le=MAX_BINS)
     lambda_d: int = Field(6000, ge=1)
     lambda_r: int = Field(600000, ge=1)
     hysteresis: float = Field(0.01, ge=0.0)

@@ -10,7 +10,8 @@ What a lab relies on, and where it is done:
   ``max_concurrent`` lock files per endpoint, held with ``flock`` while a request is out);
 - the API key read from the environment variable ``api_key_env`` when the client is made, and
   kept nowhere else: not in rows, transcripts or meta.json (a request's headers are never
-  recorded);
+  recorded); a key written into ``base_url`` (``http://user:KEY@host``, ``?api_key=``) is
+  refused when the scenario loads (:func:`url_fault`);
 - nothing a server does raises out of :meth:`Chat.ask` (any ``Exception``; a run's wall-clock
   limit, a ``BaseException``, still ends the run): a reply, or the reason there is none
   (``error``), always comes back, so the planner counts it.
@@ -26,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import urlsplit
 
+from ...credentials import WHERE_THE_KEY_GOES, redact, url_credential
 from ...errors import MissingExtra
 from ...files import cache_dir
 from ...optional import lazy_module
@@ -98,7 +100,14 @@ def require_openai() -> None:
 
 
 def url_fault(base_url: str) -> str | None:
-    """What is wrong with ``base_url`` as written (no scheme, no host), or None."""
+    """What is wrong with ``base_url`` as written (a credential in it, no scheme, no host), or
+    None. A credential (:func:`~semsearch_cli.credentials.url_credential`: a user name and
+    password before the host, a query parameter such as ``api_key=``) is refused, as the address
+    is written into the planner's label, and so into rows, reports and file names; the message
+    shows the address masked, never the key."""
+    secret = url_credential(base_url, bare=True)
+    if secret:
+        return f"{redact(base_url)!r} holds {secret}: {WHERE_THE_KEY_GOES}"
     parts = urlsplit(base_url.strip())
     if parts.scheme not in ("http", "https") or not parts.netloc:
         example = "http://" + base_url.strip().split("://")[-1].rstrip("/") if base_url.strip() else "http://localhost:8000"

@@ -30,13 +30,15 @@ d_mean)``. The probabilities are taken as given when they sum to 1 or less, and 
 from __future__ import annotations
 
 import hashlib
+import re
 from pathlib import Path
 from string import Template
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from ...credentials import looks_like_key
 from ...errors import BudgetSpent, PlannerError, ScenarioError, Unavailable
 from ..base import COST_COLUMNS, Planner
 from .client import MISSING, Chat, Reply, openai_installed, prompt_path, require_openai, url_fault
@@ -76,6 +78,7 @@ FIELDS = {  # kind -> the fields a prompt template may use ($name), each documen
 }
 MODES = {"doors": ("actor", "estimator"), "objects": ("actor", "estimator"), "indirect": ("actor",)}
 SPLIT = ("=== system ===", "=== user ===")
+ENV_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}")  # an environment variable's name, as api_key_env takes it
 REPEAT_CHARS = 2000  # characters of an invalid reply sent back with the re-ask (a reply of 20,000 is not sent back whole)
 
 
@@ -106,6 +109,18 @@ class LlmParams(BaseModel):
     prompt: str | None = Field(None, json_schema_extra={"path": True}, description="a prompt template file")
     replay: str | None = Field(None, json_schema_extra={"path": True}, description="replay the transcripts in this folder")
     replay_planner: str | None = Field(None, description="the planner label to replay when the folder holds several")
+
+    @field_validator("api_key_env")
+    @classmethod
+    def _a_variable_not_a_key(cls, v: str) -> str:
+        """``api_key_env`` names a variable: a key written in its place (``sk-...``, or anything
+        that is not a variable's name) would be written into the label, so it is refused."""
+        if not ENV_NAME.fullmatch(v) or looks_like_key(v):
+            raise ValueError("api_key_env must be the name of the environment variable that holds the key (letters, digits "
+                             "and _, e.g. OPENAI_API_KEY), never the key itself, which would be written into the label, "
+                             "rows and reports: export OPENAI_API_KEY=<your key> and leave api_key_env out, or name your "
+                             "own variable")
+        return v
 
 
 def load_prompt(path: str | None, kind: str, mode: str) -> tuple[str, str, str]:
