@@ -108,7 +108,13 @@ def url_fault(base_url: str) -> str | None:
     secret = url_credential(base_url, bare=True)
     if secret:
         return f"{redact(base_url)!r} holds {secret}: {WHERE_THE_KEY_GOES}"
-    parts = urlsplit(base_url.strip())
+    try:
+        parts = urlsplit(base_url.strip())
+        port = parts.port  # a port outside 0-65535 raises here
+    except ValueError as exc:  # a bracket left open (http://[::1), a port of letters or past 65535
+        return f"{base_url!r} is not an address ({exc}); write it whole, e.g. http://localhost:8000/v1 or http://[::1]:8000/v1"
+    if port == 0:
+        return f"{base_url!r} names port 0; give the server's port (1-65535), e.g. http://localhost:8000/v1"
     if parts.scheme not in ("http", "https") or not parts.netloc:
         example = "http://" + base_url.strip().split("://")[-1].rstrip("/") if base_url.strip() else "http://localhost:8000"
         if not example.endswith("/v1"):

@@ -44,7 +44,7 @@ from ..base import COST_COLUMNS, Planner
 from .client import MISSING, Chat, Reply, openai_installed, prompt_path, require_openai, url_fault
 from .client import preflight as look_at_endpoint
 from .replies import parse_number, parse_probabilities
-from .transcript import folder_text, header, index, read, replan_on_signs, run_key
+from .transcript import files, folder_text, header, index, read, replan_on_signs, run_key
 
 FIELDS = {  # kind -> the fields a prompt template may use ($name), each documented in docs/llm.md
     "doors": {
@@ -186,13 +186,21 @@ class LlmCore(Planner):
 
     @classmethod
     def fault(cls, params: LlmParams, kind: str | None = None) -> tuple[str, str] | None:
-        """A model to call, or transcripts to replay, must be named; in a scenario of ``kind``, the
-        mode must be one that kind takes and the prompt template must use only its fields."""
+        """A model to call, or transcripts to replay, must be named (a ``base_url`` that is an
+        address holding no credential; a ``replay`` folder that holds transcripts); in a scenario
+        of ``kind``, the mode must be one that kind takes and the prompt template must use only
+        its fields."""
         if params.replay is None and not params.model.strip():
             return "model", ("name the model the server serves (e.g. model: qwen2.5-7b-instruct), or replay "
                              "transcripts (replay: DIR)")
         if params.replay is None and url_fault(params.base_url):
             return "base_url", url_fault(params.base_url)
+        if params.replay is not None and not Path(params.replay).is_dir():
+            return "replay", (f"{params.replay} is not a folder: replay names a results folder (or a bench folder) whose runs "
+                              "were made with --transcripts")
+        if params.replay is not None and not files(Path(params.replay)):
+            return "replay", (f"{params.replay} holds no transcripts (transcripts/<run>.jsonl, which run --transcripts "
+                              "writes): a replay would find none of its runs")
         if kind in MODES and params.mode not in MODES[kind]:
             return "mode", (f"{kind} search takes mode {' or '.join(MODES[kind])}: its choices are poses of a lattice, "
                             "not places a probability can be put on" if kind == "indirect" else
