@@ -33,7 +33,8 @@ from .report.document import atomic_text, markdown_table
 from .report.figures.distances import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows, workers_for
-from .runner.verify import Verdict, verify_folder
+from .runner.store import read_runs
+from .runner.verify import Verdict, records_in, verify_folder
 from .tasks import TASKS
 from .tasks.decisions import Seat
 from .tasks.doors import DoorTask
@@ -57,6 +58,9 @@ def default_out(loaded: Loaded, out: str | Path | None) -> Path:
     if loaded.sc.experiment.out:
         return (loaded.path.parent / loaded.sc.experiment.out).resolve()
     return Path("results") / loaded.sc.name
+
+
+RECORDED = ("decisions_sha256",)  # a run recorded with --decisions names its record in its rows (semsearch verify)
 
 
 def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=None, plots: bool = True,
@@ -83,7 +87,7 @@ def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=N
     if not specs:
         raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
     out_dir = default_out(loaded, options.out)
-    with Batch(loaded, specs, out_dir, options) as batch:  # the folder held and its rows checked, once
+    with Batch(loaded, specs, out_dir, options, own=RECORDED if options.decisions else ()) as batch:  # held and checked, once
         report_build.write_meta(out_dir, loaded)
         loaded.task.write_inputs(out_dir)
         runs = batch.run(progress)
@@ -313,15 +317,19 @@ def _door_variant(planner: str, planner_file: str | Path | None):
 
 
 def verify(folder: str | Path, scenario: str | Path | None = None, progress=None, workers: int | None = None,
-           salt_file: str | Path | None = None) -> VerifyOutput:
-    """Replay every run of a results folder that has a decisions record (``run --decisions``)
-    from its decisions alone, no planner built, and check outcome, distance and steps against its
-    rows (:mod:`semsearch_cli.runner.verify`). ``scenario``: the scenario the rows were made with
+           salt_file: str | Path | None = None, allow_unrecorded: bool = False) -> VerifyOutput:
+    """Check a results folder recorded with ``run --decisions``: replay each of its runs from its
+    decisions alone, no planner built, against its rows (outcome, distance, steps, decisions), and
+    check the folder whole (:func:`~semsearch_cli.runner.verify.verify_folder`): a row without its
+    record, a record without its row, a row twice or of no run of the scenario, a record of
+    another run each fail the verdict. ``scenario``: the scenario the rows were made with
     (default: the one meta.json names, with the parameter a sweep set in that folder); its
     planners' files are not needed. ``workers``: replaying processes (None: the CPU count, at
-    most 4; the verdict does not depend on it). A bench folder (``semsearch bench run``) is verified
-    floor by floor on the suite's own floors (:func:`~semsearch_cli.bench.verify_bench`;
-    ``salt_file`` for a hidden split)."""
+    most 4; the verdict does not depend on it). ``allow_unrecorded``: a folder recorded partly
+    without ``--decisions``: its runs without a record (naming none) are counted, not failed. A
+    bench folder (``semsearch bench run``) is verified floor by floor on the suite's own floors
+    (:func:`~semsearch_cli.bench.verify_bench`; ``salt_file`` for a hidden split), every run
+    recorded."""
     folder = Path(folder)
     cpus = os.cpu_count() or 1
     if workers is not None and workers > cpus:
@@ -330,15 +338,20 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
         if scenario is not None:
             raise ScenarioError("<command line>", "--scenario", f"{folder} is a bench folder: its floors are the suite's "
                                 "(bench.json); give --salt-file for a hidden split, never a scenario")
+        if allow_unrecorded:
+            raise ScenarioError("<command line>", "--allow-unrecorded", f"{folder} is a bench folder: a bench run records "
+                                "every run, so each must have its record")
         return _verify_bench(folder, salt_file, progress, workers)
     if salt_file is not None:
         raise ScenarioError("<command line>", "--salt-file", f"{folder} is not a bench folder (no bench.json)")
     path, loaded = _rows_scenario(folder, scenario)
-    verdict = verify_folder(folder, loaded, progress, workers_for(workers))
-    if not verdict.verified and not verdict.failed:
-        raise ScenarioError(str(folder / "decisions"), "", f"none of the {verdict.runs} runs has a decisions record: run the "
-                            "batch with --decisions (the runs already done are not recorded again; run them into a fresh "
-                            "folder)")
+    rows = read_runs(folder / "runs.csv", as_written=True)
+    digests = rows["decisions_sha256"].astype(str).str.len().gt(0).any() if "decisions_sha256" in rows.columns else False
+    if not records_in(folder) and not digests:  # never recorded (a row naming its record says it was)
+        raise ScenarioError(str(folder / "decisions"), "", f"none of the {int((rows['stage'] == '').sum())} runs has a decisions "
+                            "record: run the batch with --decisions (the runs already done are not recorded again; run them "
+                            "into a fresh folder)")
+    verdict = verify_folder(folder, loaded, progress, workers_for(workers), allow_unrecorded)
     return VerifyOutput(folder, path, verdict)
 
 
@@ -449,7 +462,7 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
             specs = expand(ld, options.seeds, options.goals, options.planners)
             if not specs:
                 raise ScenarioError("<command line>", "--planner", f"no planner variant matches {options.planners}")
-            batches.append(held.enter_context(Batch(ld, specs, sub, options)))
+            batches.append(held.enter_context(Batch(ld, specs, sub, options, own=RECORDED if options.decisions else ())))
         frames = []
         for v, ld, sub, batch in zip(values, loaded, subs, batches):
             report_build.write_meta(sub, ld, {"param": param, "value": v})
@@ -732,10 +745,11 @@ def _verify_bench(folder: Path, salt_file=None, progress=None, workers: int | No
         v.runs += fv.runs
         v.verified += fv.verified
         v.unrecorded += fv.unrecorded
-        v.failed += [(f"floor {fid}: {name}", why) for name, why in fv.failed]
+        v.unfinished += fv.unfinished
+        v.failed += [(f"{'the bench folder' if fid == '(top)' else f'floor {fid}'}: {name}", why) for name, why in fv.failed]
     if not v.runs:
         raise ScenarioError(str(folder), "", "holds no floor with rows to verify")
-    bench.board.write_verdict(folder, split.hash, v.runs, v.verified, len(v.failed))
+    bench.board.write_verdict(folder, split.hash, v.runs, v.verified, len(v.failed), v.unfinished)
     return VerifyOutput(folder, f"{split.suite.name} {split.name}, hash {split.hash[:16]}", v)
 
 

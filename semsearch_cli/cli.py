@@ -392,24 +392,32 @@ def verify(
                                           "most 4; at most the CPU count). The verdict does not depend on it."),
     salt_file: Optional[Path] = typer.Option(None, "--salt-file", help="A bench folder of a hidden split: the file holding "
                                              "its salt (maintainers)."),
+    allow_unrecorded: bool = typer.Option(False, "--allow-unrecorded", help="A folder recorded partly without --decisions: "
+                                          "its runs without a record are counted, not failed (never for a bench folder)."),
 ):
-    """Replay every run of a results folder that has its decisions (`semsearch run --decisions`),
-    without its planner, and check its outcome, distance, steps and decisions exactly: each run
-    that does not replay is named, and the status is 1."""
+    """Check a results folder recorded with `semsearch run --decisions`: replay each run from its
+    decisions, without its planner, to its outcome, distance, steps and decisions exactly, and
+    check the folder whole: a row without its record, a record without its row, a row added or
+    twice, a record of another run. Each is named, and the status is 1."""
 
     try:
-        res = api.verify(folder, scenario, workers=workers, salt_file=salt_file)
+        res = api.verify(folder, scenario, workers=workers, salt_file=salt_file, allow_unrecorded=allow_unrecorded)
     except ScenarioError as exc:
         _fail(exc)
     v = res.verdict
     for name, why in v.failed:
-        out.print(f"does not replay: {name}: {why}")
-    skipped = f"; {v.unrecorded} without decisions (not recorded with --decisions, or an error or timeout) not checked" \
-        if v.unrecorded else ""
+        out.print(f"does not replay: {name}: {why}", highlight=False, soft_wrap=True)
+    notes = []
+    if v.unrecorded:
+        notes.append(f"{v.unrecorded} without decisions not checked (--allow-unrecorded)")
+    if v.unfinished:
+        notes.append(f"{v.unfinished} error or timeout run(s), which keep no record, claiming no result")
+    more = "".join(f"; {n}" for n in notes)
     out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance, steps and "
-              f"decisions recorded{skipped} ({'suite' if isinstance(res.scenario, str) else 'scenario'} {res.scenario})")
+              f"decisions recorded{more} ({'suite' if isinstance(res.scenario, str) else 'scenario'} {res.scenario})",
+              highlight=False, soft_wrap=True)
     if v.failed:
-        out.print(f"{len(v.failed)} run(s) do not replay")
+        out.print(f"{len(v.failed)} problem(s): the folder does not verify", highlight=False, soft_wrap=True)
         raise typer.Exit(1)
 
 

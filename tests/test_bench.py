@@ -216,7 +216,8 @@ def test_verify_fails_a_folder_that_is_no_floor_and_a_run_whose_record_was_taken
     out = runner.invoke(app, ["verify", str(res.out), "--workers", "1"])
     assert out.exit_code == 1
     assert "floor zzz: its rows: folder zzz is not a floor of doors-v1 val" in out.stdout
-    assert "floor f000: 1 run(s): have no decisions record" in out.stdout
+    assert re.search(r"floor f000: greedy goal \S+ episode 2 seed 0: its record decisions/\S+, which the row names "
+                     r"\(decisions_sha256\), is gone", " ".join(out.stdout.split()))
     board = api.bench_board([res.out], tmp_path / "site")  # the board reads the split's floors alone, and says it failed
     md = (tmp_path / "site" / "board.md").read_text()
     assert "| greedy | 3 of 800 | 3 |" in md and "failed" in md and board

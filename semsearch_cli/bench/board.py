@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -47,25 +48,39 @@ def rows_digest(folder: Path) -> str:
     return h.hexdigest()
 
 
-def write_verdict(folder: Path, split_hash: str, runs: int, verified: int, failed: int) -> None:
-    """Record a verification of a bench folder beside its rows (``verify.json``)."""
+def write_verdict(folder: Path, split_hash: str, runs: int, verified: int, failed: int, unfinished: int = 0) -> None:
+    """Record a verification of a bench folder beside its rows (``verify.json``); ``unfinished``:
+    its error and timeout runs, which keep no record and claim no result."""
     atomic_text(Path(folder) / VERIFY_FILE, json.dumps({"hash": split_hash, "runs": runs, "verified": verified,
-                                                        "failed": failed, "rows": rows_digest(folder)}, indent=1) + "\n")
+                                                        "failed": failed, "unfinished": unfinished,
+                                                        "rows": rows_digest(folder)}, indent=1) + "\n")
+
+
+MAX_VERIFY_BYTES = 1_000_000  # a verify.json semsearch writes is a few hundred bytes
 
 
 def verdict_of(folder: Path, split_hash: str) -> str:
-    """How a folder stands: ``verified`` (every run replayed, on these rows), ``failed``,
-    ``changed`` (rows written since the verification), or ``not verified``."""
+    """How a folder stands: ``verified`` (every run replayed, or did not finish and claims
+    nothing, on these rows), ``N failed``, ``changed since verified`` (rows written since the
+    verification), or ``not verified`` (no verify.json). A verify.json that is not the JSON object
+    ``semsearch verify`` writes is a :class:`ScenarioError` naming it."""
     f = Path(folder) / VERIFY_FILE
-    if not f.is_file():
+    if not f.exists():
         return "not verified"
+    bad = "not a verify.json semsearch wrote; run `semsearch verify` on the folder again"
     try:
-        v = json.loads(f.read_text())
-    except ValueError:
-        return "not verified"
+        if f.stat().st_size > MAX_VERIFY_BYTES:
+            raise ScenarioError(str(f), "", f"{bad} (larger than {MAX_VERIFY_BYTES:,} bytes)")
+        v = json.loads(f.read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError, RecursionError) as exc:
+        raise ScenarioError(str(f), "", f"{bad} ({type(exc).__name__}: {str(exc)[:80]})") from None
+    counts = ("runs", "verified", "failed")
+    if not isinstance(v, dict) or not all(isinstance(v.get(k), int) and not isinstance(v.get(k), bool) for k in counts):
+        raise ScenarioError(str(f), "", f"{bad} (not an object of its counts: runs, verified, failed)")
     if v.get("hash") != split_hash or v.get("rows") != rows_digest(folder):
         return "changed since verified"
-    return "verified" if v.get("failed") == 0 and v.get("verified") == v.get("runs") else f"{v.get('failed')} failed"
+    unfinished = v.get("unfinished", 0) if isinstance(v.get("unfinished", 0), int) else 0
+    return "verified" if v["failed"] == 0 and v["verified"] + unfinished == v["runs"] else f"{v['failed']} failed"
 
 
 def load(folders) -> pd.DataFrame:
@@ -78,8 +93,14 @@ def load(folders) -> pd.DataFrame:
     Rows of runs that failed for a cause outside them (``unavailable:``, run again on resume)
     are kept with ``unavailable`` True; the tables leave them out of every statistic."""
     frames = []
+    seen: dict[str, Path] = {}  # each folder's real path: the same folder given twice
     for folder in folders:
         folder = Path(folder)
+        real = os.path.realpath(folder)
+        if real in seen:
+            raise ScenarioError(str(folder), "", f"is the folder {seen[real]} given again: the board counts each run once; "
+                                "give each bench folder once")
+        seen[real] = folder
         if not is_bench(folder):
             raise ScenarioError(str(folder), "", f"no {BENCH_FILE} here: give folders written by `semsearch bench run`")
         meta = read_bench(folder)
@@ -95,6 +116,9 @@ def load(folders) -> pd.DataFrame:
             if not f.is_file():
                 continue
             r = read_runs(f)
+            lacking = [c for c in ("suite", "split", "suite_hash", "numbering", "floor") if c not in r.columns]
+            if lacking:
+                raise ScenarioError(str(f), lacking[0], f"has no column {', '.join(lacking)}: not the rows of a bench run")
             r = r[(r["stage"] == "") & (r["floor"].astype(str) == fid) & (r["numbering"].astype(str) == meta["numbering"])]
             if not len(r):
                 continue
@@ -109,7 +133,31 @@ def load(folders) -> pd.DataFrame:
             frames.append(r)
     if not frames:
         raise ScenarioError(str(folders[0]), "", "the bench folders hold no rows")
-    return pd.concat(frames, ignore_index=True)
+    rows = pd.concat(frames, ignore_index=True)
+    _once(rows)
+    return rows
+
+
+RUN_KEY = ["suite", "split", "suite_hash", "numbering", "planner", "floor", "goal", "episode", "seed"]
+
+
+def _once(rows: pd.DataFrame) -> None:
+    """Refuse rows that hold one run twice (two folders, a copy of one, or a row repeated): the
+    board would count it twice, and its intervals narrow as if there were twice the episodes. A
+    :class:`ScenarioError` naming both folders (or the one)."""
+    key = rows[RUN_KEY].astype(str).agg("|".join, axis=1)
+    twice = key.duplicated(keep=False)
+    if not twice.any():
+        return
+    first = key[twice].iloc[0]
+    where = list(dict.fromkeys(rows.loc[key == first, "folder"]))
+    n = int(key[twice].nunique())
+    if len(where) > 1:
+        raise ScenarioError(where[1], "", f"holds {n} of the runs {where[0]} holds too (the same suite, split, hash, "
+                            f"numbering, planner, floor, episode and repeat; {where[0]} and {where[1]}): the board counts each run "
+                            "once; give one of the two folders (a copy of a folder is the same runs)")
+    raise ScenarioError(where[0], "", f"holds {n} run(s) twice (one planner, floor, episode and repeat in two rows): the "
+                        "board counts each run once; `semsearch verify` names them")
 
 
 def _ci(m, lo, hi, fmt="{:.3f}") -> str:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 from contextlib import nullcontext
 import shutil
 import tempfile
@@ -31,6 +32,7 @@ from ..report.build import write_meta
 from ..metrics import outside_the_run
 from ..planners.base import expand_variants, preflight
 from ..runner import Batch, BatchOptions, Loaded, folder_lock, make_executor, read_runs
+from ..runner.batch import BENCH_FILE as _BENCH_MARK
 from ..runner.specs import RunList
 from ..runner.verify import Verdict, verify_folder
 from ..tasks.episodes import Episode
@@ -38,7 +40,7 @@ from .numbering import NUMBERINGS, relabel
 from .predictability import predictability
 from .suites import Floor, Split, open_split, suite_named
 
-BENCH_FILE = "bench.json"
+BENCH_FILE = _BENCH_MARK  # one name, which the runner refuses a plain run into (runner.batch)
 
 
 def _copy_named(doc, base: Path, dest: Path):
@@ -112,16 +114,14 @@ def _check_bench_file(out: Path, split: Split, numbering: str, planners: list[st
     f = out / BENCH_FILE
     want = {"suite": split.suite.name, "split": split.name, "hash": split.hash, "numbering": numbering}
     if f.is_file():
-        try:
-            have = json.loads(f.read_text())
-        except ValueError as exc:
-            raise ScenarioError(str(f), "", f"not a bench.json semsearch wrote ({exc})") from None
+        have = read_bench(out)
         for key, value in want.items():
             if have.get(key) != value:
                 raise ScenarioError(str(f), key, f"this folder holds {have.get(key)!r}, this run is {value!r}: a bench folder "
                                     "holds one suite, split and numbering; write into another folder with --out")
     else:
         have = dict(want)
+    have.pop("runs", None)  # what the folder holds is said when this run ends (an interrupted run claims nothing)
     have["official"] = split.official
     have["repeats"] = split.suite.repeats
     have["kind"] = split.suite.kind
@@ -146,6 +146,7 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
     except ScenarioError:
         variants = []  # a planner the command line names wrong: said of --planner below, with the floor loaded
     preflight(variants, "<command line>", "--planner")  # before the folder, bench.json or a floor is written
+    check_bench_out(Path(out))
     out = output_folder(out)
     counts = [len(pd.read_csv(f.scenario.parent / "episodes.csv", usecols=["goal"])) for f in sp.floors]
     todo, left = [], limit
@@ -184,8 +185,21 @@ def run_bench(suite: str, planners: list[PlannerSpec], out: str | Path, split: s
     with folder_lock(out):
         meta = json.loads((out / BENCH_FILE).read_text())
         meta["partial"] = bool(missing_runs(out, meta))
+        meta["runs"] = floor_runs(out, meta)
         atomic_text(out / BENCH_FILE, json.dumps(meta, indent=1) + "\n")
     return BenchOutput(out, sp, numbering, runs, [f.id for f, _ in todo], meta["partial"])
+
+
+def floor_runs(out: Path, meta: dict) -> dict[str, int]:
+    """Per floor of a bench folder that holds rows, its runs (rows of whole runs): what
+    bench.json says the folder holds, which ``verify`` holds the floors to (a floor taken away)."""
+    held = {}
+    for fid in meta.get("floors", {}):
+        f = out / fid / "runs.csv"
+        if f.is_file():
+            r = read_runs(f)
+            held[fid] = int((r["stage"] == "").sum()) if len(r) else 0
+    return held
 
 
 def missing_runs(out: Path, meta: dict) -> dict[str, int]:
@@ -256,19 +270,61 @@ def floor_info(split: Split, floor: Floor) -> dict:
     return info
 
 
+MAX_BENCH_BYTES = 10_000_000  # a bench.json semsearch writes is kilobytes (one entry per floor)
+BENCH_KEYS = ("suite", "split", "hash", "numbering")  # what every bench.json names, as text
+
+
 def read_bench(folder: Path) -> dict:
-    """A bench folder's bench.json, or a :class:`ScenarioError`."""
+    """A bench folder's bench.json, checked: a JSON object naming a known suite, its split, hash
+    and numbering (text), and its floors (an object, when given); else a :class:`ScenarioError`
+    naming the file."""
     f = Path(folder) / BENCH_FILE
+    bad = "not a bench.json semsearch wrote"
     try:
-        meta = json.loads(f.read_text())
+        if f.stat().st_size > MAX_BENCH_BYTES:
+            raise ScenarioError(str(f), "", f"{bad} (larger than {MAX_BENCH_BYTES:,} bytes)")
+        meta = json.loads(f.read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError, RecursionError) as exc:
+        raise ScenarioError(str(f), "", f"{bad} ({type(exc).__name__}: {str(exc)[:80]})") from None
+    if not isinstance(meta, dict):
+        raise ScenarioError(str(f), "", f"{bad} (a JSON {type(meta).__name__}, not an object)")
+    for key in BENCH_KEYS:
+        if not isinstance(meta.get(key), str) or not meta[key]:
+            got = "none" if key not in meta else repr(meta[key])[:40]
+            raise ScenarioError(str(f), key, f"{bad}: its {key} is {got}, not the text a bench run writes")
+    if "floors" in meta and not isinstance(meta["floors"], dict):
+        raise ScenarioError(str(f), "floors", f"{bad}: its floors are not an object of floor ids")
+    if meta["numbering"] not in NUMBERINGS:
+        raise ScenarioError(str(f), "numbering", f"{bad}: {unknown_numbering(meta['numbering'])}")
+    try:
         suite_named(meta["suite"])
-        return meta
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise ScenarioError(str(f), "", f"not a bench.json semsearch wrote ({type(exc).__name__}: {exc})") from None
+    except ScenarioError as exc:
+        raise ScenarioError(str(f), "suite", exc.message) from None
+    return meta
 
 
 def is_bench(folder: Path) -> bool:
     return (Path(folder) / BENCH_FILE).is_file()
+
+
+def check_bench_out(out: Path) -> None:
+    """A bench run's ``--out`` is a bench folder or a fresh one: never a plain results folder
+    (``semsearch run`` wrote its runs.csv or meta.json there) nor a folder inside a bench folder
+    (its floors are its own), for then one folder would mix two kinds of rows and ``verify``
+    check one of them. A :class:`ScenarioError` for ``--out``."""
+    out = Path(out)
+    if (out / BENCH_FILE).exists() and not (out / BENCH_FILE).is_file():
+        raise ScenarioError("<command line>", "--out", f"{out / BENCH_FILE} is not a file; give another folder")
+    if not is_bench(out):
+        plain = [n for n in ("runs.csv", "meta.json") if (out / n).exists()]
+        if plain:
+            raise ScenarioError("<command line>", "--out", f"{out} is a results folder of `semsearch run` (it holds "
+                                f"{plain[0]}): a bench folder and a plain results folder never share a folder; give the "
+                                "bench run a folder of its own")
+    for p in Path(os.path.abspath(out)).parents:
+        if (p / BENCH_FILE).is_file():
+            raise ScenarioError("<command line>", "--out", f"{out} lies inside the bench folder {p}: give the bench run a "
+                                "folder of its own")
 
 
 def verify_bench(folder: str | Path, salt_file: str | Path | None = None, workers: int = 1,
@@ -286,23 +342,38 @@ def verify_bench(folder: str | Path, salt_file: str | Path | None = None, worker
                             "were made on")
     verdicts: dict[str, Verdict] = {}
     ids = {f.id for f in sp.floors}
+    if (folder / "runs.csv").exists() or (folder / "decisions").exists():  # a plain run's rows, written beside the floors
+        verdicts["(top)"] = Verdict(runs=1, failed=[("runs.csv", f"{folder} holds rows of its own beside its floors (a "
+                                                     "`semsearch run` into a bench folder): a bench folder's rows are its "
+                                                     "floors'")])
     for extra in sorted(p.parent.name for p in folder.glob("*/runs.csv") if p.parent.name not in ids):
         verdicts[extra] = Verdict(runs=1, failed=[("its rows", f"folder {extra} is not a floor of {sp.suite.name} {sp.name}")])
+    held = [f.id for f in sp.floors if (folder / f.id / "runs.csv").is_file()]
+    order = [f.id for f in sp.floors]
+    if held and order[: len(held)] != held:  # a bench run fills the floors in the split's order
+        gap = next(fid for fid in order if fid not in held)
+        verdicts[gap] = Verdict(runs=1, failed=[("its rows", f"are gone: floor {gap} comes before floors that hold rows "
+                                                 f"({held[-1]}), and a bench run fills the floors in order")])
+    said = meta.get("runs") if isinstance(meta.get("runs"), dict) else {}
     with tempfile.TemporaryDirectory(prefix="semsearch-verify-") as tmp:
         for f in sp.floors:
             if not (folder / f.id / "runs.csv").is_file():
+                if said.get(f.id):
+                    verdicts[f.id] = Verdict(runs=int(said[f.id]) if isinstance(said[f.id], int) else 1,
+                                             failed=[("its rows", f"are gone: bench.json says floor {f.id} holds "
+                                                      f"{said[f.id]} run(s), and it has no runs.csv")])
                 continue
             rows = read_runs(folder / f.id / "runs.csv", as_written=True)
             own = rows[rows["stage"] == ""]
             loaded = Loaded.load(materialise(sp, f, meta["numbering"], Path(tmp) / f.id), planners=False)
-            v = verify_folder(folder / f.id, loaded, progress, workers)
+            v = verify_folder(folder / f.id, loaded, progress, workers)  # every run recorded: none may lack its record
             for col, want, what in (("suite_hash", sp.hash, "another suite hash"), ("floor", f.id, "another floor"),
                                     ("numbering", meta["numbering"], "another numbering than bench.json's")):
                 bad = own[col].astype(str) != want if col in own.columns else pd.Series(True, index=own.index)
                 if bad.any():
                     v.failed.append((f"{int(bad.sum())} row(s)", f"carry {what} ({col} is not {want[:16]})"))
-            if v.unrecorded:  # a bench run records every run: a row without its record cannot be checked
-                v.failed.append((f"{v.unrecorded} run(s)", "have no decisions record (an error or timeout row, or a "
-                                 "record taken away): not verifiable"))
+            if f.id in said and said[f.id] != len(own):
+                v.failed.append(("its rows", f"bench.json says floor {f.id} holds {said[f.id]} run(s), its runs.csv holds "
+                                 f"{len(own)}"))
             verdicts[f.id] = v
     return sp, verdicts

@@ -20,6 +20,7 @@ import hashlib
 import json
 import os
 import shutil
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -144,11 +145,37 @@ def split_hash(suite: Suite, split: str, floors) -> str:
     return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
 
 
+MAX_SALT_BYTES = 4096  # a salt is a few dozen characters (secrets.token_hex(32): 64)
+
+
 def read_salt(salt_file: str | Path) -> str:
-    """A salt file's text (stripped); refused when missing or shorter than 16 characters."""
+    """A salt file's text (stripped). Refused when it is not a regular file (a FIFO with no
+    writer would block the read forever; a folder, a device), larger than
+    :data:`MAX_SALT_BYTES`, not UTF-8, or shorter than 16 characters: each before it is read, and
+    the file is opened without blocking, so nothing that takes its place in between can hang it."""
     p = Path(salt_file)
     try:
-        salt = p.read_text(encoding="utf-8").strip()
+        st = os.stat(p)
+    except OSError as exc:
+        raise ScenarioError(str(p), "", f"cannot read the salt file ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        what = ("a FIFO" if stat.S_ISFIFO(st.st_mode) else "a folder" if stat.S_ISDIR(st.st_mode) else
+                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a socket" if stat.S_ISSOCK(st.st_mode)
+                else "not a file")
+        raise ScenarioError(str(p), "", f"the salt file is {what}, not a regular file: give the file holding the salt")
+    if st.st_size > MAX_SALT_BYTES:
+        raise ScenarioError(str(p), "", f"a salt file of {st.st_size:,} bytes; a salt is at most {MAX_SALT_BYTES:,} "
+                            "(e.g. python -c 'import secrets; print(secrets.token_hex(32))')")
+    try:
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+                raise ScenarioError(str(p), "", "the salt file is not a regular file: give the file holding the salt")
+            data = fh.read(MAX_SALT_BYTES + 1)
+        if len(data) > MAX_SALT_BYTES:
+            raise ScenarioError(str(p), "", f"a salt file of more than {MAX_SALT_BYTES:,} bytes; a salt is at most "
+                                f"{MAX_SALT_BYTES:,}")
+        salt = data.decode("utf-8").strip()
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(str(p), "", f"cannot read the salt file ({getattr(exc, 'strerror', None) or exc})") from None
     if len(salt) < 16:

@@ -24,6 +24,20 @@ from .specs import Loaded, RunSpec, file_stem
 from .store import RowWriter, read_runs, run_rows
 
 
+BENCH_FILE = "bench.json"  # what marks a bench results folder (semsearch bench run; semsearch_cli.bench)
+
+
+def check_plain_out(out: Path) -> None:
+    """A plain batch's folder (``semsearch run``, a sweep) is never a bench folder nor inside one
+    (a floor's): one folder would mix two kinds of rows, and ``verify`` would check one of them.
+    A :class:`ScenarioError` for ``--out``."""
+    for p in (Path(out), *Path(os.path.abspath(out)).parents):
+        if (p / BENCH_FILE).exists():
+            where = "is" if p == Path(out) else f"lies inside {p}, which is"
+            raise ScenarioError("<command line>", "--out", f"{out} {where} a bench folder (it holds {BENCH_FILE}): a bench "
+                                "folder and a plain results folder never share a folder; give the run a folder of its own")
+
+
 def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | None = None) -> pd.DataFrame:
     """The rows of ``out/runs.csv`` that a batch of ``loaded`` may resume (see :func:`run_batch`);
     a :class:`ScenarioError` when they were made with another scenario, unless ``force``.
@@ -201,6 +215,8 @@ class Batch:
     def __enter__(self) -> "Batch":
         # a planner that cannot run at all (a language model's endpoint that does not answer, a
         # package it needs): refused before the folder is made, locked or touched
+        if not self.stamp:  # a bench run's floors carry its stamp; any other batch is a plain one
+            check_plain_out(self.out)
         if not self.looked:
             preflight(_pending(self.variants, self.specs, _have(self.out / "runs.csv")), str(self.loaded.path))
         with ExitStack() as stack:
