@@ -34,7 +34,7 @@ from .report.figures.distances import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows, workers_for
 from .runner.store import read_runs
-from .runner.verify import Verdict, records_in, verify_folder
+from .runner.verify import UNFINISHED, Verdict, records_in, verify_folder
 from .tasks import TASKS
 from .tasks.decisions import Seat
 from .tasks.doors import DoorTask
@@ -348,7 +348,11 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
     rows = read_runs(folder / "runs.csv", as_written=True)
     digests = rows["decisions_sha256"].astype(str).str.len().gt(0).any() if "decisions_sha256" in rows.columns else False
     if not records_in(folder) and not digests:  # never recorded (a row naming its record says it was)
-        raise ScenarioError(str(folder / "decisions"), "", f"none of the {int((rows['stage'] == '').sum())} runs has a decisions "
+        own = rows[rows["stage"] == ""]
+        if len(own) and own["outcome"].astype(str).isin(UNFINISHED).all():
+            raise ScenarioError(str(folder / "runs.csv"), "", f"all {len(own)} runs ended in an error or a timeout, which keep "
+                                "no decisions record: nothing to replay")
+        raise ScenarioError(str(folder / "decisions"), "", f"none of the {len(own)} runs has a decisions "
                             "record: run the batch with --decisions (the runs already done are not recorded again; run them "
                             "into a fresh folder)")
     verdict = verify_folder(folder, loaded, progress, workers_for(workers), allow_unrecorded)

@@ -411,7 +411,8 @@ def verify(
     if v.unrecorded:
         notes.append(f"{v.unrecorded} without decisions not checked (--allow-unrecorded)")
     if v.unfinished:
-        notes.append(f"{v.unfinished} error or timeout run(s), which keep no record, claiming no result")
+        notes.append(f"{v.unfinished} error or timeout run(s) not replayed (a run that did not finish keeps no record; "
+                     "they claim no result)")
     more = "".join(f"; {n}" for n in notes)
     out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance, steps and "
               f"decisions recorded{more} ({'suite' if isinstance(res.scenario, str) else 'scenario'} {res.scenario})",

@@ -30,7 +30,7 @@ class Case:
     category: str
     name: str
     args: list[str]
-    expect: str = "refuse"  # refuse | accept | either (no traceback, no hang)
+    expect: str = "refuse"  # refuse | accept | fail (exit 1: a check that finds its input wrong) | either (no traceback, no hang)
     issue: bool = False  # a defect found in the first hostile review (the tests run these)
     says: tuple = ()  # text the output must hold (the field or flag blamed, the file named)
     cwd: Path | None = field(default=None, repr=False)
@@ -83,11 +83,13 @@ def check_outcome(case: Case, res, cwd: Path) -> None:
         assert "error" in text.lower() or "invalid value" in text.lower(), text
     elif case.expect == "accept":
         assert res.exit_code == 0, text
+    elif case.expect == "fail":  # a check that finds what it checks wrong (verify of a falsified folder): exit 1, said
+        assert res.exit_code == 1, text
     else:
         assert res.exit_code in (0, 2), text
     for s in case.says:
         assert s in text, f"{s!r} not in: {text}"
-    assert list(cwd.iterdir()) == [] or case.expect == "accept", sorted(p.name for p in cwd.iterdir())
+    assert list(cwd.iterdir()) == [] or case.expect in ("accept", "fail"), sorted(p.name for p in cwd.iterdir())
 
 
 def build_cases(root: Path) -> list[Case]:

@@ -297,9 +297,12 @@ def read_bench(folder: Path) -> dict:
     if meta["numbering"] not in NUMBERINGS:
         raise ScenarioError(str(f), "numbering", f"{bad}: {unknown_numbering(meta['numbering'])}")
     try:
-        suite_named(meta["suite"])
+        suite = suite_named(meta["suite"])
     except ScenarioError as exc:
         raise ScenarioError(str(f), "suite", exc.message) from None
+    if meta["split"] not in suite.splits:
+        raise ScenarioError(str(f), "split", f"{bad}: {suite.name} has no split {meta['split']!r}; its splits: "
+                            f"{', '.join(suite.splits)}")
     return meta
 
 
@@ -313,6 +316,10 @@ def check_bench_out(out: Path) -> None:
     (its floors are its own), for then one folder would mix two kinds of rows and ``verify``
     check one of them. A :class:`ScenarioError` for ``--out``."""
     out = Path(out)
+    for p in Path(os.path.abspath(out)).parents:
+        if (p / BENCH_FILE).is_file():
+            raise ScenarioError("<command line>", "--out", f"{out} lies inside the bench folder {p}: give the bench run a "
+                                "folder of its own")
     if (out / BENCH_FILE).exists() and not (out / BENCH_FILE).is_file():
         raise ScenarioError("<command line>", "--out", f"{out / BENCH_FILE} is not a file; give another folder")
     if not is_bench(out):
@@ -321,10 +328,6 @@ def check_bench_out(out: Path) -> None:
             raise ScenarioError("<command line>", "--out", f"{out} is a results folder of `semsearch run` (it holds "
                                 f"{plain[0]}): a bench folder and a plain results folder never share a folder; give the "
                                 "bench run a folder of its own")
-    for p in Path(os.path.abspath(out)).parents:
-        if (p / BENCH_FILE).is_file():
-            raise ScenarioError("<command line>", "--out", f"{out} lies inside the bench folder {p}: give the bench run a "
-                                "folder of its own")
 
 
 def verify_bench(folder: str | Path, salt_file: str | Path | None = None, workers: int = 1,
@@ -366,7 +369,11 @@ def verify_bench(folder: str | Path, salt_file: str | Path | None = None, worker
             rows = read_runs(folder / f.id / "runs.csv", as_written=True)
             own = rows[rows["stage"] == ""]
             loaded = Loaded.load(materialise(sp, f, meta["numbering"], Path(tmp) / f.id), planners=False)
-            v = verify_folder(folder / f.id, loaded, progress, workers)  # every run recorded: none may lack its record
+            try:
+                v = verify_folder(folder / f.id, loaded, progress, workers)  # every run recorded: none may lack its record
+            except ScenarioError as exc:  # rows of another floor's scenario, none at all: this floor fails, said so
+                verdicts[f.id] = Verdict(runs=max(len(own), 1), failed=[("its rows", exc.message)])
+                continue
             for col, want, what in (("suite_hash", sp.hash, "another suite hash"), ("floor", f.id, "another floor"),
                                     ("numbering", meta["numbering"], "another numbering than bench.json's")):
                 bad = own[col].astype(str) != want if col in own.columns else pd.Series(True, index=own.index)
