@@ -552,3 +552,95 @@ def test_a_gain_within_float_noise_is_shown_as_zero(tmp_path, monkeypatch):
     assert [float(y) for y in ax.collections[0].get_offsets()[:, 1]] == [0.0, 0.0, 0.0]
     assert "gain +0.000 on every one of 3 floors" in ax.get_title()  # under the title, over no point
     plt.close(seen[0])
+
+
+# -- a falsified bench folder, folders that share runs, damaged files (issue 52) --------------------
+
+@pytest.fixture(scope="module")
+def bench_two(tmp_path_factory):
+    """A real bench folder (doors-v1 val, greedy, --limit 2; tests/hostile_bench_surface.make_bench)."""
+    from tests.hostile_bench_surface import make_bench
+    return make_bench(tmp_path_factory.mktemp("bench_two"))
+
+
+def _copy(src, tmp_path, name="b"):
+    shutil.copytree(src, tmp_path / name)
+    return tmp_path / name
+
+
+def test_the_board_refuses_the_same_runs_twice_naming_both_folders(bench_two, tmp_path):
+    b = _copy(bench_two, tmp_path)
+    c = _copy(bench_two, tmp_path, "copy")
+    for folders, says in (([b, b], [str(b), "given again"]), ([b, c], [str(b), str(c), "counts each run once"])):
+        res = runner.invoke(app, ["bench", "board", *map(str, folders), "--out", str(tmp_path / "site")])
+        text = " ".join(res.output.split())
+        assert res.exit_code == 2 and "Traceback" not in text and all(s in text for s in says), text
+    assert not (tmp_path / "site" / "board.md").exists()
+    assert runner.invoke(app, ["bench", "board", str(b), "--out", str(tmp_path / "site")]).exit_code == 0
+
+
+@pytest.mark.parametrize("name, text, says", [
+    ("bench.json without its hash", lambda m: json.dumps({k: v for k, v in m.items() if k != "hash"}), "bench.json, field 'hash'"),
+    ("bench.json a list", lambda m: "[1]", "a JSON list, not an object"),
+    ("bench.json not JSON", lambda m: "{", "not a bench.json semsearch wrote"),
+    ("verify.json a list", "[1]", "verify.json"),
+    ("verify.json not JSON", "{", "verify.json"),
+])
+def test_a_malformed_bench_or_verify_json_is_one_error_naming_it(bench_two, tmp_path, name, text, says):
+    b = _copy(bench_two, tmp_path)
+    if name.startswith("bench.json"):
+        (b / "bench.json").write_text(text(json.loads((b / "bench.json").read_text())))
+    else:
+        (b / "verify.json").write_text(text)
+    res = runner.invoke(app, ["bench", "board", str(b), "--out", str(tmp_path / "site")])
+    assert res.exception is None or isinstance(res.exception, SystemExit)
+    assert res.exit_code == 2 and says in " ".join(res.output.split()) and str(b) in res.output, res.output
+
+
+def test_verify_of_a_bench_folder_without_its_split_or_its_floor(bench_two, tmp_path):
+    b = _copy(bench_two, tmp_path)
+    meta = json.loads((b / "bench.json").read_text())
+    (b / "bench.json").write_text(json.dumps({k: v for k, v in meta.items() if k != "split"}))
+    res = runner.invoke(app, ["verify", str(b), "--workers", "1"])
+    assert res.exit_code == 2 and "bench.json, field 'split'" in " ".join(res.output.split()), res.output
+    (b / "bench.json").write_text(json.dumps(meta))
+    shutil.rmtree(b / "f000")  # the floor that holds the rows, taken away
+    res = runner.invoke(app, ["verify", str(b), "--workers", "1"])
+    assert res.exit_code == 1 and "floor f000: its rows: are gone: bench.json says floor f000 holds 2 run(s)" in \
+        " ".join(res.output.split()), res.output
+
+
+def test_a_bench_folder_and_a_plain_folder_never_share_an_out(bench_two, tmp_path):
+    from tests.hostile_bench_surface import make_results
+    plain, scenario = make_results(tmp_path / "plain")
+    res = runner.invoke(app, ["bench", "run", "doors-v1", "--planner", "greedy", "--limit", "1", "--workers", "1",
+                              "--out", str(plain)])
+    assert res.exit_code == 2 and "never share a folder" in " ".join(res.output.split()), res.output
+    assert not (plain / "bench.json").exists() and not (plain / "f000").exists()
+    b = _copy(bench_two, tmp_path)
+    for out in (b, b / "f000"):
+        res = runner.invoke(app, ["run", str(scenario), "--workers", "1", "--out", str(out)])
+        assert res.exit_code == 2 and "never share a folder" in " ".join(res.output.split()), res.output
+    assert not (b / "runs.csv").exists()
+    assert api.verify(b, workers=1).verdict.failed == []  # the bench folder as it was
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+def test_a_salt_file_that_is_a_fifo_a_folder_or_huge_is_refused_without_reading_it(tmp_path):
+    import signal
+    fifo = tmp_path / "salt.fifo"
+    os.mkfifo(fifo)
+    huge = tmp_path / "salt.huge"
+    huge.write_text("s" * 100_000)
+
+    def hang(signum, frame):
+        raise TimeoutError("the salt file blocked")
+    old = signal.signal(signal.SIGALRM, hang)
+    signal.alarm(20)
+    try:
+        for f, says in ((fifo, "is a FIFO, not a regular file"), (tmp_path, "is a folder"), (huge, "100,000 bytes")):
+            res = runner.invoke(app, ["bench", "hash", "doors-v1", "--split", "test", "--salt-file", str(f)])
+            assert res.exit_code == 2 and says in " ".join(res.output.split()), res.output
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)

@@ -178,3 +178,108 @@ def test_an_environment_answers_the_batchs_decision_points(recorded):
         assert info["distance_m"] == pytest.approx(row["distance_m"], abs=1e-3)
         checked += 1
     assert checked >= 2
+
+
+# -- verify checks the folder, not only the runs that kept a record (issue 52) ---------------------
+
+@pytest.fixture(scope="module")
+def two_runs(tmp_path_factory):
+    """A real results folder of ``semsearch run --decisions``: greedy on the demo building, goals
+    304 and 452, one repeat each (tests/hostile_bench_surface.make_results, ~2 s), and its scenario."""
+    from tests.hostile_bench_surface import make_results
+    return make_results(tmp_path_factory.mktemp("two_runs"))
+
+
+def _tampered(two_runs, tmp_path, change):
+    folder = tmp_path / "r"
+    shutil.copytree(two_runs[0], folder)
+    change(folder)
+    return folder
+
+
+def _edit(folder, edit):
+    f = folder / "runs.csv"
+    edit(pd.read_csv(f, dtype=str, keep_default_na=False)).to_csv(f, index=False)
+
+
+def _cell(col, value):
+    def edit(r):
+        r.loc[0, col] = value
+        return r
+    return lambda d: _edit(d, edit)
+
+
+RUN0 = "greedy__goal304__ep0__seed0.json"
+TAMPERED = {  # each tampering -> what the verdict names (the first run is greedy goal 304 episode 0 seed 0)
+    "a record deleted": (lambda d: (d / "decisions" / RUN0).unlink(), "which the row names (decisions_sha256), is gone"),
+    "a record replaced by a folder": (lambda d: ((d / "decisions" / RUN0).unlink(), (d / "decisions" / RUN0).mkdir()),
+                                      "is not a file"),
+    "a row's seed edited": (_cell("seed", "5"), "a record without its row"),
+    "a row added": (lambda d: _edit(d, lambda r: pd.concat([r, r.iloc[[0]].assign(seed="2")], ignore_index=True)),
+                    "seed 2: its record"),
+    "a row duplicated": (lambda d: _edit(d, lambda r: pd.concat([r, r.iloc[[0]]], ignore_index=True)), "appears 2 times"),
+    "a row deleted": (lambda d: _edit(d, lambda r: r.iloc[1:]), "a record without its row"),
+    "5.0 m and its record deleted": (lambda d: (_cell("distance_m", "5.0")(d), (d / "decisions" / RUN0).unlink()), "is gone"),
+    "a row of no episode": (_cell("episode", "7"), "no episode 7 of goal 304"),
+    "a record of the other run": (lambda d: (shutil.copyfile(d / "decisions" / "greedy__goal452__ep1__seed0.json",
+                                                             d / "decisions" / RUN0), _cell("decisions_sha256", "")(d)),
+                                  "records another run (greedy goal 452 episode 1 seed 0)"),
+}
+
+
+@pytest.mark.parametrize("tampering", list(TAMPERED))
+def test_a_falsified_folder_does_not_verify(two_runs, tmp_path, tampering):
+    change, says = TAMPERED[tampering]
+    folder = _tampered(two_runs, tmp_path, change)
+    v = api.verify(folder, two_runs[1], workers=1).verdict
+    assert v.failed and any(says in f"{name}: {why}" for name, why in v.failed), v.failed
+
+
+def test_verify_exits_1_naming_a_run_whose_record_was_taken_away(two_runs, tmp_path):
+    folder = _tampered(two_runs, tmp_path, lambda d: (d / "decisions" / RUN0).unlink())
+    res = CliRunner().invoke(app, ["verify", str(folder), "--scenario", str(two_runs[1]), "--workers", "1"])
+    assert res.exit_code == 1, res.output
+    assert "does not replay: greedy goal 304 episode 0 seed 0: its record" in " ".join(res.output.split())
+
+
+def test_rows_recorded_with_decisions_name_their_record_and_allow_unrecorded_counts_the_rest(two_runs, tmp_path):
+    import hashlib
+    rows = pd.read_csv(two_runs[0] / "runs.csv", dtype=str)
+    files = sorted((two_runs[0] / "decisions").glob("*.json"))
+    assert sorted(rows["decisions_sha256"]) == sorted(hashlib.sha256(f.read_bytes()).hexdigest() for f in files)
+    # a folder recorded partly without --decisions: a row without a record, naming none
+    folder = _tampered(two_runs, tmp_path, lambda d: ((d / "decisions" / RUN0).unlink(), _cell("decisions_sha256", "")(d)))
+    strict = api.verify(folder, two_runs[1], workers=1).verdict
+    assert [n for n, _ in strict.failed] == ["greedy goal 304 episode 0 seed 0"]
+    loose = api.verify(folder, two_runs[1], workers=1, allow_unrecorded=True).verdict
+    assert (loose.failed, loose.unrecorded, loose.verified) == ([], 1, 1)
+    res = CliRunner().invoke(app, ["verify", str(folder), "--scenario", str(two_runs[1]), "--workers", "1", "--allow-unrecorded"])
+    assert res.exit_code == 0 and "1 without decisions not checked" in res.output
+    _cell("distance_m", "5.0")(folder)  # and it claims less than the shortest path (11.7 m): no run does that
+    loose = api.verify(folder, two_runs[1], workers=1, allow_unrecorded=True).verdict
+    assert "below its episode's shortest path" in loose.failed[0][1]
+
+
+def test_an_honest_folder_with_error_rows_verifies(tmp_path):
+    """A planner that raises leaves error rows and no record (the run did not finish): they are
+    counted, and the folder verifies."""
+    src = TASKS["doors"].example(tmp_path / "s", "greedy")
+    (src.parent / "boom.py").write_text(textwrap.dedent('''
+        from semsearch_cli.planners import DoorPlanner, register_planner
+
+        @register_planner("verify_boom")
+        class Boom(DoorPlanner):
+            """Raises at its first decision."""
+            def choose(self, ctx, cands):
+                raise RuntimeError("boom")
+    '''))
+    src.write_text(src.read_text().replace("name: greedy", "name: greedy\n- name: verify_boom\n  module: boom.py"))
+    out = tmp_path / "r"
+    res = CliRunner().invoke(app, ["run", str(src), "--seeds", "1", "--workers", "1", "--decisions", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    rows = pd.read_csv(out / "runs.csv")
+    assert set(rows.loc[rows["planner"] == "verify_boom", "outcome"]) == {"error"}
+    res = CliRunner().invoke(app, ["verify", str(out), "--workers", "1"])
+    assert res.exit_code == 0, res.output
+    n = int((rows["planner"] == "verify_boom").sum())
+    assert f"{n} error or timeout run(s) not replayed" in " ".join(res.output.split())
