@@ -32,7 +32,8 @@ import numpy as np
 
 from ..config.base import sign_label
 from ..geometry import GridFrame
-from ..errors import BudgetSpent, PlannerError, ScenarioError
+from ..errors import BudgetSpent, MissingExtra, PlannerError, ScenarioError
+from ..optional import lazy_module
 from ..planners import Variant
 from ..runner.specs import Loaded
 from ..tasks.base import RobotState
@@ -43,7 +44,36 @@ from .robot import (BASE_FRAMES, MAX_COORD, MAX_MAP_CELLS, POSE_TOPICS, GoalWrit
                     map_frame, refusal)
 
 
+mcap_stream = lazy_module("mcap.stream_reader", "ros")  # optional: the ros extra
+mcap_records = lazy_module("mcap.records", "ros")
+
 MAX_MESSAGE_BYTES = 64 << 20  # one message of a bag: a map of MAX_MAP_CELLS int8 cells is 25 MB
+MAX_RECORD_BYTES = 1 << 30  # one MCAP record (a chunk of messages, decompressed): what a bag may claim
+
+
+def check_mcap(f: Path) -> None:
+    """Read an MCAP file through once, checked: its checksums where it has them (rosbags writes
+    none), and its messages counted against its statistics record. rosbags reads a damaged chunk
+    without a word, the messages after the damage lost; a ScenarioError names the file. A record
+    claiming more than :data:`MAX_RECORD_BYTES` is refused before it is read."""
+    counts: dict = {}
+    stats = None
+    try:
+        with f.open("rb") as fh:
+            for rec in mcap_stream.StreamReader(fh, validate_crcs=True, record_size_limit=MAX_RECORD_BYTES).records:
+                if isinstance(rec, mcap_records.Message):
+                    counts[rec.channel_id] = counts.get(rec.channel_id, 0) + 1
+                elif isinstance(rec, mcap_records.Statistics):
+                    stats = rec
+    except MissingExtra:
+        raise
+    except Exception as exc:  # noqa: BLE001  the mcap library's errors (CRC, a truncated record, zstd's): the bag named
+        raise ScenarioError(str(f), "", f"is damaged: {type(exc).__name__}: {str(exc)[:160]} (the MCAP file's checks fail; "
+                            "record the bag again, or copy it from where it was recorded)") from None
+    if stats is not None and stats.channel_message_counts and {k: v for k, v in stats.channel_message_counts.items() if v} != counts:
+        raise ScenarioError(str(f), "", f"is damaged: its chunks hold {sum(counts.values()):,} messages, its statistics count "
+                            f"{stats.message_count:,} (a chunk that does not decompress whole; record the bag again, or copy "
+                            "it from where it was recorded)")
 
 
 class BagStream:
@@ -57,6 +87,8 @@ class BagStream:
             self.reader.open()
         except Exception as exc:  # noqa: BLE001  not a bag rosbags reads: named, never a traceback
             raise ScenarioError(str(path), "", f"is not a ROS 2 bag folder rosbags can read ({type(exc).__name__}: {exc})") from None
+        for f in sorted(self.path.glob("*.mcap")):
+            check_mcap(f)
         self.topics = {c.topic for c in self.reader.connections}
         conns = [c for c in self.reader.connections if c.topic in only] if only else None  # only these topics decoded
         self._it = self.reader.messages(connections=conns) if conns is not None else self.reader.messages()

@@ -319,10 +319,13 @@ class TfTree:
 
 
 def detection_label(data: str):
-    """The label of a detection (``std_msgs/String`` JSON ``{"label": ...}``), or None for a
-    message that is not one."""
+    """The label of a detection (``std_msgs/String`` JSON ``{"label": ...}``, the label a number or
+    text), or None for a message that is not one."""
     try:
-        return sign_label(json.loads(data)["label"])
+        label = json.loads(data)["label"]
+        if isinstance(label, bool) or not isinstance(label, (int, float, str)):
+            return None  # null, true, a list: what a detector writes for a sign it did not read
+        return sign_label(label)
     except (ValueError, KeyError, TypeError, IndexError, RecursionError):  # not JSON, not an object, not a label
         return None
 
