@@ -1,15 +1,18 @@
 """Hostile inputs, as a user would meet them: every case of a catalogue run as a real ``semsearch``
 process with a time limit and a cap on its memory, classified, and tabulated by category. The
 catalogues: ``issue14`` (``tests/hostile_inputs.py``, the first reviews), ``release`` (``tests/
-hostile_release.py``, the surfaces the last release added, issue 35: its categories are labels,
-episodes, output, frames, planners, commands) or ``all`` (both; the release's categories are then
-shown as ``release: <category>``, apart from the first catalogue's of the same name).
+hostile_release.py``, the surfaces the release before added, issue 35: its categories are labels,
+episodes, output, frames, planners, commands), ``surfaces`` (``tests/hostile_surfaces.py``, issue
+52: the robot, bench and llm surfaces, categories shown as ``robot: live``) or ``all`` (every one;
+the release's categories are then shown as ``release: <category>``, apart from the first
+catalogue's of the same name).
 
 Usage:
-  python benchmarks/hostile.py [--catalogue {issue14,release,all}] [--timeout 120] [--jobs 2]
+  python benchmarks/hostile.py [--catalogue {issue14,release,surfaces,all}] [--timeout 120] [--jobs 2]
                                [--memory 4] [--only CATEGORY] [--md FILE] [--csv FILE]
 
-Outcomes: ``refused`` (exit 2, no traceback), ``accepted`` (exit 0), ``traceback`` (a Python
+Outcomes: ``refused`` (exit 2, no traceback), ``accepted`` (exit 0), ``failed`` (exit 1 of a case
+that expects it: a verify that finds a falsified folder), ``traceback`` (a Python
 traceback on stderr, whatever the status), ``other`` (another status) and ``hang`` (killed at the
 time limit); ``warnings`` counts cases that printed a numpy, OpenCV or libpng warning (a defect:
 the user should see one paragraph). A case accepted where it should be refused is ``garbage accepted``; one refused
@@ -39,11 +42,12 @@ import pandas as pd
 from output import emit
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests import hostile_inputs, hostile_release  # noqa: E402
+from tests import hostile_inputs, hostile_release, hostile_surfaces  # noqa: E402
 
 from semsearch_cli.report.document import markdown_table  # noqa: E402
 
-CATALOGUES = {"issue14": hostile_inputs.build_cases, "release": hostile_release.build_cases}
+CATALOGUES = {"issue14": hostile_inputs.build_cases, "release": hostile_release.build_cases,
+              "surfaces": hostile_surfaces.build_cases}
 
 
 def cli(memory_gb: float) -> list[str]:
@@ -63,17 +67,18 @@ def run_case(case, timeout: float, cwd: Path, memory_gb: float = 4.0, category: 
         out, err = p.communicate(timeout=timeout)
         status = p.returncode
         outcome = ("traceback" if "Traceback (most recent call last)" in err else
-                   "refused" if status == 2 else "accepted" if status == 0 else "other")
+                   "refused" if status == 2 else "accepted" if status == 0 else
+                   "failed" if status == 1 and case.expect == "fail" else "other")
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         p.communicate()
         status, err, outcome = None, "", "hang"
     defect = outcome in ("traceback", "other", "hang") or (case.expect == "refuse" and outcome == "accepted") \
-        or (case.expect == "accept" and outcome == "refused")
+        or (case.expect == "accept" and outcome == "refused") or (case.expect == "fail" and outcome != "failed")
     lines = [ln for ln in err.strip().splitlines() if ln.strip()]
     warned = any(w in ln for ln in lines for w in ("Warning:", "[ WARN", "libpng", "RuntimeWarning"))
     said = " ".join((out + " " + err).split())  # the console wraps long lines
-    unsaid = [s for s in case.says if s not in said] if outcome in ("refused", "accepted") else []
+    unsaid = [s for s in case.says if s not in said] if outcome in ("refused", "accepted", "failed") else []
     seconds = time.perf_counter() - t0
     within = getattr(case, "within", None)  # a refusal that must come before any work (a release case)
     slow = within is not None and seconds > within
@@ -91,8 +96,9 @@ def run_case(case, timeout: float, cwd: Path, memory_gb: float = 4.0, category: 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--catalogue", choices=["issue14", "release", "all"], default="all",
-                    help="tests/hostile_inputs.py (issue14), tests/hostile_release.py (release) or both")
+    ap.add_argument("--catalogue", choices=["issue14", "release", "surfaces", "all"], default="all",
+                    help="tests/hostile_inputs.py (issue14), tests/hostile_release.py (release), tests/hostile_surfaces.py "
+                    "(surfaces: the robot, bench and llm surfaces of issue 52) or all three")
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--memory", type=float, default=4.0, help="GB of address space each case's process may take")
@@ -120,6 +126,7 @@ def main() -> int:
     table = df.groupby("category", sort=False).agg(
         tried=("case", "size"), refused=("outcome", lambda s: int((s == "refused").sum())),
         accepted=("outcome", lambda s: int((s == "accepted").sum())),
+        failed=("outcome", lambda s: int((s == "failed").sum())),
         traceback=("outcome", lambda s: int((s == "traceback").sum())),
         hang=("outcome", lambda s: int((s == "hang").sum())), other=("outcome", lambda s: int((s == "other").sum())),
         warnings=("warned", "sum"),
