@@ -300,9 +300,9 @@ def _array(desc: str, v, count: int, where: str) -> np.ndarray:
     if desc in _FLOATS:
         return a.astype(desc)
     lo, hi = _INTS[desc] if desc in _INTS else (None, None)
-    if lo is None or not (np.all(np.isfinite(a)) and np.all(a == np.round(a)) and (not len(a) or (a.min() >= lo and a.max() <= hi))):
+    if lo is None or a.dtype.kind == "f" or (len(a) and (a.min() < lo or a.max() > hi)):
         raise ValueError(f"{where} holds a value that is not a {desc}")
-    return np.asarray(v, desc)
+    return a.astype(desc)
 
 
 def from_json(ts, msgtype: str, d: dict, where: str = ""):

@@ -33,6 +33,7 @@ import math
 import queue
 import shutil
 import socket
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -160,6 +161,9 @@ class Live:
         self.aborts = 0
         self.clipped = False
         self.dropped_early: Counter = Counter()  # messages dropped before the first map made the session
+        self.maps_waiting = 0  # maps in the queue (a newer one supersedes the one taken: _superseded)
+        self.superseded = 0  # maps skipped for a newer one
+        self._maps_lock = threading.Lock()
 
     # -- the connection ---------------------------------------------------------------
     def run(self) -> LiveRun:
@@ -194,7 +198,7 @@ class Live:
         subs = []
         for t, kind in INPUTS.items():
             sub = roslibpy.Topic(ros, t, kind)
-            sub.subscribe(lambda msg, t=t: self.q.put((t, msg)))
+            sub.subscribe(self._enqueue if t == MAP else (lambda msg, t=t: self.q.put((t, msg))))
             subs.append(sub)
         ros.on("close", lambda *_: self.q.put(("closed", None)))
         self.repro = _Repro(self.repro_path, self.m)
@@ -222,6 +226,19 @@ class Live:
                 else:
                     res.repro = kept
         return res
+
+    def _enqueue(self, msg) -> None:
+        """A map in, on roslibpy's thread: counted, so that the loop folds only the newest of the
+        maps waiting (each map is folded whole: a newer one makes an older one moot)."""
+        with self._maps_lock:
+            self.maps_waiting += 1
+        self.q.put((MAP, msg))
+
+    def _superseded(self) -> bool:
+        """Whether a newer map waits behind the one taken now (then it is skipped, not folded)."""
+        with self._maps_lock:
+            self.maps_waiting = max(0, self.maps_waiting - 1)
+            return self.maps_waiting > 0
 
     def _publish(self, topic: str, t_ns: int, msg) -> None:
         """A decision's message out to the robot, and into the repro bag (``ros replay`` reads only
@@ -284,6 +301,9 @@ class Live:
                 return self._result("stuck", f"the robot gave up on {ABORTS} goals in a row")
             topic, msg = GOAL_STATUS, goal_ended(self.m, k, status)
         else:
+            if topic == MAP and self._superseded():
+                self.superseded += 1  # not taken, not in the repro bag: the replay folds the maps this run folded
+                return None
             try:
                 msg = from_json(self.m.ts, INPUTS[topic], payload)
             except (ValueError, TypeError, RecursionError) as exc:  # not a message of its type: dropped, counted
@@ -381,8 +401,9 @@ class Live:
         if s is None:
             early = "; ".join(f"{n} {topic} ({why})" for (topic, why), n in self.dropped_early.items())
             return LiveRun(outcome, 0.0, 0, [], len(self._goal_ids), message, dropped=early)
+        skipped = f"{self.superseded} /map skipped for a newer one waiting" if self.superseded else ""
         return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, len(self._goal_ids), message,
-                       dropped=s.dropped_text())
+                       dropped="; ".join(filter(None, (s.dropped_text(), skipped))))
 
 
 def _status(res) -> int:
