@@ -11,8 +11,9 @@ or half an IPv6 bracket, credentials in it, a margin of 1e6 m, no server listeni
 any connection is kept).
 
 Each robot bag is a 6 m x 4 m walled room mapped at 0.1 m, a robot driving across it and reading
-the goal's sign at the far wall; a hostile message is put in the middle of it. Every case is fast
-(a replay of a small bag takes a fraction of a second); they are each written in both bag formats.
+the goal's sign at the far wall; a hostile message is put in the middle of it, in both bag formats
+(the MCAP ones run in CI, the SQLite 3 copies in ``benchmarks/hostile.py``). The other cases are
+fast: each is refused before any work, or replays a small bag in a fraction of a second.
 """
 
 from __future__ import annotations
@@ -204,7 +205,7 @@ def build_cases(root: Path) -> list[ReleaseCase]:
         for i, (name, hostile, says) in enumerate(hostile_messages()):
             bag = write_bag(root / "robot" / fmt / f"bag{i}", fmt, robot_messages(hostile))
             add("robot messages", f"{name} ({fmt})", [*replay, bag, "--planner", "greedy", "--goal", GOAL, "--out", out_dir()],
-                "accept", ["the goal was read in the bag", *says])
+                "accept", ["the goal was read in the bag", *says], fast=fmt == "mcap")  # SQLite's copies: the benchmark's
 
     # -- damaged bags ------------------------------------------------------------------------------
     good = write_bag(root / "damaged" / "good", "mcap", robot_messages([]))
