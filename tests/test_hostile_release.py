@@ -78,9 +78,9 @@ def guarded():
                 del sys.modules[name]
 
 
-@pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="the address-space guard reads /proc")
-@pytest.mark.parametrize("case", CASES, ids=[f"{c.category}: {c.name}" for c in CASES])
-def test_hostile_input(case, tmp_path):
+def run_guarded(case, tmp_path: Path) -> None:
+    """Run a case's command in-process, in the empty folder ``tmp_path``, under :func:`guarded`,
+    and check its outcome (tests/hostile_inputs.check_outcome)."""
     os.chdir(tmp_path)  # the working folder: nothing may be written here
     try:
         with guarded():
@@ -88,3 +88,9 @@ def test_hostile_input(case, tmp_path):
     finally:
         os.chdir(Path(__file__).resolve().parents[1])
     check_outcome(case, res, tmp_path)
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="the address-space guard reads /proc")
+@pytest.mark.parametrize("case", CASES, ids=[f"{c.category}: {c.name}" for c in CASES])
+def test_hostile_input(case, tmp_path):
+    run_guarded(case, tmp_path)

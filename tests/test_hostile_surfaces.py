@@ -7,25 +7,18 @@ surfaces`` runs every case as a real process."""
 
 from __future__ import annotations
 
-import os
 import tempfile
 from pathlib import Path
 
 import pytest
 
 pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed: the robot surface's bags need it")
-from typer.testing import CliRunner  # noqa: E402
-
-from semsearch_cli.cli import app  # noqa: E402
-
-from .hostile_inputs import check_outcome  # noqa: E402
 from .hostile_surfaces import CLASSES, build_cases  # noqa: E402
-from .test_hostile_release import guarded  # noqa: E402
+from .test_hostile_release import run_guarded  # noqa: E402
 
 _TMP = tempfile.TemporaryDirectory(prefix="semsearch-hostile-surfaces-")
 ALL = build_cases(Path(_TMP.name) / "cases")
 CASES = [c for c in ALL if c.fast]
-runner = CliRunner()
 
 
 def test_the_catalogue_covers_every_class_with_at_least_150_cases():
@@ -41,10 +34,4 @@ def test_the_catalogue_covers_every_class_with_at_least_150_cases():
 @pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="the address-space guard reads /proc")
 @pytest.mark.parametrize("case", CASES, ids=[f"{c.category}: {c.name}" for c in CASES])
 def test_hostile_input(case, tmp_path):
-    os.chdir(tmp_path)  # the working folder: nothing may be written here
-    try:
-        with guarded():
-            res = runner.invoke(app, case.args)
-    finally:
-        os.chdir(Path(__file__).resolve().parents[1])
-    check_outcome(case, res, tmp_path)
+    run_guarded(case, tmp_path)
