@@ -217,7 +217,8 @@ def views_needed(p_read: float, miss: float = 0.01, cap: int = 20) -> int:
         return 1
     if p_read <= 0.0:
         return cap
-    return int(min(cap, max(1, np.ceil(np.log(miss) / np.log1p(-p_read)))))
+    # less a hair: where the ratio is a whole number (0.99 -> exactly 1), log1p's last bit differs by numpy version
+    return int(min(cap, max(1, np.ceil(np.log(miss) / np.log1p(-p_read) - 1e-9))))
 
 
 class DoorSearch(DoorSensing):
