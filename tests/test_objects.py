@@ -141,7 +141,7 @@ def test_a_recorded_log_replays_like_its_timeline(office, tmp_path):
     (lambda d: d["objects"]["cases"][0].update(record=["Tuesday"]), "objects.cases[0].record", "unknown timeline"),
     (lambda d: d["objects"]["places"][0].update(x=-5.0), "objects.places[0]", "outside the map"),
     (lambda d: d["objects"]["requests"][0].update(hour=25), "objects.requests[0].hour", "less than 24"),
-    (lambda d: d["planners"].append({"name": "lsos", "radius": -1}), "planners[3].radius", "greater than 0"),
+    (lambda d: d["planners"].append({"name": "lsos", "radius": -1}), "planners[3].radius", "radius must be more than 0"),
     (lambda d: d["objects"]["camera"].update(p_detect={"distances": [1, 2], "p": [[0.5]]}), "objects.camera.p_detect",
      "p must have 1 row(s) (one per angle) of 2 values"),
 ])

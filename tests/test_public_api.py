@@ -40,7 +40,7 @@ API = {
     "scenarios": [],
     "default_out": ["loaded", "out"],
     "init": ["name", "folder", "force"],
-    "verify": ["folder", "scenario", "progress", "workers", "salt_file"],
+    "verify": ["folder", "scenario", "progress", "workers", "salt_file", "allow_unrecorded"],
     "export": ["folder", "out", "fmt", "run", "scenario", "kept"],
     "ros_replay": ["bag", "planner", "out", "scenario", "fmt", "planner_file", "goal", "margin"],
     "ros_live": ["rosbridge", "planner", "goal", "scenario", "publish_only", "repro", "margin", "max_distance", "planner_file",
