@@ -40,8 +40,8 @@ from ..tasks.base import RobotState
 from ..tasks.decisions import set_rng
 from ..tasks.doors import DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
-from .robot import (BASE_FRAMES, MAX_COORD, MAX_MAP_CELLS, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree, drive,
-                    map_frame, refusal)
+from .robot import (BASE_FRAMES, MAX_MAP_CELLS, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree, drive,
+                    map_frame, refusal, within)
 
 
 mcap_stream = lazy_module("mcap.stream_reader", "ros")  # optional: the ros extra
@@ -378,7 +378,7 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
                 session.drop(topic, why)
                 continue
             pose = next(filter(None, map(tf.pose, BASE_FRAMES)), None) if tf.add(msg) & set(BASE_FRAMES) else None
-            what = "plan" if pose is not None and _finite_pose(pose) and session.pose(*pose) else None
+            what = "plan" if pose is not None and within(*pose[:2]) and math.isfinite(pose[2]) and session.pose(*pose) else None
         else:
             what = session.take(topic, msg)
         if what == "found":
@@ -387,9 +387,3 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
             session.plan()
     return session.found, out.rows, session.dropped_text()
 
-
-def _finite_pose(pose) -> bool:
-    """A pose composed from /tf is within the bounds a pose message is held to (a chain of
-    transforms each within them can add up past them)."""
-    x, y, yaw = pose
-    return all(math.isfinite(v) for v in pose) and abs(x) <= MAX_COORD and abs(y) <= MAX_COORD

@@ -210,8 +210,15 @@ def fold_map(belief, msg) -> Folded:
     return Folded(not covered, True, odd)
 
 
-def _finite(*values, bound: float = MAX_COORD) -> bool:
+def within(*values, bound: float = MAX_COORD) -> bool:
+    """Every value finite and at most ``bound`` from 0 (coordinates: :data:`MAX_COORD` m)."""
     return all(math.isfinite(v) and abs(v) <= bound for v in values)
+
+
+def is_rotation(q) -> bool:
+    """A quaternion a yaw can be read from: finite, and not all zeros (its norm need not be 1)."""
+    quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+    return within(*quat, bound=1e6) and math.hypot(*quat) >= 1e-9
 
 
 def stamp_refusal(stamp) -> str:
@@ -232,11 +239,10 @@ def pose_refusal(msg) -> str:
         return why
     pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
     p, q = pose.position, pose.orientation
-    if not _finite(float(p.x), float(p.y)):
+    if not within(float(p.x), float(p.y)):
         return f"a pose at ({float(p.x):g}, {float(p.y):g}), not within {MAX_COORD:g} m"
-    quat = (float(q.x), float(q.y), float(q.z), float(q.w))
-    if not _finite(*quat, bound=1e6) or math.hypot(*quat) < 1e-9:
-        return f"a pose whose orientation {quat} is not a rotation"
+    if not is_rotation(q):
+        return f"a pose whose orientation {(float(q.x), float(q.y), float(q.z), float(q.w))} is not a rotation"
     return ""
 
 
@@ -261,9 +267,8 @@ def refusal(topic: str, msg) -> str:
         if len(msg.transforms) > MAX_LIST:
             return f"a TFMessage of {len(msg.transforms):,} transforms (at most {MAX_LIST:,})"
         for tr in msg.transforms:
-            t, q = tr.transform.translation, tr.transform.rotation
-            quat = (float(q.x), float(q.y), float(q.z), float(q.w))
-            if not _finite(float(t.x), float(t.y)) or not _finite(*quat, bound=1e6) or math.hypot(*quat) < 1e-9:
+            t = tr.transform.translation
+            if not within(float(t.x), float(t.y)) or not is_rotation(tr.transform.rotation):
                 return f"a transform to {tr.child_frame_id!r} that is not finite, within {MAX_COORD:g} m and a rotation"
     return ""
 
