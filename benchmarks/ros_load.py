@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+from array import array
 import multiprocessing as mp
 import signal
 import sys
@@ -93,9 +94,11 @@ class Timed(Live):
 
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
-        self.took: dict[str, list] = {}
-        self.queue: list[int] = []
-        self.replans: list[float] = []
+        # 8 bytes an entry (a list of floats holds 32), so that the benchmark's own records weigh
+        # little in the process's memory it measures
+        self.took: dict[str, array] = {}
+        self.queue = array("q")
+        self.replans = array("d")
 
     def _take(self, topic, payload):
         self.queue.append(self.q.qsize())
@@ -103,7 +106,7 @@ class Timed(Live):
         try:
             return super()._take(topic, payload)
         finally:
-            self.took.setdefault(topic, []).append(time.perf_counter() - t)
+            self.took.setdefault(topic, array("d")).append(time.perf_counter() - t)
 
     def _replan(self):
         t = time.perf_counter()

@@ -350,3 +350,23 @@ def test_fold_grid_takes_a_window_of_another_mapper_and_marks_what_changed():
     b.dirty[:] = (H, -1, W, -1)
     b.fold_grid(5, 6, seen, gone)  # nothing new: nothing dirty
     assert b.lost == 1 and b.dirty.tolist() == [H, -1, W, -1]
+
+
+def test_views_waiting_are_one_row_per_pose_and_fold_as_every_view():
+    """200 copies of one pose (a robot standing while its stack publishes) wait as one row; 100
+    poses that differ as 100 rows (the buffer grows past its first 64); the viewed counts after the
+    fold are those of a belief given the same poses with no two alike back to back."""
+    free = np.ones((40, 60), bool)
+    free[:, 0] = free[:, -1] = free[0] = free[-1] = False
+    a, b = make_belief(free), make_belief(free)
+    for _ in range(200):
+        a.add_view(20.0, 30.0, 0.0)
+    for k in range(100):
+        a.add_view(20.0, 10.0 + 0.4 * k, 0.5)
+        b.add_view(20.0, 10.0 + 0.4 * k, 0.5)
+    assert a._n_pending == 101
+    a.unread_walls(2.0, np.radians(30), 0.3, 3)
+    b.unread_walls(2.0, np.radians(30), 0.3, 3)
+    seen_from_the_standing_pose = a.viewed.astype(int) - b.viewed.astype(int)
+    assert seen_from_the_standing_pose.max() == 200 and seen_from_the_standing_pose.min() == 0
+    assert a._n_views == 300 and a._n_pending == 0

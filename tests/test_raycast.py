@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 
-from semsearch_cli.kernels.raycast import cast_ray, cast_rays, fold_free, himm_update, line_of_sight
+from semsearch_cli.kernels.raycast import cast_ray, cast_rays, fold_free, himm_update, line_of_sight, mark_viewed
 
 
 def slow_ray(occ, v0, u0, theta, max_cells, step=1e-4):
@@ -93,3 +93,31 @@ def test_fold_free_matches_refresh_over_the_box():
     cv[3, 2] = 9
     fold_free(free, seen, cv, 3, cells, 3, dirty)
     assert not free[3, 2] and dirty.tolist() == [1, 3, 1, 2]
+
+
+def _viewed(free, rows, first=0, viewed=None, stamp=None):
+    H, W = free.shape
+    viewed = np.zeros((H, W), np.uint8) if viewed is None else viewed
+    stamp = np.full((H, W), -1, np.int64) if stamp is None else stamp
+    mark_viewed(free, viewed, stamp, first, np.asarray(rows, np.float64).reshape(-1, 4), math.radians(30), 40.0)
+    return viewed, stamp
+
+
+def test_a_row_of_views_counts_as_that_many_views_one_after_the_other():
+    """A pose repeated back to back is one row with its count (the belief's buffer keeps a robot
+    that dwells, or publishes its pose at 200 Hz, at one row): the same viewed counts as one row
+    per view, saturating at 255, and later views still count once per view."""
+    rng = np.random.default_rng(5)
+    free = rng.random((60, 80)) > 0.08
+    poses = [(rng.uniform(5, 55), rng.uniform(5, 75), rng.uniform(-math.pi, math.pi)) for _ in range(12)]
+    times = [1, 3, 1, 7, 2, 300, 1, 1, 4, 9, 1, 2]
+    runs = [(*p, n) for p, n in zip(poses, times)]
+    one_by_one = [(*p, 1) for p, n in zip(poses, times) for _ in range(n)]
+    a, sa = _viewed(free, runs, first=10)
+    b, sb = _viewed(free, one_by_one, first=10)
+    assert a.max() == 255 and np.array_equal(a, b)
+    # the next fold numbers its views after all of those: it counts once per view, as it would have
+    later = [(*poses[5], 1), (*poses[5], 1)]
+    a2, _ = _viewed(free, [(*poses[5], 2)], first=10 + sum(times), viewed=a.copy(), stamp=sa)
+    b2, _ = _viewed(free, later, first=10 + len(one_by_one), viewed=b.copy(), stamp=sb)
+    assert np.array_equal(a2, b2)

@@ -162,7 +162,8 @@ class DoorBelief:
         self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
         self._cands = None
         self._seg_labels = None
-        self.views: list = []  # camera poses (v, u, heading) not yet folded into ``viewed``
+        self._views = np.empty((64, 4), np.float64)  # camera poses (v, u, heading, times) not yet folded into ``viewed``
+        self._n_pending = 0  # rows of ``_views`` in use: a pose repeated back to back is one row, counted
         self.viewed = None  # (H, W) uint8: how many poses a side camera looked at each free cell from (lazy)
         self.examined = None  # (H, W) bool: wall faces given up on after a look from close by (lazy)
         self._view_stamp = None  # (H, W) int64: the last pose that counted for each cell
@@ -171,6 +172,22 @@ class DoorBelief:
         self._joins = np.empty(0, np.int64)  # cells a search added to the skeleton band (flat indices)
 
     # ---- per-step updates -------------------------------------------------------------
+    def add_view(self, v: float, u: float, heading: float) -> None:
+        """A camera pose (continuous cell coordinates, radians), folded into ``viewed`` when wall
+        faces are next asked for (:meth:`unread_walls`). The same pose again, back to back (a robot
+        that dwells, or a robot stack publishing its pose at 200 Hz while it stands), is counted
+        on its row: 32 bytes for each pose that differs from the one before, not for each frame."""
+        n = self._n_pending
+        if n:
+            last = self._views[n - 1]
+            if last[0] == v and last[1] == u and last[2] == heading:
+                last[3] += 1.0
+                return
+        if n == len(self._views):
+            self._views = np.concatenate([self._views, np.empty_like(self._views)])
+        self._views[n] = (v, u, heading, 1.0)
+        self._n_pending = n + 1
+
     def fold_scan(self, v: float, u: float, thetas: np.ndarray, dist: np.ndarray, hit: np.ndarray) -> None:
         """Fold one laser scan from continuous cell position (v, u) into HIMM (``cv``, ``seen``),
         re-derive ``free`` where the scan changed it and grow the dirty box by those cells (what
@@ -379,11 +396,11 @@ class DoorBelief:
             self.viewed = np.zeros((H, W), np.uint8)
             self.examined = np.zeros((H, W), bool)
             self._view_stamp = np.full((H, W), -1, np.int64)
-        if self.views:
-            mark_viewed(self.free, self.viewed, self._view_stamp, self._n_views, np.array(self.views, np.float64),
-                        half_fov, cam_range / self.frame.res)
-            self._n_views += len(self.views)
-            self.views.clear()
+        if self._n_pending:
+            pending = self._views[:self._n_pending]
+            mark_viewed(self.free, self.viewed, self._view_stamp, self._n_views, pending, half_fov, cam_range / self.frame.res)
+            self._n_views += int(pending[:, 3].sum())
+            self._n_pending = 0
         rr, cc = np.nonzero(self.seen)
         if rr.size == 0:
             return _empty()

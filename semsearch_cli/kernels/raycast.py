@@ -234,15 +234,17 @@ def mark_viewed(free, viewed, stamp, first, views, half_fov, max_cells):
     """Count, for each view, the last free cell before the first cell that is not free along
     every ray of two side cameras: ``viewed`` (H, W) uint8 (saturating) is incremented in place,
     once per view and cell (``stamp`` (H, W) int64 holds the last view that counted, views being
-    numbered from ``first``).
+    numbered from ``first``). A row of ``views`` stands for ``times`` views from one pose, one after
+    the other: each cell it sees is incremented ``times`` (saturating), as that many rows would.
 
     Parameters
     ----------
     free : (H, W) bool
         Cells the camera sees through (a ray stops at the first other cell or at the grid's edge).
-    views : (n, 3) float64
-        Camera poses ``(v, u, heading)``: continuous cell coordinates and radians; the cameras look
-        along ``heading +- pi/2``, each over ``+-half_fov``.
+    views : (n, 4) float64
+        Camera poses ``(v, u, heading, times)``: continuous cell coordinates, radians and how many
+        views in a row were taken from that pose; the cameras look along ``heading +- pi/2``, each
+        over ``+-half_fov``.
     max_cells : float
         Camera range, cells. Rays are spaced so that neighbouring rays are at most half a cell
         apart at that range.
@@ -250,9 +252,10 @@ def mark_viewed(free, viewed, stamp, first, views, half_fov, max_cells):
     H, W = free.shape
     n_side = int(math.ceil(2.0 * half_fov * max_cells / 0.5)) + 1
     step = 2.0 * half_fov / max(1, n_side - 1)
+    vid = first - 1
     for k in range(views.shape[0]):
-        v0, u0, heading = views[k, 0], views[k, 1], views[k, 2]
-        vid = first + k
+        v0, u0, heading, times = views[k, 0], views[k, 1], views[k, 2], int(views[k, 3])
+        vid += times  # the last of the row's views: a number no other row has
         for side in (-1.0, 1.0):
             centre = heading + side * 0.5 * math.pi
             for j in range(n_side):
@@ -268,8 +271,7 @@ def mark_viewed(free, viewed, stamp, first, views, half_fov, max_cells):
                     if not free[r, c]:
                         if t > 0.0 and stamp[pr, pc] != vid:
                             stamp[pr, pc] = vid
-                            if viewed[pr, pc] < 255:
-                                viewed[pr, pc] += 1
+                            viewed[pr, pc] = min(255, int(viewed[pr, pc]) + times)
                         break
                     pr, pc = r, c
                     if tmr < tmc:

@@ -157,7 +157,7 @@ class ReplaySearch(DoorSearch):
         b, fr = st.belief, self.task.world.frame
         st.x, st.y, st.heading, st.steps = float(ev["x"]), float(ev["y"]), float(ev["heading"]), int(ev["step"])
         v, u, r, c = fr.point_to_cell(st.x, st.y)
-        b.views.append((v, u, st.heading))
+        b.add_view(v, u, st.heading)
         event = False
         for label in ev.get("reads", []):
             if b.reads.add(sign_label(label), r * fr.width + c, st.x, st.y, st.heading) == b.spec.min_reads:

@@ -465,6 +465,8 @@ class RobotSession:
             st.distance += moved
             self.since += moved
         st.steps += self.posed  # the first pose is step 0
+        if yaw == st.heading:  # one float for a heading that did not change: st.headings grows 8 bytes a pose, not 32
+            yaw = st.heading
         st.x, st.y, st.heading, self.posed = x, y, yaw, True
         v, u, r, c = fr.point_to_cell(x, y)
         self.inside = 0 <= r < fr.height and 0 <= c < fr.width
@@ -475,7 +477,7 @@ class RobotSession:
             if b.reads.add(label, r * fr.width + c, x, y, yaw) == b.spec.min_reads:
                 self.event = True
         self.pending.clear()
-        b.views.append((v, u, yaw))
+        b.add_view(v, u, yaw)
         self.search.update(st)
         return self.due()
 

@@ -75,7 +75,7 @@ class DoorSensing:
         scan = t.laser.scan(v, u, st.heading, self.rng)
         b.fold_scan(v, u, *scan)
         min_reads = b.spec.min_reads
-        b.views.append((v, u, st.heading))
+        b.add_view(v, u, st.heading)
         found = event = False
         reads = t.camera.read(st.x, st.y, st.heading, self.rng)
         for i, label in reads:
