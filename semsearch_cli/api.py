@@ -630,7 +630,8 @@ def planners(scenario: str | Path | None = None) -> list[dict]:
         params = [{"name": k, "type": getattr(f.annotation, "__name__", str(f.annotation)),
                    "default": None if f.is_required() else f.default, "description": f.description or ""}
                   for k, f in cls.Params.model_fields.items()]
-        out.append({"name": name, "kind": ", ".join(cls.kinds) if cls.kinds else cls.task, "source": source, "description": " ".join(doc.split()), "params": params})
+        out.append({"name": name, "kind": ", ".join(cls.kinds) if cls.kinds else cls.task, "source": source,
+                    "description": " ".join(doc.split()), "params": params, "privileged": cls.privileged})
     return out
 
 

@@ -983,7 +983,8 @@ def planners_cmd(scenario: Optional[Path] = typer.Argument(None, help="Also list
     for p in found:
         params = "\n".join(f"{q['name']} = {q['default']!r}" + (f": {q['description']}" if q["description"] else "")
                            for q in p["params"]) or "none"
-        t.add_row(p["name"], p["kind"], p["source"], p["description"], params)
+        kind = p["kind"] + (f"\nprivileged: told {p['privileged']}" if p["privileged"] else "")  # a reference, not a competitor
+        t.add_row(p["name"], kind, p["source"], p["description"], params)
     out.print(t)
 
 

@@ -24,6 +24,9 @@ SHARED = [c for c in COLUMNS if c not in BUILT_IN_KIND_COLUMNS]  # what every ki
 # SHA-256 of the run's decisions file (decisions/<run>.json: the record that replays it)
 BENCH_COLUMNS = ("suite", "split", "suite_hash", "numbering", "floor", "decisions_sha256")
 # what a planner that pays for its decisions reports on each row: planners.base.COST_COLUMNS
+# what a privileged planner was told that a robot is not (Planner.privileged; "" on every other
+# planner's row): a folder that ran one has the column (a reference, never a competitor)
+PRIVILEGED = "privileged"
 
 
 def columns_for(kind_columns) -> list[str]:

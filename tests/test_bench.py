@@ -168,7 +168,7 @@ def _run(tmp_path, planner, limit=3, numbering="true", suite="doors-v1", **kw):
                          options=BatchOptions(workers=1), limit=limit, **kw)
 
 
-@pytest.mark.parametrize("planner", ["greedy", "nsos[alpha=0.9]", "bvp", "draft"])
+@pytest.mark.parametrize("planner", ["greedy", "nsos[alpha=0.9]", "bvp", "draft", "oracle_goal"])
 def test_every_built_in_door_planner_verifies_exactly_on_a_slice(tmp_path, planner):
     res = _run(tmp_path, planner, limit=7)  # floor f000's 20 episodes are more than 7: one floor
     runs = res.runs

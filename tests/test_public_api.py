@@ -17,7 +17,7 @@ from semsearch_cli.planners import base as planners_base
 
 # what planner authors import (semsearch_cli.planners.__all__)
 PLANNER_NAMES = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner",
-                 "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner", "Variant", "code_of",
+                 "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner", "Told", "Variant", "code_of",
                  "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class",
                  "register_planner"]
 # the Python API: each function with its parameters in order

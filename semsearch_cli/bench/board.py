@@ -25,16 +25,20 @@ from scipy.stats import kendalltau, spearmanr
 
 from ..errors import ScenarioError
 from ..files import atomic_text, output_folder
-from ..metrics import COST_COLUMNS, FALLBACK_FLAG, fallback_shares, outside_the_run
+from ..metrics import COST_COLUMNS, FALLBACK_FLAG, PRIVILEGED, fallback_shares, outside_the_run
+from ..planners.base import planner_named
 from ..report.document import Document
 from ..report.figures.bench import GAIN_FLOOR, plot_gain_vs_predictability
 from ..report.indirect import PAPER_SCALES, PAPER_TABLE3, claims_table
-from ..report.stats import mean_ci, rate_ci
+from ..report.stats import mean_ci, rate_ci, ratio_ci
 from ..runner import read_runs
 from .run import BENCH_FILE, is_bench, read_bench
 from .suites import PUBLISHED
 
 BASELINES = {"doors": "nsos[alpha=0.9]", "objects": "lsos"}  # each kind's planner of the thesis, the board's reference
+# the gap every door planner's share is measured on: from nearest-frontier to the planner told
+# where the goal is (planners/doors/oracle.py)
+GAP = ("greedy", "oracle_goal")
 VERIFY_FILE = "verify.json"
 
 
@@ -198,9 +202,33 @@ def fallback_note(d: pd.DataFrame) -> str:
     return ""
 
 
+def told(rows: pd.DataFrame, lab: str) -> str:
+    """What planner ``lab`` was told that a robot is not: its rows' ``privileged`` column, else its
+    class's (when registered in this process); "" for a planner that sees only what a robot senses."""
+    if PRIVILEGED in rows.columns:
+        said = next((v for v in rows.loc[rows["planner"] == lab, PRIVILEGED].astype(str) if v), "")
+        if said:
+            return said
+    cls = planner_named(lab)
+    return getattr(cls, "privileged", "") if cls is not None else ""
+
+
+def gap_closed(d: pd.DataFrame, low: pd.DataFrame, high: pd.DataFrame, value: str) -> tuple[float, float, float, int]:
+    """The share of the gap from ``low`` (greedy) to ``high`` (oracle_goal) in ``value`` that the
+    planner of rows ``d`` closes, over the episodes all three ran (each side's repeats averaged per
+    episode): ``sum(d - low) / sum(high - low)``, its 95% BCa interval over episodes (the three
+    resampled together) and the number of episodes."""
+    m = [x.groupby("unit")[value].mean() for x in (d, low, high)]
+    common = m[0].index.intersection(m[1].index).intersection(m[2].index)
+    if not len(common):
+        return np.nan, np.nan, np.nan, 0
+    p, g, o = (x[common].to_numpy(float) for x in m)
+    return (*(x + 0.0 for x in ratio_ci(p - g, o - g)), len(common))  # + 0.0: no -0.0% on the board
+
+
 def tables(rows: pd.DataFrame) -> dict:
-    """The board's tables of one suite and split (keys: planners, conventions, numberings,
-    floors)."""
+    """The board's tables of one suite and split (keys: planners, references (the privileged
+    planners, never ranked with the others), conventions, numberings, floors)."""
     kind = str(rows["kind"].iloc[0])
     planners = list(dict.fromkeys(rows.loc[rows["numbering"] == "true", "planner"]))  # a planner all of whose runs could not run too
     gone = rows[rows["unavailable"]] if "unavailable" in rows.columns else rows.iloc[:0]
@@ -230,9 +258,15 @@ def tables(rows: pd.DataFrame) -> dict:
             row[f"SPL - {baseline}"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
         else:
             row[f"SPL - {baseline}"] = ""
+        low, high = (true[true["planner"] == g] for g in GAP)
+        if kind == "doors" and len(low) and len(high) and lab not in GAP:
+            for value, col in (("spl", "SPL gap closed"), ("distance_m", "distance gap closed")):
+                m, lo, hi, n = gap_closed(d, low, high, value)
+                row[col] = _ci(m, lo, hi, fmt="{:.1%}") + (f" (n={n})" if n else "")
         sh = rows[(rows["numbering"] == "shuffled") & (rows["planner"] == lab)]
         m, lo, hi, n = paired_diff(d, sh) if len(sh) else (np.nan, np.nan, np.nan, 0)
         row["semantic gain"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
+        row["told"] = told(rows, lab)
         for c in COST_COLUMNS:  # what a planner that pays for its decisions reports (a language model): summed
             v = pd.to_numeric(d[c], errors="coerce") if c in d.columns else pd.Series(dtype=float)
             if v.notna().any():
@@ -246,8 +280,14 @@ def tables(rows: pd.DataFrame) -> dict:
             (f", {lost} run(s) unavailable (left out; the same bench run runs them again)" if lost else "")
         row["official"] = "yes" if d["official"].all() and complete else "no" + ("" if complete else f" ({why})")
         out.append(row)
-    planners_df = pd.DataFrame(out)
-    planners_df = planners_df.loc[:, [c for c in planners_df.columns if (planners_df[c].astype(str) != "").any()]]
+    every = pd.DataFrame(out)
+    privileged = every["told"].fillna("").astype(str) != "" if "told" in every.columns else pd.Series(False, every.index)
+
+    def shown(df):
+        return df.loc[:, [c for c in df.columns if (df[c].fillna("").astype(str) != "").any()]]
+
+    planners_df = shown(every[~privileged].drop(columns="told", errors="ignore"))
+    references = shown(every[privileged])
     conv, numb, floors = [], [], []
     for lab in planners:
         d = true[true["planner"] == lab]
@@ -270,7 +310,7 @@ def tables(rows: pd.DataFrame) -> dict:
             row[f"true - {how}"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
         if any(row[k] for k in row if k != "planner"):
             numb.append(row)
-    return {"planners": planners_df, "conventions": pd.DataFrame(conv), "numberings": pd.DataFrame(numb),
+    return {"planners": planners_df, "references": references, "conventions": pd.DataFrame(conv), "numberings": pd.DataFrame(numb),
             "floors": pd.DataFrame(floors)}
 
 
@@ -414,7 +454,15 @@ def board(folders, out: str | Path) -> list[Path]:
             _indirect_section(doc, g)
             continue
         t = tables(g)
-        doc.table(t["planners"].set_index("planner"), fmt="{}")
+        if len(t["planners"]):
+            doc.table(t["planners"].set_index("planner"), fmt="{}")
+        if len(t["references"]):
+            doc.heading(3, "Privileged references (told what a robot is not; never ranked with the planners above)")
+            doc.para("Each is told something a robot does not know (its told column): a ceiling or a bound on what reasoning "
+                     "over the signs can buy, not a competitor. The planners' gap closed is their share of the gap from "
+                     f"{GAP[0]} to {GAP[1]} (sum over the episodes all three ran of the planner's gain over {GAP[0]}, over "
+                     f"{GAP[1]}'s), with its 95% BCa interval over episodes.")
+            doc.table(t["references"].set_index("planner"), fmt="{}")
         if len(t["conventions"]):
             doc.heading(3, "Semantic gain per numbering convention (SPL, true minus shuffled)")
             doc.table(t["conventions"].set_index("planner"), fmt="{}")

@@ -9,15 +9,15 @@ search).
 
 from .. import deprecation
 from . import base
-from .base import (PLANNERS, Decision, DoorContext, DoorPlanner, NoParams, Planner, Variant, code_of, expand_variants, load_entry_points,
-                   load_planner_file, planner_class, register_planner)
-from .doors import bvp, draft, greedy, learned, nsos, numbering  # noqa: F401  (registration side effect)
+from .base import (PLANNERS, Decision, DoorContext, DoorPlanner, NoParams, Planner, Told, Variant, code_of, expand_variants,
+                   load_entry_points, load_planner_file, planner_class, register_planner)
+from .doors import bvp, draft, greedy, learned, nsos, numbering, oracle  # noqa: F401  (registration side effect)
 from . import llm  # noqa: F401  (registers llm)
 from .indirect import Goal, IndirectContext, IndirectPlanner
 from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 
 __all__ = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner",
-           "Variant", "code_of", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class", "register_planner"]
+           "Told", "Variant", "code_of", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class", "register_planner"]
 
 DEPRECATED = base.DEPRECATED  # PlanContext (0.2.0 -> removed in 0.3.0)
 

@@ -79,6 +79,8 @@ class DoorContext:
     - ``explain``: whether the caller keeps the numbers behind each choice (``Decision.info``,
       for traces and recordings); a planner may skip tabulating them when it is False.
     - ``distance``: the metres travelled so far in the run (NaN when the caller does not say).
+    - ``told``: what a privileged planner (:attr:`Planner.privileged`) is told about the episode
+      that a robot is not (:class:`Told`); None for every other planner.
     """
 
     belief: DoorBelief
@@ -92,6 +94,17 @@ class DoorContext:
     headings: list = field(default_factory=list)
     explain: bool = True
     distance: float = float("nan")  # m travelled so far in the run (NaN: not known)
+    told: "Told | None" = None
+
+
+@dataclass(frozen=True)
+class Told:
+    """What a privileged planner is told about its episode that a robot is not, from the world's
+    ground truth (never the map): ``goal_xy``, the position (x, y m) of each sign that carries the
+    goal's label (one; more under ``duplicates: any``), under the numbering the run has (a bench run
+    of shuffled labels tells where the shuffled goal's sign is)."""
+
+    goal_xy: tuple  # ((x, y), ...) m
 
 
 @dataclass
@@ -193,6 +206,11 @@ class Planner:
     # parameters to run: what takes every built-in planner with its defaults (the bench board,
     # the golden runs) leaves it out
     service: ClassVar[bool] = False
+    # what the planner is told about the episode that a robot is not, in words ("" for every
+    # planner that sees only what the robot senses): a privileged planner is a reference (a
+    # ceiling, a bound), never a competitor. Door planners that set it get ``DoorContext.told``;
+    # the planner list and the bench board mark it, and the board never ranks it with the others.
+    privileged: ClassVar[str] = ""
 
     def __init__(self, params: BaseModel):
         self.params = params

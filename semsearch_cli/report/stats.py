@@ -186,6 +186,53 @@ def mean_ci(values, units, confidence: float = 0.95, n_resamples: int = 9999, se
     return _boot((um,), m, confidence, n_resamples, seed)
 
 
+def ratio_ci(num, den, confidence: float = 0.95, n_resamples: int = 9999, seed: int = 0) -> tuple[float, float, float]:
+    """``mean(num) / mean(den)`` over paired units (``num[i]`` and ``den[i]`` are one unit's), with
+    a BCa bootstrap interval over units, the pairs resampled together: the share of a gap a
+    planner closes (``num``: its gain over the baseline per episode; ``den``: the ceiling's).
+
+    The acceleration comes from the jackknife of the ratio, written out: leaving unit ``i`` out
+    gives ``(S_num - num_i) / (S_den - den_i)``, O(n). NaN bounds with fewer than two units, a
+    ``den`` whose mean is 0, or a degenerate bootstrap distribution (as :func:`_boot`); ``(r, r,
+    r)`` when every unit's ratio is the same."""
+    a, b = np.asarray(num, float), np.asarray(den, float)
+    keep = np.isfinite(a) & np.isfinite(b)
+    a, b = a[keep], b[keep]
+    n = len(a)
+    if n == 0 or b.sum() == 0:
+        return NAN, NAN, NAN
+    point = float(a.sum() / b.sum())
+    if n < 2:
+        return point, NAN, NAN
+    if np.all(a * b.sum() == b * a.sum()):  # every pair on the line through 0 of slope point: no spread
+        return point, point, point
+    rng = np.random.default_rng(seed)
+    rows = max(1, RESAMPLE_BLOCK // n)
+    dist = np.empty(n_resamples)
+    for k in range(0, n_resamples, rows):
+        m = min(rows, n_resamples - k)
+        idx = rng.integers(0, n, (m, n))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dist[k:k + m] = a[idx].sum(axis=-1) / b[idx].sum(axis=-1)
+    dist = dist[np.isfinite(dist)]
+    if len(dist) < n_resamples // 2:
+        return point, NAN, NAN
+    with np.errstate(divide="ignore", invalid="ignore"):
+        jack = (a.sum() - a) / (b.sum() - b)
+    if not np.isfinite(jack).all():
+        return point, NAN, NAN
+    z0 = ndtri((np.count_nonzero(dist < point) + np.count_nonzero(dist <= point)) / (2.0 * len(dist)))
+    u = jack.mean() - jack
+    den3 = np.sum(u**2) ** 1.5
+    acc = np.sum(u**3) / (6.0 * den3) if den3 > 0 else 0.0
+    z = ndtri((1.0 - confidence) / 2.0)
+    levels = [ndtr(z0 + (z0 + zz) / (1.0 - acc * (z0 + zz))) for zz in (z, -z)]
+    if not all(0.0 <= q <= 1.0 for q in levels):
+        return point, NAN, NAN
+    lo, hi = np.quantile(dist, levels)
+    return point, float(lo), float(hi)
+
+
 def _wilson(p, n, confidence: float):
     """:func:`wilson` over arrays: ``p``, ``n`` broadcast; returns (lo, hi) arrays."""
     z = float(norm.ppf(0.5 + confidence / 2.0))

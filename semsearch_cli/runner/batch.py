@@ -13,7 +13,7 @@ import pandas as pd
 
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
-from ..metrics import columns_for, outside_the_run
+from ..metrics import PRIVILEGED, columns_for, outside_the_run
 from ..planners import code_of, planner_class
 from ..planners.base import has_preflight, preflight
 from .execution import Executor, Watch
@@ -257,13 +257,17 @@ class Batch:
         # a language model's calls and tokens: the columns of every planner of the scenario, so that a
         # folder first run with another planner alone (--planner) still has them
         costs = [c for v in [*self.variants, *loaded.task.variants()] for c in planner_class(v).cost_columns]
-        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *costs, *self.stamp, *self.own]))
+        # what a privileged planner was told, on each of its rows (a reference, never a competitor)
+        told = {v.label: planner_class(v).privileged for v in self.variants}
+        marks = [PRIVILEGED] if any(told.values()) else []
+        writer = RowWriter(runs_csv, columns_for([*loaded.task.columns, *costs, *marks, *self.stamp, *self.own]))
         n = 0
         try:
             for rows in runner.rows(loaded, todo, out, watch):
                 for r in rows:
                     r["fingerprint"] = fp
                     r["code"] = codes.get(r["planner"], "")
+                    r[PRIVILEGED] = told.get(r["planner"], "")
                     r.update(self.stamp)
                 writer.write(rows)
                 n += 1

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ScenarioError, did_you_mean
-from ..metrics import BENCH_COLUMNS, CAUSES, COLUMNS, COST_COLUMNS, columns_for
+from ..metrics import BENCH_COLUMNS, CAUSES, COLUMNS, COST_COLUMNS, PRIVILEGED, columns_for
 from ..planners.base import MAX_INFO_DEPTH
 from ..plugins import load_kinds
 from ..tasks import TASKS
@@ -48,7 +48,7 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
     try:
         df = pd.read_csv(io.BytesIO(data), dtype={"stage": str, "map": str, "message": str, "kind": str, "scenario": str,
                                                   "fingerprint": str, "code": str, "room": str, "cause": str,
-                                                  **dict.fromkeys(BENCH_COLUMNS, str),
+                                                  **dict.fromkeys(BENCH_COLUMNS, str), PRIVILEGED: str,
                                                   **dict.fromkeys(KEY_TEXT, str)},
                          encoding="utf-8", keep_default_na=False,
                          na_values={c: MISSING for c in [*COLUMNS, *LATER] if c not in KEY_TEXT})  # a scenario may be named 50045233
@@ -64,12 +64,14 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
         if c not in df.columns:
             df[c] = df["outcome"].map(CAUSES) if c == "cause" else default
     df[TEXT] = df[TEXT].fillna("")
+    if PRIVILEGED in df.columns:
+        df[PRIVILEGED] = df[PRIVILEGED].fillna("")
     if not as_written:
         for c in KEY_TEXT:
             if c in df.columns:
                 df[c] = _lossless(df[c])
     load_kinds()
-    known = columns_for([*(c for t in TASKS.values() for c in t.columns), *COST_COLUMNS, *BENCH_COLUMNS])  # every kind's, costs, a bench's
+    known = columns_for([*(c for t in TASKS.values() for c in t.columns), *COST_COLUMNS, *BENCH_COLUMNS, PRIVILEGED])  # every kind's, costs, a bench's
     extra = [c for c in df.columns if c not in known]
     if extra:
         raise ScenarioError(str(path), extra[0], f"a column semsearch does not write{did_you_mean(str(extra[0]), known)} "
@@ -148,7 +150,11 @@ class RowWriter:
 
     def __init__(self, path: Path, columns: list[str] | None = None):
         """``columns``: a new file's (default :data:`~semsearch_cli.metrics.COLUMNS`; a batch
-        gives :func:`~semsearch_cli.metrics.columns_for` its kind); a file that exists keeps its own."""
+        gives :func:`~semsearch_cli.metrics.columns_for` its kind, its planners' cost columns, ...).
+        A file that exists keeps its own columns, widened by those of ``columns`` it lacks (a
+        planner with cost columns run into a folder whose first planners had none): the file is
+        rewritten once, atomically, its rows empty in the new columns, so that no column of a new
+        row is dropped."""
         path.parent.mkdir(parents=True, exist_ok=True)
         if path.is_file():  # drop a last line cut by an interruption
             with open(path, "rb+") as fh:
@@ -158,6 +164,8 @@ class RowWriter:
         if not new:  # keep the file's columns
             with open(path, newline="") as fh:
                 fields = next(csv.reader(fh))
+            if columns and any(c not in fields for c in columns):
+                fields = _widen(path, fields, list(columns))
         self.fh = open(path, "a", newline="")
         self.w = csv.DictWriter(self.fh, fieldnames=fields, extrasaction="ignore")
         if new:
@@ -181,6 +189,39 @@ class RowWriter:
 
     def close(self) -> None:
         self.fh.close()
+
+
+def widened(have: list[str], want: list[str]) -> list[str]:
+    """``have`` (a file's columns, in its order) with each column of ``want`` it lacks inserted
+    after the column that comes before it in ``want`` (first when none does)."""
+    out = list(have)
+    for i, c in enumerate(want):
+        if c not in out:
+            before = next((w for w in reversed(want[:i]) if w in out), None)
+            out.insert(out.index(before) + 1 if before is not None else 0, c)
+    return out
+
+
+def _widen(path: Path, have: list[str], want: list[str]) -> list[str]:
+    """Rewrite runs.csv ``path`` with the columns of ``want`` it lacks (:func:`widened`), its
+    rows as they were and empty in those; atomically (a temporary file beside it, synced, then
+    renamed over it): an interruption leaves the old file or the new one, never part of either."""
+    fields = widened(have, want)
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    tmp = temp_path(path)
+    try:
+        with open(tmp, "w", newline="") as out:
+            w = csv.DictWriter(out, fieldnames=fields, extrasaction="ignore")
+            w.writeheader()
+            w.writerows(rows)
+            out.flush()
+            os.fsync(out.fileno())
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return fields
 
 
 def _cut_back(fh, size: int):

@@ -24,7 +24,7 @@ from ..errors import ScenarioError
 from ..geometry import wrap_angle
 from ..navigation import NAVIGATORS
 from ..belief import Candidates
-from ..planners import Decision, DoorContext
+from ..planners import Decision, DoorContext, Told
 from ..planners.doors.greedy import nearest_candidate
 from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
@@ -244,6 +244,9 @@ class DoorSearch(DoorSensing):
         self.look_turns = int(np.ceil(180.0 / cam.fov)) - 1
         self.views_needed = views_needed(cam.p_read)
         self.sweep_target: tuple[int, int] | None = None
+        signs = task.world.signs
+        self.told = Told(tuple((float(signs.x[i]), float(signs.y[i])) for i in sorted(self.goal_idx))) \
+            if getattr(planner, "privileged", "") else None  # a privileged planner's ground truth (oracle_goal)
 
     def replan_due(self, path_done, since_plan, event):
         if path_done or (event and self.uses_signs):
@@ -373,7 +376,7 @@ class DoorSearch(DoorSensing):
             b.refresh_derived()
             cands = b.candidates()
         ctx = DoorContext(b, r, c, st.x, st.y, st.heading, self.goal, self.rng, st.headings,
-                          explain=self.observer is not None, distance=st.distance)
+                          explain=self.observer is not None, distance=st.distance, told=self.told)
         return ctx, cands
 
     def attempt(self, st, ctx, cands, dec):
