@@ -73,6 +73,7 @@ def test_oracle_goal_is_the_ceiling_and_the_board_keeps_it_apart(tmp_path):
     assert v.failed == [] and v.verified == v.runs == 12
     t = tables(load([out]))
     assert list(t["references"]["planner"]) == ["oracle_goal"]
+    assert t["references"]["official"].str.startswith("no (a privileged reference").all()
     assert "oracle_goal" not in set(t["planners"]["planner"])
     ranked = t["planners"].set_index("planner")
     assert ranked.loc["costly_nearest", "SPL gap closed"].startswith("0.0%")  # greedy's twin closes none of it

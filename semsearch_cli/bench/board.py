@@ -279,6 +279,8 @@ def tables(rows: pd.DataFrame) -> dict:
         row["verified"] = ", ".join(sorted(set(d["verdict"]))) + fallback_note(d) + \
             (f", {lost} run(s) unavailable (left out; the same bench run runs them again)" if lost else "")
         row["official"] = "yes" if d["official"].all() and complete else "no" + ("" if complete else f" ({why})")
+        if row["told"]:  # a reference is never an official competitor, whatever its hash
+            row["official"] = "no (a privileged reference)" + ("" if complete else f"; {why}")
         out.append(row)
     every = pd.DataFrame(out)
     privileged = every["told"].fillna("").astype(str) != "" if "told" in every.columns else pd.Series(False, every.index)
