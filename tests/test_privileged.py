@@ -55,10 +55,11 @@ def test_oracle_goal_is_the_ceiling_and_the_board_keeps_it_apart(tmp_path):
     opts = BatchOptions(workers=1)
     api.bench_run("doors-v1", ["greedy"], out, options=opts, limit=4)
     first = (out / "f000" / "runs.csv").read_text().splitlines()
-    api.bench_run("doors-v1", ["oracle_goal", "costly_nearest"], out, options=opts, limit=4, planner_file=planner_file)
+    api.bench_run("doors-v1", ["oracle_goal", "costly_nearest", "numbering"], out, options=opts, limit=4,
+                  planner_file=planner_file)
     rows = read_runs(out / "f000" / "runs.csv")
     assert {"llm_calls", "privileged"} <= set(rows.columns)
-    assert rows.groupby("planner").size().to_dict() == {"costly_nearest": 4, "greedy": 4, "oracle_goal": 4}
+    assert rows.groupby("planner").size().to_dict() == {"costly_nearest": 4, "greedy": 4, "numbering": 4, "oracle_goal": 4}
     assert (rows.loc[rows["planner"] == "costly_nearest", "llm_calls"] == 7).all()
     assert rows.loc[rows["planner"] == "oracle_goal", "privileged"].str.contains("goal sign").all()
     assert (rows.loc[rows["planner"] != "oracle_goal", "privileged"] == "").all()
@@ -70,12 +71,16 @@ def test_oracle_goal_is_the_ceiling_and_the_board_keeps_it_apart(tmp_path):
     gd = g.set_index("episode")["distance_m"]
     assert (o <= gd + 1e-9).sum() >= 3  # told where the goal is: shorter on most episodes
     v = api.verify(out).verdict
-    assert v.failed == [] and v.verified == v.runs == 12
+    assert v.failed == [] and v.verified == v.runs == 16
     t = tables(load([out]))
     assert list(t["references"]["planner"]) == ["oracle_goal"]
     assert t["references"]["official"].str.startswith("no (a privileged reference").all()
     assert "oracle_goal" not in set(t["planners"]["planner"])
     ranked = t["planners"].set_index("planner")
+    # what each was tuned on, and a row of the split a planner was tuned on flagged as not held out
+    assert ranked.loc["greedy", "tuned on"] == "none"
+    assert ranked.loc["numbering", "tuned on"].endswith("TUNED ON THIS SPLIT: not held out")
+    assert ranked.loc["costly_nearest", "tuned on"] == "none"  # its class states nothing: the default
     assert ranked.loc["costly_nearest", "SPL gap closed"].startswith("0.0%")  # greedy's twin closes none of it
     assert "SPL gap closed" not in t["references"].columns or not t["references"]["SPL gap closed"].astype(str).str.len().any()
 

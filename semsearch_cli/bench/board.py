@@ -267,6 +267,11 @@ def tables(rows: pd.DataFrame) -> dict:
         m, lo, hi, n = paired_diff(d, sh) if len(sh) else (np.nan, np.nan, np.nan, 0)
         row["semantic gain"] = _ci(m, lo, hi) + (f" (n={n})" if n else "")
         row["told"] = told(rows, lab)
+        cls = planner_named(lab)
+        tuned = getattr(cls, "tuned_on", "") if cls is not None else ""
+        split = f"{d['suite'].iloc[0]} {d['split'].iloc[0]}"
+        row["tuned on"] = (tuned + (" -- TUNED ON THIS SPLIT: not held out" if tuned.startswith(split) else "")) if tuned else \
+            ("not known (a planner not registered in this process)" if cls is None else "none")
         for c in COST_COLUMNS:  # what a planner that pays for its decisions reports (a language model): summed
             v = pd.to_numeric(d[c], errors="coerce") if c in d.columns else pd.Series(dtype=float)
             if v.notna().any():

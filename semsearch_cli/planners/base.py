@@ -211,6 +211,11 @@ class Planner:
     # ceiling, a bound), never a competitor. Door planners that set it get ``DoorContext.told``;
     # the planner list and the bench board mark it, and the board never ranks it with the others.
     privileged: ClassVar[str] = ""
+    # the floors its parameters (or model) were chosen or trained on, in words: "" for none (no
+    # parameter, or values set before any run), else a suite and split ("doors-v1 val") or a
+    # salt ("doors-train, salt semsearch-train-v1"). The bench board gives it beside each row and
+    # flags a row of the split it was tuned on: a result there is not held out.
+    tuned_on: ClassVar[str] = ""
 
     def __init__(self, params: BaseModel):
         self.params = params

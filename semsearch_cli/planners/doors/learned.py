@@ -147,6 +147,7 @@ class Learned(KeepTarget):
     evaluated with NumPy; no learning library is needed to run it."""
 
     rank = 6
+    tuned_on = "doors-train, salt semsearch-train-v1 (training floors disjoint from the benchmark's)"
     Params = LearnedParams
 
     def __init__(self, params):

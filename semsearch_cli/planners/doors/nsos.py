@@ -220,6 +220,7 @@ class NSOS(KeepTarget):
     """The semantic planner (Eqs. 4.5-4.8), with :class:`KeepTarget`'s hysteresis."""
 
     rank = 4
+    tuned_on = "the thesis' floors (its published parameters)"
     swept = "alpha"
 
     Params = NSOSParams

@@ -168,6 +168,7 @@ class Numbering(KeepTarget):
     to the goal under it (docs/numbering.md)."""
 
     rank = 5
+    tuned_on = "doors-v1 val (designed while val was the one split it was measured on)"
     Params = NumberingParams
 
     def _decide(self, ctx, cands, keep: int | None = None):
