@@ -117,6 +117,33 @@ def _damaged_frames(good: Path) -> dict:
     }
 
 
+def _frames_unlike_the_run(good: Path) -> list[tuple[str, bytes, str]]:
+    """Copies of a door run's frames file, each well formed but with values no run of its scenario
+    records (the replay drew them into a traceback, or drew them without a word): (name, the bytes
+    to write in its place, the key the refusal names)."""
+    with np.load(good) as z:
+        arrays = {k: z[k] for k in z.files}
+
+    def savez(**kw) -> bytes:
+        buf = io.BytesIO()
+        np.savez(buf, **{**arrays, **{k.replace("__", "/"): v for k, v in kw.items()}})
+        return buf.getvalue()
+
+    shape = arrays["0/map"].shape
+    indirect = io.BytesIO()
+    np.savez(indirect, n=np.int64(1), **{"0/p": np.full((5, 5), 0.04), "0/p0": np.float64(0.0), "0/trail": np.zeros((1, 2)),
+                                         "0/t": np.float64(0.0), "0/goal": np.zeros(2)})
+    return [("0/read holds a sign index past the scenario's 24 signs", savez(**{"0__read": np.array([10**6])}), "0/read"),
+            ("0/read holds the index -1 (read as the last sign)", savez(**{"0__read": np.array([-1])}), "0/read"),
+            ("0/read holds 1.5", savez(**{"0__read": np.array([1.5])}), "0/read"),
+            ("0/path of no pose", savez(**{"0__path": np.zeros((0, 2))}), "0/path"),
+            ("0/path of NaN", savez(**{"0__path": np.full((3, 2), np.nan)}), "0/path"),
+            ("0/distance -1", savez(**{"0__distance": np.float64(-1.0)}), "0/distance"),
+            ("0/map of 3 x 3 cells (another scenario's)", savez(**{"0__map": np.zeros((3, 3), np.uint8)}), "0/map"),
+            ("0/map of 7s", savez(**{"0__map": np.full(shape, 7, np.uint8)}), "0/map"),
+            ("an indirect search's frame in a door run's file", indirect.getvalue(), "0/")]
+
+
 def build_cases(root: Path) -> list[ReleaseCase]:
     """Every case of the release catalogue, its files written under ``root`` (one results folder
     with frames is made by a real run, ~2 s)."""
@@ -258,6 +285,17 @@ def build_cases(root: Path) -> list[ReleaseCase]:
         d = results_copy("frames", name)
         (d / "frames" / frame_file.name).write_bytes(data)
         add("frames", f"frames file: {name}", ["report", d, "--replay", replay], says=[frame_file.name], within=30)
+    for name, data, key in _frames_unlike_the_run(frame_file):
+        d = results_copy("frames", name)
+        (d / "frames" / frame_file.name).write_bytes(data)
+        add("frames", f"frames file: {name}", ["report", d, "--replay", replay, "--format", "md"], says=[frame_file.name, key])
+    # --replay's goal as check_replay reads it (304.0 is the goal 304): the section found no run and
+    # drew none, exit 0; it reads the run's frames (here damaged, so refused)
+    d = results_copy("frames", "replay 304.0")
+    (d / "frames" / frame_file.name).write_bytes(b"not a zip file\n")
+    add("frames", f"--replay {first['planner']},{first['goal']}.0,... reads that run's frames",
+        ["report", d, "--replay", f"{first['planner']},{first['goal']}.0,{first['episode']},{first['seed']}", "--format", "md"],
+        says=[frame_file.name])
     d = results_copy("frames", "replay_ok")
     add("frames", "the undamaged frames replay", ["report", d, "--replay", replay], "accept")
     for value in ("greedy,452,0,--1", "greedy,452,0,²", "greedy,452,٠,0", f"greedy,452,0,{LONG_DIGITS}"):
