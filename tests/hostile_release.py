@@ -232,6 +232,25 @@ def build_cases(root: Path) -> list[ReleaseCase]:
     episodes_csv("the hash of an edited row (start_x moved)", head.replace("\n", ",hash\n") + f"{GOAL},16.0,10.0,0.0,{right}\n",
                  says=["eps.csv", "hash"])
     episodes_csv("a goal written 304.0", head + f"{GOAL}.0,15.0,10.0,0.0\n", "accept")
+    # the columns and the numbers of each row, named where they are wrong
+    episodes_csv("a column start_headng (misspelt: every heading was drawn at random)",
+                 head.replace("start_heading", "start_headng") + row, says=["eps.csv", "start_headng", "'start_heading'"])
+    episodes_csv("a column colour", head.replace("\n", ",colour\n") + row.replace("\n", ",red\n"), says=["eps.csv", "colour"])
+    episodes_csv("the column goal twice in the header", "goal,start_x,start_y,goal\n304,15,10,305\n", says=["eps.csv", "given twice"])
+    episodes_csv("episode 0 on two lines", "episode," + head + f"0,{row}0,{GOAL},16.0,10.0,0.0\n", says=["eps.csv", "line 3 episode"])
+    episodes_csv("an episode column of abc", "episode," + head + f"abc,{row}", says=["eps.csv", "line 2 episode"])
+    episodes_csv("start_heading 1e9 (episodes.list takes -3600 to 3600)", head + f"{GOAL},15.0,10.0,1e9\n",
+                 says=["eps.csv", "line 2 start_heading", "3600"])
+    episodes_csv("start_heading Random", head + f"{GOAL},15.0,10.0,Random\n", says=["eps.csv", "line 2 start_heading"])
+    episodes_csv("start_x empty", head + f"{GOAL},,10.0,0.0\n", says=["eps.csv", "line 2 start_x"])
+    episodes_csv("a room kitchen in a door scenario's episodes", head.replace("\n", ",room\n") + row.replace("\n", ",kitchen\n"),
+                 says=["eps.csv", "line 2 room"])
+    episodes_csv("a header Goal (capitalised)", head.replace("goal", "Goal") + row, says=["eps.csv", "'Goal'"])
+    episodes_csv("a file of semicolons", head.replace(",", ";") + row.replace(",", ";"), says=["eps.csv", "';'"])
+    episodes_csv("a byte-order mark and CRLF line ends", ("\ufeff" + head + row).replace("\n", "\r\n"), "accept")
+    own = Episode(0, GOAL, 15.0, 10.0, 0.0, None, 11.73).row()
+    episodes_csv("the eight columns semsearch episodes writes", ",".join(own) + "\n" + ",".join(str(v) for v in own.values()) + "\n",
+                 "accept")
     base_text = yaml.safe_dump(base, sort_keys=False)
     add("episodes", "episodes: {starts: yes} (YAML 1.1 true)",
         ["validate", raw_scen("episodes", "starts_yes", base_text + "episodes: {starts: yes}\n")], says=["episodes.starts"])
