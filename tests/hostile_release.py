@@ -323,10 +323,10 @@ def build_cases(root: Path) -> list[ReleaseCase]:
 
     # -- planners: a user's planner file, and what lies beside it -----------------------------------
     def planner_case(name: str, body: str, expect="refuse", says=(), register=None, beside=None, command="validate",
-                     planners=None):
+                     planners=None, prelude=""):
         d = folder("planners", name)
         reg = register or f"hostile_release_{len(cases)}"
-        (d / "p.py").write_text(PLANNER_HEAD + f"@register_planner({reg!r})\n" + body)
+        (d / "p.py").write_text(PLANNER_HEAD + prelude + f"@register_planner({reg!r})\n" + body)
         for junk in beside or ():
             junk(d)
         doc = _set(base, ["planners"], planners or [{"name": reg, "module": "p.py"}])
@@ -346,6 +346,33 @@ def build_cases(root: Path) -> list[ReleaseCase]:
     planner_case("a planner named nsos_alpha0.9 beside {name: nsos, alpha: 0.9}", good_body, says=["planners", "nsos_alpha0.9"],
                  register="nsos_alpha0.9", planners=[{"name": "nsos", "alpha": 0.9}, {"name": "nsos_alpha0.9", "module": "p.py"}])
     planner_case("a planner name of 300 characters", good_body, says=["p.py", "at most 64 characters"], register="m" * 300)
+    # a Params model's defaults, and the parameters a scenario gives it
+    pyd = "from pydantic import BaseModel, ConfigDict, Field\n\n\n"
+    def params(field: str) -> str:
+        return "class Mine(DoorPlanner):\n    \"\"\"Nearest candidate.\"\"\"\n\n    class Params(BaseModel):\n        " + field + "\n\n" + NEAREST
+
+    planner_case("Params: a default_factory of -5 for a field ge=0 (was taken unchecked)",
+                 params("k: int = Field(default_factory=lambda: -5, ge=0)"), says=["p.py", "Mine.Params", "k"], prelude=pyd)
+    planner_case("Params: a default of float('nan')", params("k: float = float('nan')"), says=["p.py", "Mine.Params", "nan"],
+                 prelude=pyd)
+    planner_case("Params: a valid default_factory", params("k: list = Field(default_factory=lambda: [1, 2])"), "accept",
+                 prelude=pyd)
+    planner_case("a parameter kk the Params does not take (pydantic ignores it: the run used k's default)",
+                 params("k: int = 1"), says=["planners[0].kk", "'k'"], register="hostile_release_kk", prelude=pyd,
+                 planners=[{"name": "hostile_release_kk", "module": "p.py", "kk": 2}])
+    planner_case("a parameter given by its alias K", params("k: int = Field(1, alias='K')"), "accept",
+                 register="hostile_release_alias", prelude=pyd, planners=[{"name": "hostile_release_alias", "module": "p.py", "K": 2}])
+    planner_case("a Params of extra='allow' takes any key", params("model_config = ConfigDict(extra='allow')"), "accept",
+                 register="hostile_release_allow", prelude=pyd, planners=[{"name": "hostile_release_allow", "module": "p.py", "kk": 2}])
+    planner_case("rank = 10**400 (past a float)", "class Mine(DoorPlanner):\n    rank = 10**400\n" + NEAREST,
+                 says=["p.py", "Mine.rank", "a finite number"])
+    planner_case("cost_columns = ('colour',) (the batch wrote the column, then refused its runs.csv)",
+                 "class Mine(DoorPlanner):\n    cost_columns = ('colour',)\n" + NEAREST, says=["p.py", "Mine.cost_columns", "colour"])
+    d = folder("planners", "nul")
+    (d / "p.py").write_bytes(PLANNER_HEAD.encode() + b"x = 1\x00\n")
+    add("planners", "a planner file holding a NUL byte (was blamed on 'line None')",
+        ["validate", _dump(d / "scenario.yaml", _set(base, ["planners"], [{"name": "mine", "module": "p.py"}]))],
+        says=["p.py: not valid Python"])
     for name, up in (("module: ../../../../etc/passwd", 4), ("module: ../ up to the root, then etc/passwd (a file, not Python)", None)):
         d = folder("planners", name)
         up = up or len(d.resolve().parts) - 1  # enough to reach / from the scenario's folder
