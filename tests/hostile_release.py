@@ -190,6 +190,17 @@ def build_cases(root: Path) -> list[ReleaseCase]:
                              ("--goal of 60,000 digits", LONG_DIGITS, ["--goal"]),
                              ("--goal ²", "²", ["--goal"]), ("--goal 30²", "30²", ["--goal"])):
         add("labels", name, ["run", good, *run, "--goal", goal, "--out", out_dir()], says=says, within=10 if len(goal) > 100 else None)
+    # --goal read as a CSV's column of labels (sign_label's docs: 148.0 is the number 148), as goals: [304.0] is
+    add("labels", "--goal 304.0 (a goal written 304.0 in YAML is 304)", ["run", good, *run, "--goal", f"{GOAL}.0", "--out", out_dir()],
+        "accept")
+    add("labels", "--goal 304.0,305 (a column of mixed forms is text)", ["run", good, *run, "--goal", f"{GOAL}.0,305", "--out", out_dir()],
+        says=["--goal", "304.0"])
+    add("labels", "--goal ３０４ (full-width digits)", ["run", good, *run, "--goal", "３０４", "--out", out_dir()], says=["--goal"])
+    for name, goal, expect, says in (("a goal -304", -304, "refuse", ["goals[0]"]),
+                                     ("a goal 304 with a zero-width space", "304\u200b", "refuse", ["goals[0]", "control"]),
+                                     ("a goal '+304'", "+304", "accept", []), ("a goal ' 304 ' (spaces)", " 304 ", "accept", []),
+                                     ("a goal 304 with a no-break space", "304\u00a0", "accept", [])):
+        add("labels", name, ["validate", scen("labels", name, _set(base, ["goals"], [goal]))], expect, says)
     dtext = (demo / "doors.csv").read_text()
     doors = folder("labels", "doors304.0") / "doors.csv"
     doors.write_text(re.sub(r"(?m)^(\d+),", r"\1.0,", dtext))  # a spreadsheet's column of numbers: 304.0
@@ -398,6 +409,18 @@ def build_cases(root: Path) -> list[ReleaseCase]:
         r.loc[r["outcome"] == "found", "distance_m"] = value
         r.to_csv(d / "runs.csv", index=False)
         add("commands", f"report: a found run of distance_m {value}", ["report", d, "--no-replay"], says=["runs.csv", "distance_m"])
+    # sweep --param read as a scenario's YAML is (ScenarioLoader), --alphas as a person writes numbers
+    for value, says in (("9" * 5000, ["--param", "laser.beams", "5,000 characters"]), ("1_81", ["--param", "1_81"]),
+                        ("010", ["--param", "010"])):
+        add("commands", f"sweep --param laser.beams={value[:12]} (yaml.safe_load read {'its int' if len(value) > 9 else 'a number'})",
+            ["sweep", good, *run, "--param", f"laser.beams={value}", "--out", out_dir()], says=says)
+    add("commands", "sweep-alpha --alphas ٠.٥ (Arabic-Indic digits: float() read 0.5)",
+        ["sweep-alpha", good, *run, "--alphas", "٠.٥", "--out", out_dir()], says=["--alphas"])
+    d = results_copy("commands", "one folder twice")
+    add("commands", "report of one folder given twice (its rows counted twice)", ["report", d, f"{d}/.", "--no-replay",
+                                                                                    "--out", out_dir()], says=["FOLDERS", "twice"])
+    add("commands", "--planner gredy names the nearest", ["run", good, *run, "--planner", "gredy", "--out", out_dir()],
+        says=["--planner", "'greedy'"])
     ros = folder("commands", "ros")
     room = np.zeros((40, 60), np.uint8)
     room[2:-2, 2:-2] = 254

@@ -253,6 +253,13 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
         replay = parse_replay(replay)
     t0 = time.perf_counter()
     folders = [Path(f) for f in folders]
+    seen: dict = {}
+    for f in folders:  # the same folder twice counted its rows twice, in every table and test
+        key = f.resolve()
+        if key in seen:
+            raise ScenarioError("<command line>", "FOLDERS", f"{f} is given twice (as {seen[key]} too): its rows would "
+                                "count twice; give each results folder once")
+        seen[key] = f
     out = Path(out) if out is not None else folders[0] if len(folders) == 1 else Path("results") / "report"
     parts_by_kind: dict[str, list[Part]] = {}
     metas = {str(f): read_meta(f) for f in folders}
