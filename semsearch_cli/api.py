@@ -15,6 +15,7 @@ import pandas as pd
 import yaml
 
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
+from .config.scenario import load_yaml_text
 from .config.base import sign_label
 from .credentials import WHERE_THE_KEY_GOES, credential_in, redact, url_credential
 from .errors import MissingExtra, ScenarioError, did_you_mean
@@ -85,7 +86,7 @@ def run(scenario: str | Path, options: BatchOptions = BatchOptions(), progress=N
                 raise ScenarioError("<command line>", "--goal", f"goal {g} is not among the scenario's goals {loaded.goals}")
     specs = expand(loaded, options.seeds, goals, planners)
     if not specs:
-        raise ScenarioError("<command line>", "--planner", f"no planner variant matches {planners}")
+        raise _no_variant(loaded, planners)
     out_dir = default_out(loaded, options.out)
     with Batch(loaded, specs, out_dir, options, own=RECORDED if options.decisions else ()) as batch:  # held and checked, once
         report_build.write_meta(out_dir, loaded)
@@ -410,6 +411,16 @@ def _typed(param: str, value, loaded: Loaded) -> None:
                             "not yes/no; give its values")
 
 
+def _no_variant(loaded: Loaded, planners) -> ScenarioError:
+    """The error of a ``--planner`` list that matches no variant of the scenario: each name with
+    the nearest variant names and labels, and those there are."""
+    variants = loaded.task.variants()
+    valid = sorted({v.name for v in variants} | {v.label for v in variants})
+    near = "; ".join(f"{p!r}{did_you_mean(p, valid)}" for p in planners or ())
+    return ScenarioError("<command line>", "--planner", f"no planner variant matches {near or planners}; the scenario's "
+                         f"variants: {', '.join(valid[:12])}{', ...' if len(valid) > 12 else ''}")
+
+
 def parse_param(text: str) -> tuple[str, list]:
     """``SECTION.FIELD=V1,V2,...`` -> (dotted name, values read as YAML scalars); an address
     holding a credential is refused, never shown (its value would name a folder)."""
@@ -422,10 +433,13 @@ def parse_param(text: str) -> tuple[str, list]:
         raise ScenarioError("<command line>", "--param", f"expected SECTION.FIELD=V1,V2,... (e.g. door_camera.p_misread=0,0.05,0.1), got {text!r}")
     values = []
     for v in items:
+        # read as a scenario's YAML is (ScenarioLoader): numbers as written, so that 1_5 and 010 are
+        # text its field refuses, and 5,000 digits are text too (yaml.safe_load's int() of them raised
+        # a ValueError, a traceback)
         try:
-            values.append(yaml.safe_load(v))
-        except yaml.YAMLError:
-            raise ScenarioError("<command line>", "--param", f"cannot read the value {v!r}") from None
+            values.append(load_yaml_text(v))
+        except (yaml.YAMLError, ValueError, RecursionError):
+            raise ScenarioError("<command line>", "--param", f"cannot read the value {v[:40]!r}") from None
     return name.strip(), values
 
 
@@ -438,8 +452,10 @@ def _load_value(path: Path, data: dict, param: str, value) -> Loaded:
         own = exc.field == param or exc.field.startswith(param + ".") or (  # a section's field, or a planner's parameter
             exc.field.startswith("planners[") and exc.field.split(".")[-1] == param.split(".")[-1])
         if exc.file == str(path) and own:
-            raise ScenarioError("<command line>", "--param", f"{param}={str(value).lower() if isinstance(value, bool) else redact(value)} "
-                                f"({exc.field} of the scenario): {exc.message}") from None
+            shown = str(value).lower() if isinstance(value, bool) else redact(value)
+            cut = (lambda t: t if len(t) <= 80 else f"{t[:60]}... ({len(t):,} characters)")  # 5,000 digits: not twice in full
+            raise ScenarioError("<command line>", "--param", f"{param}={cut(shown)} "
+                                f"({exc.field} of the scenario): {exc.message.replace(shown, cut(shown))}") from None
         raise
 
 
@@ -465,7 +481,7 @@ def sweep(scenario: str | Path, param: str, values: list, options: BatchOptions 
         for ld, sub in zip(loaded, subs):  # every value's folder held and checked (foreign rows refused) before anything runs
             specs = expand(ld, options.seeds, options.goals, options.planners)
             if not specs:
-                raise ScenarioError("<command line>", "--planner", f"no planner variant matches {options.planners}")
+                raise _no_variant(ld, options.planners)
             batches.append(held.enter_context(Batch(ld, specs, sub, options, own=RECORDED if options.decisions else ())))
         frames = []
         for v, ld, sub, batch in zip(values, loaded, subs, batches):

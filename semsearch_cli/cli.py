@@ -23,7 +23,7 @@ from rich.text import Text
 from . import api
 from .provenance import version_line
 from .runner import BatchOptions
-from .config.base import MAX_SEEDS, sign_label
+from .config.base import MAX_SEEDS, label_column, number_text, sign_label
 from .kernels import announce_compiling
 from .errors import DISK_FULL, BatchStopped, ScenarioError, Terminated, did_you_mean
 from .metrics import FALLBACK_FLAG, fallback_shares, outside_the_run
@@ -76,8 +76,8 @@ def _split(values: Optional[List[str]], flag: str, labels: bool = True) -> Optio
         raise ScenarioError("<command line>", flag, f"no values in {' '.join(map(repr, values))}; give one or more, comma-separated")
     if not labels:
         return items
-    try:
-        return [sign_label(v) for v in items]
+    try:  # as a CSV's column of labels is read: --goal 304.0 is the goal 304, as goals: [304.0] is
+        return label_column(items)
     except ValueError as exc:
         raise ScenarioError("<command line>", flag, str(exc)) from None
 
@@ -160,8 +160,8 @@ def sweep_alpha(
     """nsos at each alpha with greedy beside it: the rows and summary of `run`, plus
     plots/alpha_sweep.png (mean ratio to the shortest path against alpha, per goal)."""
 
-    try:
-        values = [float(a) for a in alphas.split(",") if a.strip()]
+    try:  # read as a person writes numbers (number_text): float() read ٠.٥ as 0.5 and 0_5 as 5
+        values = [number_text(a) for a in alphas.split(",") if a.strip()]
     except ValueError:
         _fail(ScenarioError("<command line>", "--alphas", f"expected comma-separated numbers, got {alphas!r}"))
     if not values or any(not 0.0 <= a <= 1.0 for a in values):

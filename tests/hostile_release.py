@@ -117,6 +117,33 @@ def _damaged_frames(good: Path) -> dict:
     }
 
 
+def _frames_unlike_the_run(good: Path) -> list[tuple[str, bytes, str]]:
+    """Copies of a door run's frames file, each well formed but with values no run of its scenario
+    records (the replay drew them into a traceback, or drew them without a word): (name, the bytes
+    to write in its place, the key the refusal names)."""
+    with np.load(good) as z:
+        arrays = {k: z[k] for k in z.files}
+
+    def savez(**kw) -> bytes:
+        buf = io.BytesIO()
+        np.savez(buf, **{**arrays, **{k.replace("__", "/"): v for k, v in kw.items()}})
+        return buf.getvalue()
+
+    shape = arrays["0/map"].shape
+    indirect = io.BytesIO()
+    np.savez(indirect, n=np.int64(1), **{"0/p": np.full((5, 5), 0.04), "0/p0": np.float64(0.0), "0/trail": np.zeros((1, 2)),
+                                         "0/t": np.float64(0.0), "0/goal": np.zeros(2)})
+    return [("0/read holds a sign index past the scenario's 24 signs", savez(**{"0__read": np.array([10**6])}), "0/read"),
+            ("0/read holds the index -1 (read as the last sign)", savez(**{"0__read": np.array([-1])}), "0/read"),
+            ("0/read holds 1.5", savez(**{"0__read": np.array([1.5])}), "0/read"),
+            ("0/path of no pose", savez(**{"0__path": np.zeros((0, 2))}), "0/path"),
+            ("0/path of NaN", savez(**{"0__path": np.full((3, 2), np.nan)}), "0/path"),
+            ("0/distance -1", savez(**{"0__distance": np.float64(-1.0)}), "0/distance"),
+            ("0/map of 3 x 3 cells (another scenario's)", savez(**{"0__map": np.zeros((3, 3), np.uint8)}), "0/map"),
+            ("0/map of 7s", savez(**{"0__map": np.full(shape, 7, np.uint8)}), "0/map"),
+            ("an indirect search's frame in a door run's file", indirect.getvalue(), "0/")]
+
+
 def build_cases(root: Path) -> list[ReleaseCase]:
     """Every case of the release catalogue, its files written under ``root`` (one results folder
     with frames is made by a real run, ~2 s)."""
@@ -163,6 +190,17 @@ def build_cases(root: Path) -> list[ReleaseCase]:
                              ("--goal of 60,000 digits", LONG_DIGITS, ["--goal"]),
                              ("--goal ²", "²", ["--goal"]), ("--goal 30²", "30²", ["--goal"])):
         add("labels", name, ["run", good, *run, "--goal", goal, "--out", out_dir()], says=says, within=10 if len(goal) > 100 else None)
+    # --goal read as a CSV's column of labels (sign_label's docs: 148.0 is the number 148), as goals: [304.0] is
+    add("labels", "--goal 304.0 (a goal written 304.0 in YAML is 304)", ["run", good, *run, "--goal", f"{GOAL}.0", "--out", out_dir()],
+        "accept")
+    add("labels", "--goal 304.0,305 (a column of mixed forms is text)", ["run", good, *run, "--goal", f"{GOAL}.0,305", "--out", out_dir()],
+        says=["--goal", "304.0"])
+    add("labels", "--goal ３０４ (full-width digits)", ["run", good, *run, "--goal", "３０４", "--out", out_dir()], says=["--goal"])
+    for name, goal, expect, says in (("a goal -304", -304, "refuse", ["goals[0]"]),
+                                     ("a goal 304 with a zero-width space", "304\u200b", "refuse", ["goals[0]", "control"]),
+                                     ("a goal '+304'", "+304", "accept", []), ("a goal ' 304 ' (spaces)", " 304 ", "accept", []),
+                                     ("a goal 304 with a no-break space", "304\u00a0", "accept", [])):
+        add("labels", name, ["validate", scen("labels", name, _set(base, ["goals"], [goal]))], expect, says)
     dtext = (demo / "doors.csv").read_text()
     doors = folder("labels", "doors304.0") / "doors.csv"
     doors.write_text(re.sub(r"(?m)^(\d+),", r"\1.0,", dtext))  # a spreadsheet's column of numbers: 304.0
@@ -205,6 +243,25 @@ def build_cases(root: Path) -> list[ReleaseCase]:
     episodes_csv("the hash of an edited row (start_x moved)", head.replace("\n", ",hash\n") + f"{GOAL},16.0,10.0,0.0,{right}\n",
                  says=["eps.csv", "hash"])
     episodes_csv("a goal written 304.0", head + f"{GOAL}.0,15.0,10.0,0.0\n", "accept")
+    # the columns and the numbers of each row, named where they are wrong
+    episodes_csv("a column start_headng (misspelt: every heading was drawn at random)",
+                 head.replace("start_heading", "start_headng") + row, says=["eps.csv", "start_headng", "'start_heading'"])
+    episodes_csv("a column colour", head.replace("\n", ",colour\n") + row.replace("\n", ",red\n"), says=["eps.csv", "colour"])
+    episodes_csv("the column goal twice in the header", "goal,start_x,start_y,goal\n304,15,10,305\n", says=["eps.csv", "given twice"])
+    episodes_csv("episode 0 on two lines", "episode," + head + f"0,{row}0,{GOAL},16.0,10.0,0.0\n", says=["eps.csv", "line 3 episode"])
+    episodes_csv("an episode column of abc", "episode," + head + f"abc,{row}", says=["eps.csv", "line 2 episode"])
+    episodes_csv("start_heading 1e9 (episodes.list takes -3600 to 3600)", head + f"{GOAL},15.0,10.0,1e9\n",
+                 says=["eps.csv", "line 2 start_heading", "3600"])
+    episodes_csv("start_heading Random", head + f"{GOAL},15.0,10.0,Random\n", says=["eps.csv", "line 2 start_heading"])
+    episodes_csv("start_x empty", head + f"{GOAL},,10.0,0.0\n", says=["eps.csv", "line 2 start_x"])
+    episodes_csv("a room kitchen in a door scenario's episodes", head.replace("\n", ",room\n") + row.replace("\n", ",kitchen\n"),
+                 says=["eps.csv", "line 2 room"])
+    episodes_csv("a header Goal (capitalised)", head.replace("goal", "Goal") + row, says=["eps.csv", "'Goal'"])
+    episodes_csv("a file of semicolons", head.replace(",", ";") + row.replace(",", ";"), says=["eps.csv", "';'"])
+    episodes_csv("a byte-order mark and CRLF line ends", ("\ufeff" + head + row).replace("\n", "\r\n"), "accept")
+    own = Episode(0, GOAL, 15.0, 10.0, 0.0, None, 11.73).row()
+    episodes_csv("the eight columns semsearch episodes writes", ",".join(own) + "\n" + ",".join(str(v) for v in own.values()) + "\n",
+                 "accept")
     base_text = yaml.safe_dump(base, sort_keys=False)
     add("episodes", "episodes: {starts: yes} (YAML 1.1 true)",
         ["validate", raw_scen("episodes", "starts_yes", base_text + "episodes: {starts: yes}\n")], says=["episodes.starts"])
@@ -258,6 +315,17 @@ def build_cases(root: Path) -> list[ReleaseCase]:
         d = results_copy("frames", name)
         (d / "frames" / frame_file.name).write_bytes(data)
         add("frames", f"frames file: {name}", ["report", d, "--replay", replay], says=[frame_file.name], within=30)
+    for name, data, key in _frames_unlike_the_run(frame_file):
+        d = results_copy("frames", name)
+        (d / "frames" / frame_file.name).write_bytes(data)
+        add("frames", f"frames file: {name}", ["report", d, "--replay", replay, "--format", "md"], says=[frame_file.name, key])
+    # --replay's goal as check_replay reads it (304.0 is the goal 304): the section found no run and
+    # drew none, exit 0; it reads the run's frames (here damaged, so refused)
+    d = results_copy("frames", "replay 304.0")
+    (d / "frames" / frame_file.name).write_bytes(b"not a zip file\n")
+    add("frames", f"--replay {first['planner']},{first['goal']}.0,... reads that run's frames",
+        ["report", d, "--replay", f"{first['planner']},{first['goal']}.0,{first['episode']},{first['seed']}", "--format", "md"],
+        says=[frame_file.name])
     d = results_copy("frames", "replay_ok")
     add("frames", "the undamaged frames replay", ["report", d, "--replay", replay], "accept")
     for value in ("greedy,452,0,--1", "greedy,452,0,²", "greedy,452,٠,0", f"greedy,452,0,{LONG_DIGITS}"):
@@ -266,10 +334,10 @@ def build_cases(root: Path) -> list[ReleaseCase]:
 
     # -- planners: a user's planner file, and what lies beside it -----------------------------------
     def planner_case(name: str, body: str, expect="refuse", says=(), register=None, beside=None, command="validate",
-                     planners=None):
+                     planners=None, prelude=""):
         d = folder("planners", name)
         reg = register or f"hostile_release_{len(cases)}"
-        (d / "p.py").write_text(PLANNER_HEAD + f"@register_planner({reg!r})\n" + body)
+        (d / "p.py").write_text(PLANNER_HEAD + prelude + f"@register_planner({reg!r})\n" + body)
         for junk in beside or ():
             junk(d)
         doc = _set(base, ["planners"], planners or [{"name": reg, "module": "p.py"}])
@@ -289,6 +357,33 @@ def build_cases(root: Path) -> list[ReleaseCase]:
     planner_case("a planner named nsos_alpha0.9 beside {name: nsos, alpha: 0.9}", good_body, says=["planners", "nsos_alpha0.9"],
                  register="nsos_alpha0.9", planners=[{"name": "nsos", "alpha": 0.9}, {"name": "nsos_alpha0.9", "module": "p.py"}])
     planner_case("a planner name of 300 characters", good_body, says=["p.py", "at most 64 characters"], register="m" * 300)
+    # a Params model's defaults, and the parameters a scenario gives it
+    pyd = "from pydantic import BaseModel, ConfigDict, Field\n\n\n"
+    def params(field: str) -> str:
+        return "class Mine(DoorPlanner):\n    \"\"\"Nearest candidate.\"\"\"\n\n    class Params(BaseModel):\n        " + field + "\n\n" + NEAREST
+
+    planner_case("Params: a default_factory of -5 for a field ge=0 (was taken unchecked)",
+                 params("k: int = Field(default_factory=lambda: -5, ge=0)"), says=["p.py", "Mine.Params", "k"], prelude=pyd)
+    planner_case("Params: a default of float('nan')", params("k: float = float('nan')"), says=["p.py", "Mine.Params", "nan"],
+                 prelude=pyd)
+    planner_case("Params: a valid default_factory", params("k: list = Field(default_factory=lambda: [1, 2])"), "accept",
+                 prelude=pyd)
+    planner_case("a parameter kk the Params does not take (pydantic ignores it: the run used k's default)",
+                 params("k: int = 1"), says=["planners[0].kk", "'k'"], register="hostile_release_kk", prelude=pyd,
+                 planners=[{"name": "hostile_release_kk", "module": "p.py", "kk": 2}])
+    planner_case("a parameter given by its alias K", params("k: int = Field(1, alias='K')"), "accept",
+                 register="hostile_release_alias", prelude=pyd, planners=[{"name": "hostile_release_alias", "module": "p.py", "K": 2}])
+    planner_case("a Params of extra='allow' takes any key", params("model_config = ConfigDict(extra='allow')"), "accept",
+                 register="hostile_release_allow", prelude=pyd, planners=[{"name": "hostile_release_allow", "module": "p.py", "kk": 2}])
+    planner_case("rank = 10**400 (past a float)", "class Mine(DoorPlanner):\n    rank = 10**400\n" + NEAREST,
+                 says=["p.py", "Mine.rank", "a finite number"])
+    planner_case("cost_columns = ('colour',) (the batch wrote the column, then refused its runs.csv)",
+                 "class Mine(DoorPlanner):\n    cost_columns = ('colour',)\n" + NEAREST, says=["p.py", "Mine.cost_columns", "colour"])
+    d = folder("planners", "nul")
+    (d / "p.py").write_bytes(PLANNER_HEAD.encode() + b"x = 1\x00\n")
+    add("planners", "a planner file holding a NUL byte (was blamed on 'line None')",
+        ["validate", _dump(d / "scenario.yaml", _set(base, ["planners"], [{"name": "mine", "module": "p.py"}]))],
+        says=["p.py: not valid Python"])
     for name, up in (("module: ../../../../etc/passwd", 4), ("module: ../ up to the root, then etc/passwd (a file, not Python)", None)):
         d = folder("planners", name)
         up = up or len(d.resolve().parts) - 1  # enough to reach / from the scenario's folder
@@ -314,6 +409,18 @@ def build_cases(root: Path) -> list[ReleaseCase]:
         r.loc[r["outcome"] == "found", "distance_m"] = value
         r.to_csv(d / "runs.csv", index=False)
         add("commands", f"report: a found run of distance_m {value}", ["report", d, "--no-replay"], says=["runs.csv", "distance_m"])
+    # sweep --param read as a scenario's YAML is (ScenarioLoader), --alphas as a person writes numbers
+    for value, says in (("9" * 5000, ["--param", "laser.beams", "5,000 characters"]), ("1_81", ["--param", "1_81"]),
+                        ("010", ["--param", "010"])):
+        add("commands", f"sweep --param laser.beams={value[:12]} (yaml.safe_load read {'its int' if len(value) > 9 else 'a number'})",
+            ["sweep", good, *run, "--param", f"laser.beams={value}", "--out", out_dir()], says=says)
+    add("commands", "sweep-alpha --alphas ٠.٥ (Arabic-Indic digits: float() read 0.5)",
+        ["sweep-alpha", good, *run, "--alphas", "٠.٥", "--out", out_dir()], says=["--alphas"])
+    d = results_copy("commands", "one folder twice")
+    add("commands", "report of one folder given twice (its rows counted twice)", ["report", d, f"{d}/.", "--no-replay",
+                                                                                    "--out", out_dir()], says=["FOLDERS", "twice"])
+    add("commands", "--planner gredy names the nearest", ["run", good, *run, "--planner", "gredy", "--out", out_dir()],
+        says=["--planner", "'greedy'"])
     ros = folder("commands", "ros")
     room = np.zeros((40, 60), np.uint8)
     room[2:-2, 2:-2] = 254

@@ -52,6 +52,8 @@ BAD_ACTIONS = {
     "bool": lambda n: True,  # an int to Python, a bug in an agent
     "1-d array": lambda n: np.array([0]),
     "float array": lambda n: np.array(0.0),
+    "0-d object array": lambda n: np.array(0, dtype=object),  # Discrete.contains refuses it too: no integer dtype
+    "complex": lambda n: 1 + 0j,
 }
 
 
@@ -175,6 +177,53 @@ CASES = ([(env_id, k, v) for env_id in ENV_IDS for k, v in COMMON]
 def test_a_bad_constructor_argument_is_refused_naming_it(env_id, name, value):
     with refused(name):
         make(env_id, **{name: value})
+
+
+@pytest.mark.parametrize("env_id,name,value", [(DOORS, "success_bonus", 10**400), (DOORS, "max_distance", 10**400),
+                                                (GENERATED, "spacing", 10**400), (INDIRECT, "lattice", 10**400),
+                                                (DOORS, "window", 10**5000), (GENERATED, "first_building", -10**5000)],
+                         ids=lambda v: v.split("/")[-1] if isinstance(v, str) else f"{v.bit_length()} bits" if isinstance(v, int) else None)
+def test_an_integer_too_large_for_a_float_is_refused_naming_the_argument(env_id, name, value):
+    """An int past a float's range (10**400) was an OverflowError from math.isfinite, not the
+    argument's ValueError; one past 4,300 digits raised again in the message's repr."""
+    with refused(name) as e:
+        make(env_id, **{name: value})
+    assert "must be" in str(e.value)
+
+
+def _snapshot(u) -> tuple:
+    return (u.task, u.episode, u.repeat, u.state.steps, u.state.x, u.state.y, getattr(u, "building_seed", None),
+            u._np_random.bit_generator.state["state"]["state"], dict(u._reset_options))
+
+
+BAD_RESETS = [(dict(seed=5, options={"episode": 10**6}), "options['episode']"),
+              (dict(seed=5, options={"repeat": -1}), "options['repeat']"),
+              (dict(seed=5, options={"episode": 0, "repeat": "x"}), "options['repeat']")]
+
+
+@pytest.mark.parametrize("bad,name", BAD_RESETS, ids=[n for _, n in BAD_RESETS])
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_a_refused_reset_changes_nothing(env_id, mode, bad, name):
+    """A reset refused for one option leaves the environment as it was: its generator (it was
+    reseeded before the options were checked), and for the generated family its building and the
+    task its steps read (a building named with a bad episode was bound: a primitive step then read
+    the new building's map with the old episode's robot, and a pickled copy replayed another run)."""
+    env = make(env_id, action_mode=mode)
+    u = env.unwrapped
+    env.reset(seed=0, options={"building": 0} if env_id == GENERATED else None)
+    env.step(0)
+    before = _snapshot(u)
+    with refused(name):
+        env.reset(**bad)
+    if env_id == GENERATED:
+        with refused("options['episode']"):
+            env.reset(seed=5, options={"building": 1, "episode": 10**6})
+    assert _snapshot(u) == before
+    if u.outcome is None:
+        env.step(0)
+    copy = pickle.loads(pickle.dumps(env))
+    assert (copy.unwrapped.state.x, copy.unwrapped.state.y, copy.unwrapped.state.steps) == (u.state.x, u.state.y, u.state.steps)
 
 
 def test_the_generated_buildings_end_at_the_largest_seed():

@@ -79,8 +79,12 @@ def load_task(scenario: str | Path, kind: str) -> Task:
 
 # ---- checking what comes in: arguments, reset options, actions --------------------------------
 def _show(value) -> str:
-    """A value as a message quotes it (at most 60 characters)."""
-    text = repr(value)
+    """A value as a message quotes it (at most 60 characters; an int past Python's 4,300 digits
+    of text by its length: its repr raises)."""
+    try:
+        text = repr(value)
+    except ValueError:
+        return f"an integer of {value.bit_length()} bits" if isinstance(value, int) else f"a {type(value).__name__}"
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -90,8 +94,10 @@ def _num(x) -> str:
 
 
 def _scalar(value):
-    """A numpy scalar or 0-d array as the Python number it holds; anything else as it is."""
-    if isinstance(value, np.ndarray) and value.ndim == 0 or isinstance(value, np.generic):
+    """A numpy scalar or 0-d array of numbers (or bools) as the Python value it holds; anything
+    else as it is: a 0-d array of objects (``np.array(1, dtype=object)``) is no number, as
+    Gymnasium's ``Discrete.contains`` says, whatever it holds."""
+    if isinstance(value, (np.ndarray, np.generic)) and value.ndim == 0 and value.dtype.kind in "biufc":
         return value.item()
     return value
 
@@ -109,8 +115,8 @@ def check_number(name: str, value, lo: float | None = None, hi: float | None = N
     if integer:
         ok = isinstance(v, int) and not isinstance(v, bool)
         what = "an integer"
-    else:
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    else:  # an int is finite however large (math.isfinite(10**400) overflows converting it to a float)
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and (isinstance(v, int) or math.isfinite(v))
         what = "a finite number"
     u = f" {unit}" if unit else ""
     if lo is not None and hi is not None:
@@ -282,17 +288,30 @@ class SearchEnv(gym.Env):
         self._actions: list = []  # since the last reset: a pickled environment replays them
 
     # ---- gymnasium --------------------------------------------------------------------
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
+    def check_reset(self, seed, options, task: Task | None = None) -> tuple[int | None, dict]:
+        """``reset``'s ``seed`` and ``options`` checked, every one, before anything changes (a
+        refused reset leaves the environment, its generator too, as it was): the seed, the keys,
+        ``options['episode']`` against ``task``'s episodes (the environment's own by default) and
+        ``options['repeat']``. Returns the seed (an int or None) and the options as a dict, the
+        episode and the repeat given as ints."""
         seed = None if seed is None else check_number("seed", seed, 0, integer=True)
         options = check_options(options, self.reset_keys)
+        eps = (task or self.task).episodes
+        if options.get("episode") is not None:
+            options["episode"] = check_number("options['episode']", options["episode"], 0, len(eps) - 1, integer=True,
+                                              note=f"the scenario has {len(eps)} episodes")
+        if options.get("repeat") is not None:
+            options["repeat"] = check_number("options['repeat']", options["repeat"], 0, MAX_REPEAT, integer=True)
+        return seed, options
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        seed, options = self.check_reset(seed, options)
         super().reset(seed=seed)
         eps = self.task.episodes
         k = options.get("episode")
-        k = int(self.np_random.integers(len(eps))) if k is None else check_number(
-            "options['episode']", k, 0, len(eps) - 1, integer=True, note=f"the scenario has {len(eps)} episodes")
+        k = int(self.np_random.integers(len(eps))) if k is None else k
         s = options.get("repeat")
-        self.repeat = int(self.np_random.integers(2**31 - 1)) if s is None else check_number(
-            "options['repeat']", s, 0, MAX_REPEAT, integer=True)
+        self.repeat = int(self.np_random.integers(2**31 - 1)) if s is None else s
         self.episode = eps[k]
         self.outcome = None
         self._reset_options = {"episode": k, "repeat": self.repeat}

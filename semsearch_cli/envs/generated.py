@@ -18,6 +18,7 @@ with that ``first_building`` to run it.
 
 from __future__ import annotations
 
+import copy
 import os
 import shutil
 import tempfile
@@ -78,15 +79,25 @@ class GeneratedDoorSearchEnv(DoorSearchEnv):
         self.building_seed = self.first
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        # everything checked before anything changes: a refused reset (a building outside the
+        # range, an episode the building has not) leaves the environment as it was, its generator,
+        # its building and the task its steps read (a primitive step read the new building's map
+        # with the old episode's robot)
         options = check_options(options, self.reset_keys)
-        if seed is not None:  # seed the generator here: the building is drawn before the episode
-            seed = check_number("seed", seed, 0, integer=True)
-            self._np_random, self._np_random_seed = seeding.np_random(seed)
+        seed = None if seed is None else check_number("seed", seed, 0, integer=True)
         b = options.pop("building", None)
         last = self.first + self.buildings - 1
-        self.building_seed = self.first + int(self.np_random.integers(self.buildings)) if b is None else check_number(
-            "options['building']", b, self.first, last, integer=True, note="this environment's buildings")
-        self.bind(load_task(building(self.layout, self.numbering, self.building_seed, self.spacing), self.kind))
+        if b is not None:
+            b = check_number("options['building']", b, self.first, last, integer=True, note="this environment's buildings")
+        # the generator the reset draws from, committed only once every option is checked: seeded
+        # here (the building is drawn before the episode), else a copy of the environment's own
+        rng, rng_seed = seeding.np_random(seed) if seed is not None else (copy.deepcopy(self.np_random), self._np_random_seed)
+        b = self.first + int(rng.integers(self.buildings)) if b is None else b
+        task = load_task(building(self.layout, self.numbering, b, self.spacing), self.kind)
+        _, options = self.check_reset(None, options, task)
+        self._np_random, self._np_random_seed = rng, rng_seed
+        self.building_seed = b
+        self.bind(task)
         obs, info = super().reset(options=options)
         self._reset_options = {**self._reset_options, "building": self.building_seed}
         return obs, info

@@ -325,12 +325,22 @@ def check_planner_class(cls: type[Planner]) -> None:
     if doc is not None and not isinstance(doc, str):
         _refuse(cls, "__doc__", f"__doc__ = {_short(doc)}: a planner's description (what `semsearch planners` lists) is "
                 "text (its docstring) or None")
+    columns = getattr(cls, "cost_columns", ())
+    if isinstance(columns, (tuple, list)):
+        for c in columns:  # a row column of another name: the batch wrote it, then refused its own runs.csv
+            if c not in COST_COLUMNS:
+                _refuse(cls, "cost_columns", f"cost_columns holds {_short(c)}, not a cost column of the rows"
+                        f"{did_you_mean(c, COST_COLUMNS) if isinstance(c, str) else ''} (they are {', '.join(COST_COLUMNS)})")
     fields = params.model_fields
     if all(not f.is_required() for f in fields.values()):
         # the defaults, validated (pydantic takes a default as it is: a run would use one that
-        # breaks its own field's bounds, and a validator that raises, unseen until a scenario sets it)
-        defaults = {f.alias or k: f.default for k, f in fields.items() if f.default_factory is None}
+        # breaks its own field's bounds, and a validator that raises, unseen until a scenario sets it),
+        # a default_factory's too (it was left out: Field(default_factory=lambda: -5, ge=0) ran with -5)
         try:
+            defaults = {f.alias or k: f.get_default(call_default_factory=True) for k, f in fields.items()}
+            for k, v in defaults.items():
+                if isinstance(v, float) and not math.isfinite(v):  # as a scenario's value is refused (check_params)
+                    _refuse(cls, "Params", f"its parameters' defaults are not valid ({k}: {v!r}, not a finite number)")
             params.model_validate(defaults)
         except ValidationError as exc:
             e = exc.errors()[0]
@@ -353,7 +363,13 @@ def check_planner_class(cls: type[Planner]) -> None:
 
 
 def _finite_number(v) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+    """A real number a float holds (an int of 10**400 is not one: math.isfinite overflowed on it)."""
+    if not isinstance(v, numbers.Real) or isinstance(v, bool):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except OverflowError:
+        return False
 
 
 def _type_fault(value, hint) -> str | None:
@@ -373,7 +389,8 @@ def _type_fault(value, hint) -> str | None:
     if hint is bool:
         return None if isinstance(value, (bool, np.bool_)) else "True or False"
     if hint in (int, float):
-        return None if _finite_number(value) and (hint is float or float(value).is_integer()) else (
+        return None if _finite_number(value) and (hint is float or isinstance(value, numbers.Integral)
+                                                  or float(value).is_integer()) else (
             "a finite number" if hint is float else "a whole number")
     if hint is str:
         return None if isinstance(value, str) else "text"
@@ -531,8 +548,8 @@ def load_planner_file(path: str | Path) -> list[str]:
         raise
     except SyntaxError as exc:
         forget()
-        if exc.filename is None or _same_file(exc.filename, key):
-            raise ScenarioError(key, f"line {exc.lineno}", f"not valid Python: {exc.msg}") from None
+        if exc.filename is None or _same_file(exc.filename, key):  # no line for a file holding a NUL byte ('line None')
+            raise ScenarioError(key, f"line {exc.lineno}" if exc.lineno else "", f"not valid Python: {exc.msg}") from None
         line = _user_line(exc, key)  # a module the file imports
         raise ScenarioError(key, f"line {line}" if line is not None else "", f"imports a file that is not valid "
                             f"Python: {exc.msg} (line {exc.lineno} of {exc.filename})") from None
@@ -658,6 +675,14 @@ def check_params(cls: type[Planner], name: str, params: dict) -> tuple[str, str]
         if secret:
             return k, f"{param_entry(name, k, v)}: {k} holds {secret}: {WHERE_THE_KEY_GOES}"
     fields = cls.Params.model_fields
+    if cls.Params.model_config.get("extra") != "allow":
+        # a key the model does not take: a model that forbids extras says so below, but pydantic's
+        # default ignores them, so that a user's planner ran with its default for a misspelt key
+        known = set(fields) | {f.alias for f in fields.values() if f.alias}
+        for k in params:
+            if k not in known:
+                return k, (f"{param_entry(name, k, params.get(k))}: {name!r} has no parameter {k!r}"
+                           f"{did_you_mean(k, fields)}; {_parameters(cls)}")
     for k, v in params.items():
         if (isinstance(v, float) or (isinstance(v, str) and k in fields and _takes_number(fields[k].annotation))) \
                 and not _finite_text(v):

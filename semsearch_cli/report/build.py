@@ -32,6 +32,7 @@ from .sections import SECTIONS, replaying
 from .stats import episodes
 from .tables import cost_table, goal_key, planner_order
 from .document import Code, Document, atomic_text
+from .runfiles import same_goal
 
 ABSOLUTE = re.compile(r"(?<![\w.])/[^\s:;,()'\"]+")  # an absolute path in a message (a report names none)
 ALL_FORMATS = ("md", "csv", "png", "pdf", "svg", "html")  # png, pdf, svg: every figure (GIF replays stay GIF)
@@ -59,14 +60,7 @@ def parse_replay(text: str) -> ReplayChoice:
     return ReplayChoice(parts[0], parts[1], int(parts[2]), int(parts[3]))
 
 
-def _same_goal(a, b) -> bool:
-    """Goals as written on the command line and as read from runs.csv (1.5 and 1.50 are one view scale)."""
-    if str(a) == str(b):
-        return True
-    try:
-        return float(a) == float(b)
-    except (TypeError, ValueError):
-        return False
+_same_goal = same_goal  # the check and the sections match a --replay goal one way (report/runfiles.py)
 
 
 def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
@@ -259,6 +253,13 @@ def build_report(folders: list[Path], out: Path | None = None, formats=ALL_FORMA
         replay = parse_replay(replay)
     t0 = time.perf_counter()
     folders = [Path(f) for f in folders]
+    seen: dict = {}
+    for f in folders:  # the same folder twice counted its rows twice, in every table and test
+        key = f.resolve()
+        if key in seen:
+            raise ScenarioError("<command line>", "FOLDERS", f"{f} is given twice (as {seen[key]} too): its rows would "
+                                "count twice; give each results folder once")
+        seen[key] = f
     out = Path(out) if out is not None else folders[0] if len(folders) == 1 else Path("results") / "report"
     parts_by_kind: dict[str, list[Part]] = {}
     metas = {str(f): read_meta(f) for f in folders}

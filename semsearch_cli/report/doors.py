@@ -17,7 +17,8 @@ from .figures.common import episode_mean, image_formats, planner_colors
 from .figures.distances import budget_curve, plot_alpha_sweep, plot_boxes, plot_budget, swept_values
 from .figures.paths import plot_path_panels, plot_scenario
 from .figures.replay import animate_run
-from .runfiles import load_paths, median_label, median_panel, replay_frames, row_variant, safe_name, start_points, stems
+from .runfiles import (load_paths, median_label, median_panel, replay_frames, row_variant, safe_name, same_goal, start_points,
+                       stems)
 from .tables import goal_key
 
 
@@ -164,7 +165,9 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
             return
         row = sub.loc[median_label(sub)]
     else:
-        m = (runs["planner"] == choice.planner) & (runs["goal"].astype(str) == str(choice.goal)) & \
+        # the goal matched as check_replay matched it (--replay greedy,304.0,0,0 is the run of goal 304:
+        # it was checked to be there, then not drawn, without a word)
+        m = (runs["planner"] == choice.planner) & runs["goal"].map(lambda g: same_goal(g, choice.goal)) & \
             (ep == choice.episode) & (runs["seed"].astype(int) == choice.seed)
         if not m.any():
             return  # the run is in another folder of this report
@@ -175,7 +178,9 @@ def _replay(doc, loaded, folder, runs, fdir, order, choice=True) -> None:
         return
     frames, how = replay_frames(folder, label, goal, seed, episode,
                                 lambda watch: _rerun(loaded.task, variant, goal, episode, seed, watch),
-                                failed=row["outcome"] == "error")
+                                failed=row["outcome"] == "error",
+                                expect={"kind": "doors", "signs": len(w.signs),
+                                        "map_shape": ((w.frame.height + 1) // 2, (w.frame.width + 1) // 2)})
     if not frames:
         return
     signs = w.signs

@@ -275,7 +275,8 @@ def _replay(doc: Document, part, runs: pd.DataFrame, fdir: Path, notes: list, ch
         return
     ep_run = _episode_of(loaded.task, scale, episode)
     frames, how = replay_frames(part.folder, label, row["goal"], seed, episode,
-                                lambda watch: loaded.task.run(variant, ep_run, seed, watch), failed=row["outcome"] == "error")
+                                lambda watch: loaded.task.run(variant, ep_run, seed, watch), failed=row["outcome"] == "error",
+                                expect={"kind": "indirect"})
     room = loaded.task.grids[ep_run.room].room
     if not frames:
         return

@@ -31,6 +31,17 @@ def stems(planner: str, goal, seed: int, episode: int = 0) -> list[str]:
     return [s for s in (new, old) if s] if new != old else [old]
 
 
+def same_goal(a, b) -> bool:
+    """Goals as written on the command line and as read from runs.csv (1.5 and 1.50 are one view
+    scale; 304.0 is the goal 304), as ``--replay`` is checked and as its section finds the run."""
+    if str(a) == str(b):
+        return True
+    try:
+        return float(a) == float(b)
+    except (TypeError, ValueError, OverflowError):
+        return False
+
+
 def path_file(folder: Path, planner: str, goal, seed: int, episode: int = 0) -> Path | None:
     """The path file of one run, or None when there is none."""
     for stem in stems(planner, goal, seed, episode):
@@ -107,18 +118,21 @@ def start_points(rows: pd.DataFrame, world) -> list[tuple[float, float]]:
 REPLAY_FRAMES = 60  # at most this many frames in a replay
 
 
-def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rerun, failed: bool = False) -> tuple[list[dict], str]:
+def replay_frames(folder: Path, planner: str, goal, seed: int, episode: int, rerun, failed: bool = False,
+                  expect: dict | None = None) -> tuple[list[dict], str]:
     """A run's replay frames (at most :data:`REPLAY_FRAMES`, evenly spaced): read from
     ``frames/<run>.npz`` when ``semsearch run --frames`` recorded them, else by ``rerun(observer)``
     (re-simulating the run, which is deterministic, with a :class:`FrameRecorder` watching).
     Returns (frames, "recorded" or "re-simulated"); a run whose planner raised (``failed``: its row's
     outcome is ``error``) is re-simulated up to the error, which ``how`` names. A run of a planner
     that answers through a service (a language model: ``Planner.service``) is never re-simulated,
-    which would call the model: without recorded frames, no frames."""
+    which would call the model: without recorded frames, no frames. ``expect``: what recorded
+    frames must agree with, :func:`~semsearch_cli.runner.store.read_frames`' ``kind``, ``signs``
+    and ``map_shape`` (the run's search, its scenario's signs and grid)."""
     for stem in stems(planner, goal, seed, episode):
         f = Path(folder) / "frames" / f"{stem}.npz"
         if f.is_file():
-            frames, how = read_frames(f), "recorded"
+            frames, how = read_frames(f, **(expect or {})), "recorded"
             break
     else:
         cls = planner_named(planner)

@@ -361,6 +361,34 @@ _POINTS = {"target", "goal"}  # one (x, y) m
 # what a frame holds (tasks' Event.frame), name -> dimensions: a door search's, an indirect search's
 FRAME_KINDS = ({"map": 2, "path": 2, "distance": 0, "cands": 2, "target": 1, "read": 1},
                {"p": 2, "p0": 0, "trail": 2, "t": 0, "goal": 1, "seen_names": 1, "seen_xy": 2})
+FRAME_KIND_NAMES = ("doors", "indirect")  # FRAME_KINDS' searches, in order (a message says "a door search's")
+_ARTICLE = {"doors": "a door", "indirect": "an indirect"}
+
+
+def _frame_value_fault(name: str, v: np.ndarray, signs: int | None, map_shape: tuple | None) -> str | None:
+    """What is wrong with the values of a frame's array ``name`` (:func:`read_frames`), or None."""
+    if v.dtype.kind == "f" and not np.isfinite(v).all():
+        return "a value that is not a finite number (NaN or infinity)"
+    if name in ("path", "trail") and v.shape[0] == 0:
+        return f"a {name} of no pose (it holds the robot's poses so far, the first at its start)"
+    if name in ("distance", "t") and float(v) < 0:
+        return f"{name} {float(v):g} below 0"
+    if name in ("p", "p0") and v.size and not (0.0 <= float(v.min()) and float(v.max()) <= 1.0):
+        return "a probability outside [0, 1]"
+    if name == "map":
+        if v.dtype.kind not in "iu" or (v.size and not (0 <= int(v.min()) and int(v.max()) <= 2)):
+            return "a map holds whole numbers 0 (occupied), 1 (unknown) and 2 (free)"
+        if map_shape is not None and tuple(v.shape) != tuple(map_shape):
+            return (f"a map of {v.shape[0]} x {v.shape[1]} cells, not the run's {map_shape[0]} x {map_shape[1]} (its grid, "
+                    "every second cell): the frames of another scenario")
+    if name == "read" and v.size:
+        if v.dtype.kind not in "iu":
+            return f"the signs read are indices, whole numbers, not {v.dtype}"
+        top = signs - 1 if signs is not None else None
+        if int(v.min()) < 0 or (top is not None and int(v.max()) > top):
+            return (f"a sign index {int(v.min()) if int(v.min()) < 0 else int(v.max())} outside 0 to {top} (the scenario's "
+                    f"{signs} signs)" if top is not None else f"a sign index {int(v.min())} below 0")
+    return None
 
 
 def read_npz(path: Path, what: str) -> dict[str, np.ndarray]:
@@ -393,11 +421,17 @@ def read_npz(path: Path, what: str) -> dict[str, np.ndarray]:
     return out
 
 
-def read_frames(path: Path) -> list[dict]:
+def read_frames(path: Path, kind: str | None = None, signs: int | None = None, map_shape: tuple | None = None) -> list[dict]:
     """The frames :func:`write_frames` wrote, as the replay draws them, read by :func:`read_npz`
     and checked: a frame count ``n`` of at most :data:`MAX_FRAMES`, keys ``<frame>/<name>`` of a
-    frame below ``n``, (x, y) arrays of two columns; a :class:`ScenarioError` naming the file and
-    the key otherwise."""
+    frame below ``n``, (x, y) arrays of two columns, finite numbers, a path (a trail) of one pose
+    at least, a distance and a time of at least 0, a map of 0, 1 and 2 and probabilities in
+    [0, 1]; with ``kind`` (``"doors"`` or ``"indirect"``, :data:`FRAME_KIND_NAMES`) every frame
+    of that kind's, with ``signs`` the signs read (``read``) whole numbers from 0 to
+    ``signs`` - 1 (indices into the world's signs), with ``map_shape`` each map of that shape (the
+    run's grid, every second cell). A :class:`ScenarioError` naming the file and the key
+    otherwise: a replay drew a damaged file's values (an index past the signs, an empty path)
+    into a traceback, or a run of another kind or scenario without a word."""
     arrays = read_npz(path, "replay frames file")
 
     def bad(field: str, why: str) -> ScenarioError:
@@ -407,6 +441,9 @@ def read_frames(path: Path) -> list[dict]:
     if n is None or n.shape != () or n.dtype.kind not in "iu" or not 0 <= int(n) <= MAX_FRAMES:
         raise bad("n", f"the frame count must be a whole number from 0 to {MAX_FRAMES:,}, got "
                   f"{'nothing' if n is None else n.ravel()[:3].tolist()}")
+    if kind is not None and kind not in FRAME_KIND_NAMES:
+        raise ValueError(f"kind must be one of {', '.join(FRAME_KIND_NAMES)}, not {kind!r}")
+    kind_name, want = kind, None if kind is None else FRAME_KINDS[FRAME_KIND_NAMES.index(kind)]
     frames = [dict() for _ in range(int(n))]
     for key, v in arrays.items():
         m = _KEY.fullmatch(key)
@@ -423,9 +460,16 @@ def read_frames(path: Path) -> list[dict]:
         if kind is None:
             raise bad(f"{k}/", f"frame {k} holds {', '.join(sorted(f)) or 'nothing'}; a frame holds "
                       + " or ".join(", ".join(d) for d in FRAME_KINDS))
+        if want is not None and kind is not want:
+            raise bad(f"{k}/", f"frame {k} is {_ARTICLE[FRAME_KIND_NAMES[FRAME_KINDS.index(kind)]]} search's "
+                      f"({', '.join(sorted(f))}), not {_ARTICLE[kind_name]} search's ({', '.join(want)}): the frames of "
+                      "another run")
         for name, v in f.items():
             if v.ndim != kind[name] and v.size:
                 raise bad(f"{k}/{name}", f"{kind[name]} dimension(s) expected, got an array of shape {v.shape}")
+            fault = _frame_value_fault(name, v, signs, map_shape)
+            if fault:
+                raise bad(f"{k}/{name}", fault)
     for f in frames:
         if "seen_names" in f:
             f["seen"] = {str(c): tuple(float(u) for u in xy) for c, xy in zip(f.pop("seen_names"), f.pop("seen_xy", ()))}

@@ -466,6 +466,9 @@ class OnMapTask(Task):
                 eps = self.draw_episodes(spec)
         goals = [self.check_episode_goal(e) for e in eps]
         for e in eps:
+            if e.get("room") is not None:  # an indirect search's column: here it was dropped without a word
+                raise ScenarioError(e["file"], f"{e['field']} room", f"a {self.sc.kind} scenario's episodes have no room "
+                                    f"(the column is an indirect search's), got {str(e['room'])[:40]!r}; leave it empty")
             r, c = w.frame.to_index(e["x"], e["y"])
             if not (0 <= r < w.reach.shape[0] and 0 <= c < w.reach.shape[1] and w.reach[r, c]):
                 raise ScenarioError(e["file"], e["field"], f"the start ({e['x']:g}, {e['y']:g}) m is not free space "

@@ -36,6 +36,7 @@ import hashlib
 import io
 import json
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,10 +44,11 @@ import cv2
 import numpy as np
 
 from ..config.base import MAX_EPISODES, EpisodesSpec, label_column, number_text, sign_label
-from ..errors import ScenarioError
+from ..errors import ScenarioError, did_you_mean
 from ..files import read_user_text
 
 EPISODE_COLUMNS = ["episode", "goal", "start_x", "start_y", "start_heading", "room", "shortest_m", "hash"]
+MAX_HEADING = 3600.0  # degrees either way, as a scenario's start and episodes.list take a heading (config.base.Angle)
 
 
 @dataclass(frozen=True)
@@ -146,25 +148,64 @@ def read_episodes_csv(path: Path, owner: str) -> list[dict]:
                                     "of an episode set (docs/usage.md, Limits); split the set into several scenarios")
     except csv.Error as exc:
         raise ScenarioError(str(path), f"line {reader.line_num}", f"not a CSV file semsearch can read ({exc})") from None
-    need = {"goal", "start_x", "start_y"}
-    if not rows or not need <= set(reader.fieldnames or ()):
+    need = ["goal", "start_x", "start_y"]
+    header = list(reader.fieldnames or ())
+    missing = [c for c in need if c not in header]
+    if not rows or missing:
+        # the columns named: a header "Goal" or " start_x" (a space after the comma), a file of
+        # semicolons, was "expected a CSV with columns ..." naming none of them
+        near = "".join(f"; no column {c}{did_you_mean(c, header)}" for c in missing)
+        one = header[0] if len(header) == 1 else ""
+        sep = next((ch for ch in ";\t|" if ch in one), None)
         raise ScenarioError(str(path), "", "expected a CSV with columns goal, start_x, start_y[, start_heading] "
-                            "(as semsearch episodes writes), with at least one row")
+                            "(as semsearch episodes writes), with at least one row"
+                            + (f"{near}; the header holds {', '.join(repr(h) for h in header[:8])}" if header and missing else "")
+                            + (f" (a file separated by {sep!r}? columns are separated by commas)" if sep else ""))
+    # a column semsearch episodes does not write is refused, as in runs.csv: a misspelt
+    # start_headng was dropped without a word, and every start's heading drawn at random
+    for c in header:
+        if c not in EPISODE_COLUMNS:
+            raise ScenarioError(str(path), c or "line 1", f"a column semsearch episodes does not write{did_you_mean(c, EPISODE_COLUMNS)}"
+                                f"; the columns are {', '.join(EPISODE_COLUMNS)} (goal, start_x and start_y needed)")
+    if len(set(header)) != len(header):
+        twice = next(c for c in header if header.count(c) > 1)
+        raise ScenarioError(str(path), twice, f"the column {twice} is given twice in the header (line 1)")
     out = []
+    ids: dict[int, int] = {}  # the episode column's numbers -> the line that gives each
     for k, r in rows:
         if None in r:
             raise ScenarioError(str(path), f"line {k}", f"{len(r[None]) + len(reader.fieldnames)} fields where the header "
                                 f"has {len(reader.fieldnames)} ({', '.join(reader.fieldnames)})")
-        try:
-            x, y = number_text(r["start_x"]), number_text(r["start_y"])
-            h = (r.get("start_heading") or "").strip()
-            heading = None if h in ("", "random") else number_text(h)
-            room = (r.get("room") or "").strip()
-        except (TypeError, ValueError):
-            raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be numbers "
-                                "(start_heading may be empty: drawn at each repeat)") from None
-        if not all(math.isfinite(v) for v in (x, y) + (() if heading is None else (heading,))):
-            raise ScenarioError(str(path), f"line {k}", "start_x, start_y and start_heading must be finite")
+        values = {}
+        for col in ("start_x", "start_y", "start_heading"):  # each named where it is wrong: line 2 start_heading
+            text = (r.get(col) or "").strip()
+            if col == "start_heading" and text in ("", "random"):
+                values[col] = None
+                continue
+            try:
+                v = number_text(text)
+            except (TypeError, ValueError):
+                raise ScenarioError(str(path), f"line {k} {col}", f"{col} must be a number, not {text[:40]!r}"
+                                    + (" (start_heading may be empty or random: drawn at each repeat)"
+                                       if col == "start_heading" else "")) from None
+            if not math.isfinite(v):
+                raise ScenarioError(str(path), f"line {k} {col}", f"{col} must be finite, not {text[:40]!r}")
+            if col == "start_heading" and abs(v) > MAX_HEADING:  # as episodes.list and start.heading bound it
+                raise ScenarioError(str(path), f"line {k} {col}", f"start_heading must lie in -{MAX_HEADING:g} to "
+                                    f"{MAX_HEADING:g} degrees, not {text[:40]}")
+            values[col] = v
+        x, y, heading = values["start_x"], values["start_y"], values["start_heading"]
+        room = (r.get("room") or "").strip()
+        given_id = (r.get("episode") or "").strip()
+        if given_id:  # semsearch episodes numbers its rows 0, 1, ...: a number given twice is two rows claiming one episode
+            if not re.fullmatch(r"[0-9]{1,9}", given_id, re.ASCII):
+                raise ScenarioError(str(path), f"line {k} episode", f"the episode column holds whole numbers (as "
+                                    f"semsearch episodes writes: 0, 1, ...), not {given_id[:40]!r}; or leave it empty")
+            if int(given_id) in ids:
+                raise ScenarioError(str(path), f"line {k} episode", f"episode {int(given_id)} is given twice (lines "
+                                    f"{ids[int(given_id)]} and {k}); each row is one episode: renumber them, or clear "
+                                    "the column")
+            ids[int(given_id)] = k
         out.append({"goal": (r["goal"] or "").strip(), "x": x, "y": y, "heading": heading, "room": room or None,
                     "hash": (r.get("hash") or "").strip() or None, "file": str(path), "field": f"line {k}"})
     for e in out:
