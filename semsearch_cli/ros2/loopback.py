@@ -83,7 +83,10 @@ class Rosbridge:
         return self
 
     async def _open(self):
-        self._server = await ws_server.serve(self._client, self.host, self.port, max_size=None)
+        # close_timeout 1 s (websockets' default is 10): a stand-in that is stopped closes its
+        # connections at once rather than waiting on a client that has gone (the tests stop it
+        # under load, where ten seconds per connection was more than they waited)
+        self._server = await ws_server.serve(self._client, self.host, self.port, max_size=None, close_timeout=1)
         self.port = self._server.sockets[0].getsockname()[1]
 
     def stop(self) -> None:
