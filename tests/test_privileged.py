@@ -12,6 +12,10 @@ import pytest
 import scipy.stats
 
 from semsearch_cli import api
+from semsearch_cli.belief import DoorBelief
+from semsearch_cli.config import BeliefSpec
+from semsearch_cli.geometry import GridFrame
+from semsearch_cli.planners.doors.oracle import OracleGoal, OracleParams
 from semsearch_cli.bench.board import load, tables
 from semsearch_cli.planners import PLANNERS
 from semsearch_cli.report.stats import ratio_ci
@@ -111,3 +115,23 @@ def test_the_gap_closed_interval_is_scipys_paired_bca_of_the_ratio_of_means(seed
     assert (lo, hi) == pytest.approx((ref.low, ref.high), rel=1e-9)
     assert ratio_ci([1.0], [2.0])[0] == 0.5 and np.isnan(ratio_ci([1.0], [2.0])[1])
     assert np.isnan(ratio_ci([1.0, -1.0], [1.0, -1.0])[0])  # a gap of 0: no share of it
+
+
+def test_the_oracle_measures_the_rest_of_the_way_around_a_wall_it_has_seen():
+    """beyond=unknown: the way from a cell to the goal goes round the walls the robot has seen and
+    through what it has not; beyond=line: the straight line, through the wall."""
+    H, W = 40, 60
+    b = DoorBelief(GridFrame(0.1, 0.0, 0.0, H, W), BeliefSpec(), robot_radius=0.05)
+    b.seen[:] = True
+    wall = np.zeros((H, W), bool)
+    wall[:30, 30] = True  # a wall from the top down to row 30, seen; open below it
+    b.cv[wall] = 10
+    b.refresh_free(np.array([0, H - 1, 0, W - 1]))
+    goal = np.array([[b.frame.to_world(10, 45)[0], b.frame.to_world(10, 45)[1]]])
+    rows, cols = np.array([10]), np.array([15])
+    line = OracleGoal(OracleParams(beyond="line")).rest(b, goal, rows, cols)[0]
+    around = OracleGoal(OracleParams()).rest(b, goal, rows, cols)[0]
+    assert line == pytest.approx(3.0, abs=0.01)  # 30 cells at 0.1 m, through the wall
+    assert around > line + 2.0  # down past row 30 and back up
+    b.seen[:, 25:] = False  # the wall not seen yet: the unknown taken as free, straight through
+    assert OracleGoal(OracleParams()).rest(b, goal, rows, cols)[0] == pytest.approx(line, abs=0.05)

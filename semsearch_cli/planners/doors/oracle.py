@@ -8,8 +8,11 @@ frontier candidate ``c`` that minimises
     D(c) + E(c),
 
 ``D(c)`` the robot's path to ``c`` along the skeleton of the map built so far (m) and ``E(c)`` the
-straight line from ``c`` to the nearest sign carrying the goal's label (m): the frontier through
-which the goal looks nearest, with what lies past the frontier unknown. It explores as greedy does
+rest of the way from ``c`` to the nearest sign carrying the goal's label (m): the frontier through
+which the goal looks nearest, with what lies past the frontier unknown. ``beyond`` says how that
+rest is measured: ``unknown`` (the default), the shortest path through every cell not known to be
+a wall (the unknown taken as free, the known walls kept: the goal behind a wall seen already is
+not near); ``line``, the straight line (the planner the issue that asked for it measured). It explores as greedy does
 (the same candidates, the same navigator, the same completeness sweep when no frontier is left), so
 the difference between the two is what knowing the goal's position is worth, and the share of that
 difference a planner recovers from the signs it reads is the board's "gap closed".
@@ -17,10 +20,21 @@ difference a planner recovers from the signs it reads is the board's "gap closed
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
 
 from ...errors import PlannerError
+from ...kernels.grid import GridSearch
 from ..base import Decision, DoorPlanner, register_planner
+
+
+class OracleParams(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    beyond: Literal["unknown", "line"] = Field("unknown", description="the way from a frontier to the goal: unknown: "
+                                               "the shortest path through every cell not known to be a wall; line: the "
+                                               "straight line")
 
 
 @register_planner("oracle_goal")
@@ -30,6 +44,29 @@ class OracleGoal(DoorPlanner):
 
     rank = 90
     privileged = "the goal sign's position (x, y), not the map"
+    Params = OracleParams
+
+    def __init__(self, params):
+        super().__init__(params)
+        self._gs = None  # the search from the goal (beyond: unknown), kept between re-plans
+        self._one = None
+
+    def rest(self, b, goals: np.ndarray, rows, cols) -> np.ndarray:
+        """The way (m) from each cell (rows, cols) to the nearest goal: the straight line, or the
+        shortest path through the cells not known to be walls (``beyond``); inf where none."""
+        fr = b.frame
+        x, y = fr.to_world(rows, cols)
+        if self.params.beyond == "line":
+            return np.hypot(x[:, None] - goals[None, :, 0], y[:, None] - goals[None, :, 1]).min(axis=1)
+        H, W = b.free.shape
+        if self._gs is None or self._gs.shape != (H, W):
+            self._gs, self._one = GridSearch((H, W)), np.ones((H, W), np.float32)
+        gr, gc = fr.to_index(goals[:, 0], goals[:, 1])
+        gr, gc = np.clip(np.atleast_1d(gr), 0, H - 1), np.clip(np.atleast_1d(gc), 0, W - 1)
+        open_ = ~(b.seen & ~b.free)  # free or unknown
+        open_[gr, gc] = True  # the sign's cell, on its wall
+        self._gs.run(open_, self._one, gr, gc, rows, cols, 0)
+        return self._gs.lengths(rows, cols) * fr.res
 
     def choose(self, ctx, cands):
         if len(cands) == 0:
@@ -40,9 +77,7 @@ class OracleGoal(DoorPlanner):
         b = ctx.belief
         gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, len(cands))
         d = gs.lengths(cands.rows, cands.cols) * b.frame.res
-        x, y = b.frame.to_world(cands.rows, cands.cols)
-        goals = np.asarray(ctx.told.goal_xy, float)
-        e = np.hypot(x[:, None] - goals[None, :, 0], y[:, None] - goals[None, :, 1]).min(axis=1)
+        e = self.rest(b, np.asarray(ctx.told.goal_xy, float).reshape(-1, 2), cands.rows, cands.cols)
         score = d + e
         if not np.isfinite(score).any():
             return None
