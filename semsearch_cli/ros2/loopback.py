@@ -25,6 +25,7 @@ run of ``semsearch run`` for the same goal, episode and seed, so the two can be 
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import json
 import threading
 
@@ -101,9 +102,12 @@ class Rosbridge:
             self._server.close()
             await self._server.wait_closed()
         if self._server is not None:
-            asyncio.run_coroutine_threadsafe(close(), self.loop).result(10)
+            try:  # bounded: a stand-in stopped on a loaded machine ends within seconds, its loop stopped either way
+                asyncio.run_coroutine_threadsafe(close(), self.loop).result(5)
+            except (TimeoutError, concurrent.futures.TimeoutError, concurrent.futures.CancelledError):
+                pass
         self.loop.call_soon_threadsafe(self.loop.stop)
-        self._thread.join(10)
+        self._thread.join(5)
 
     def call(self, fn, *args) -> None:
         """Run ``fn(*args)`` on the server's loop (from another thread)."""

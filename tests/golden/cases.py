@@ -39,6 +39,6 @@ def golden_rows(out: Path) -> pd.DataFrame:
         specs = [RunSpec(L.task.episodes[k], v, s) for v in planners(kind) for k in episodes for s in repeats]
         run_batch(L, specs, out / config, BatchOptions(workers=1))
         frames.append(pd.read_csv(out / config / "runs.csv", dtype=str, keep_default_na=False))
-    rows = pd.concat(frames, ignore_index=True).drop(columns=list(IGNORED))
+    rows = pd.concat(frames, ignore_index=True).drop(columns=list(IGNORED)).fillna("")  # a column one folder lacks: empty, as the CSV reads it
     key = ["scenario", "planner", "goal", "episode", "seed", "stage"]
     return rows.sort_values(key, kind="stable").reset_index(drop=True)
