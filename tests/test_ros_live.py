@@ -116,8 +116,8 @@ def test_the_command_line_finds_the_goal_and_a_failing_run_leaves_a_repro_bag_th
     found. A run stopped by its budget exits 1 and leaves a repro bag (map, pose, detections, goal
     ends) of a few kilobytes, which `ros replay` runs to the live run's decisions."""
     port = free_port()
-    sim = subprocess.Popen([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "ros", "sim",
-                            str(demo_dir / "scenario.yaml"), "--goal", "304", "--port", str(port), "--period", str(PERIOD)],
+    sim = subprocess.Popen([sys.executable, "-X", "faulthandler", "-c", "from semsearch_cli.cli import main; main()", "ros",
+                            "sim", str(demo_dir / "scenario.yaml"), "--goal", "304", "--port", str(port), "--period", str(PERIOD)],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert select.select([sim.stdout], [], [], 60)[0], "ros sim said nothing in 60 s"
@@ -127,7 +127,12 @@ def test_the_command_line_finds_the_goal_and_a_failing_run_leaves_a_repro_bag_th
                                      "304", "--repro", str(tmp_path / "ok")])
     finally:
         sim.send_signal(signal.SIGINT)
-        rest, _ = sim.communicate(timeout=30)
+        try:
+            rest, _ = sim.communicate(timeout=30)
+        except subprocess.TimeoutExpired:  # where it is stuck: faulthandler writes every thread's stack on SIGABRT
+            sim.send_signal(signal.SIGABRT)
+            _, err = sim.communicate(timeout=30)
+            raise AssertionError(f"ros sim still running 30 s after SIGINT; its threads:\n{err}") from None
     assert r.exit_code == 0, r.output
     assert "found: read the goal's sign; " in r.output and "repro" not in r.output and not (tmp_path / "ok").exists()
     run = demo_loaded.task.run(Variant("greedy", ()), "304", 0)
