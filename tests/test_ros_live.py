@@ -118,7 +118,11 @@ def test_the_command_line_finds_the_goal_and_a_failing_run_leaves_a_repro_bag_th
     port = free_port()
     sim = subprocess.Popen([sys.executable, "-X", "faulthandler", "-c", "from semsearch_cli.cli import main; main()", "ros",
                             "sim", str(demo_dir / "scenario.yaml"), "--goal", "304", "--port", str(port), "--period", str(PERIOD)],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           # Ctrl-C as at a terminal: a child inherits an ignored SIGINT, and a test run
+                           # earlier in the same pytest worker can leave it ignored (the stand-in's stacks
+                           # showed it sleeping in its loop 30 s after the SIGINT)
+                           preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         assert select.select([sim.stdout], [], [], 60)[0], "ros sim said nothing in 60 s"
         first = sim.stdout.readline()
