@@ -60,16 +60,13 @@ def parse_replay(text: str) -> ReplayChoice:
     return ReplayChoice(parts[0], parts[1], int(parts[2]), int(parts[3]))
 
 
-_same_goal = same_goal  # the check and the sections match a --replay goal one way (report/runfiles.py)
-
-
 def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
     """A :class:`ScenarioError` naming ``--replay`` and listing the runs there are, unless some
     folder of a kind with a replay holds the chosen run."""
     rows = [run_rows(p.runs) for k in replaying() for p in parts_by_kind.get(k, [])]
     rows = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["planner", "goal", "seed"])
     ep = episodes(rows)
-    hit = (rows["planner"].astype(str) == choice.planner) & rows["goal"].map(lambda g: _same_goal(g, choice.goal)) \
+    hit = (rows["planner"].astype(str) == choice.planner) & rows["goal"].map(lambda g: same_goal(g, choice.goal)) \
         & (ep == choice.episode) & (pd.to_numeric(rows["seed"]) == choice.seed)
     if len(rows) and hit.any():
         return
@@ -82,7 +79,7 @@ def check_replay(choice: ReplayChoice, parts_by_kind: dict) -> None:
         return f"{v[0]}-{v[-1]}" if len(v) > 2 and v[-1] - v[0] == len(v) - 1 else ", ".join(map(str, v))
 
     seen = {"planner": rows["planner"].astype(str) == choice.planner,
-            "goal": rows["goal"].map(lambda g: _same_goal(g, choice.goal)), "episode": ep == choice.episode}
+            "goal": rows["goal"].map(lambda g: same_goal(g, choice.goal)), "episode": ep == choice.episode}
     missing = [k for k, m in seen.items() if not m.any()]
     why = f"no such {' or '.join(missing)}" if missing else "no run has all four together"
     goals = sorted(rows["goal"].astype(str).unique(), key=goal_key)
