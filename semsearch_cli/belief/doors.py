@@ -7,6 +7,7 @@ refreshed at re-plan time inside the bounding box of what changed since the last
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -64,8 +65,12 @@ class DoorReads:
     """Every sign read, kept so door lists can be rebuilt when segments change.
 
     Reads are aggregated per (label, robot cell): ``cell``, ``label`` (index into ``labels``),
-    ``count``, ``sx``, ``sy`` (sums of robot x, y in m) are arrays of the first ``n`` rows.
-    ``total`` counts reads per label; ``headings`` is the robot heading (radians) at each read.
+    ``count``, ``sx``, ``sy`` (sums of robot x, y in m), ``sbx``, ``sby`` (sums of the unit
+    vector from the robot toward the sign, its bearing), ``snx``, ``sny`` (sums of the unit vector
+    of the camera's axis that saw it: the heading turned 90 degrees toward the sign's side) and
+    ``bearings`` (reads that gave a bearing; the others add 0 to those sums) are arrays of the
+    first ``n`` rows. ``total`` counts reads per label; ``headings`` is the robot
+    heading (radians) at each read.
     """
 
     def __init__(self):
@@ -78,12 +83,18 @@ class DoorReads:
         self.count = np.zeros(256, np.int64)
         self.sx = np.zeros(256)
         self.sy = np.zeros(256)
+        self.sbx = np.zeros(256)
+        self.sby = np.zeros(256)
+        self.snx = np.zeros(256)
+        self.sny = np.zeros(256)
+        self.bearings = np.zeros(256, np.int64)
         self.total: dict = {}
         self.headings: list = []
 
-    def add(self, label, cell: int, x: float, y: float, heading: float) -> int:
-        """Record one read of ``label`` from robot cell ``cell`` at robot pose (x, y, heading);
-        returns the label's total read count."""
+    def add(self, label, cell: int, x: float, y: float, heading: float, bearing: float | None = None) -> int:
+        """Record one read of ``label`` from robot cell ``cell`` at robot pose (x, y, heading),
+        the sign seen in direction ``bearing`` (radians; None: not known); returns the label's
+        total read count."""
         row = self._row.get((label, cell))
         if row is None:
             lid = self._label_id.get(label)
@@ -91,7 +102,7 @@ class DoorReads:
                 lid = self._label_id[label] = len(self.labels)
                 self.labels.append(label)
             if self.n == self.cell.shape[0]:
-                for f in ("cell", "label", "count", "sx", "sy"):
+                for f in ("cell", "label", "count", "sx", "sy", "sbx", "sby", "snx", "sny", "bearings"):
                     a = getattr(self, f)
                     setattr(self, f, np.concatenate([a, np.zeros_like(a)]))
             row = self._row[(label, cell)] = self.n
@@ -100,6 +111,13 @@ class DoorReads:
         self.count[row] += 1
         self.sx[row] += x
         self.sy[row] += y
+        if bearing is not None:
+            self.sbx[row] += math.cos(bearing)
+            self.sby[row] += math.sin(bearing)
+            axis = heading + math.copysign(math.pi / 2, math.sin(bearing - heading))
+            self.snx[row] += math.cos(axis)
+            self.sny[row] += math.sin(axis)
+            self.bearings[row] += 1
         n = self.total.get(label, 0) + 1
         self.total[label] = n
         self.headings.append(heading)
@@ -157,6 +175,7 @@ class DoorBelief:
         self.dirty = np.array([H, -1, W, -1], np.int64)  # rmin, rmax, cmin, cmax since last refresh
         self.min_clear = robot_radius + 0.5 * frame.res - 1e-6
         self.reads = DoorReads()
+        self._faces = np.full((0, 2), np.nan)  # per read row: where its ray meets a wall (sign_faces), NaN: not yet
         self._seg_parent = lazy_zeros(H * W, np.int32)  # segments as a union-find forest (see kernels.grid.mark_visited)
         self.vbox = [H, -1, W, -1]
         self.cdirty = [H, -1, W, -1]  # where candidates may have changed since the last call
@@ -550,6 +569,56 @@ class DoorBelief:
             if lists:
                 out[int(s)] = lists
         return out
+
+    def sign_faces(self, min_reads: int | None = None, reach: float = 10.0) -> tuple[list, np.ndarray, np.ndarray]:
+        """Where the signs read are, as far as the robot can tell: every label read at least
+        ``min_reads`` times with a bearing, as (labels, ``face`` (k, 2) m, ``axis`` (k, 2)).
+        Each read's ray (from the mean robot position of its reads from one cell, along their mean
+        bearing) ends where it first leaves the known free space within ``reach`` m: the face of
+        the wall the sign hangs on (the camera reads a sign only in line of sight). ``face`` is the
+        mean of a label's ray ends (weighted by reads), ``axis`` the mean unit vector of the
+        cameras that read it (toward its wall). A ray is followed once, when its row is first
+        asked for, and again while it ends nowhere (its wall not yet in the map)."""
+        min_reads = self.spec.min_reads if min_reads is None else min_reads
+        rd, n = self.reads, self.reads.n
+        if self._faces.shape[0] < n:
+            grow = np.full((max(n, 2 * self._faces.shape[0]), 2), np.nan)
+            grow[: self._faces.shape[0]] = self._faces
+            self._faces = grow
+        todo = np.flatnonzero((rd.bearings[:n] > 0) & np.isnan(self._faces[:n, 0]))
+        if todo.size:
+            cnt = rd.count[todo].astype(float)
+            p = np.column_stack([rd.sx[todo], rd.sy[todo]]) / cnt[:, None]
+            v = np.column_stack([rd.sbx[todo], rd.sby[todo]])
+            v /= np.maximum(np.hypot(v[:, 0], v[:, 1]), 1e-12)[:, None]
+            fr = self.frame
+            step = np.arange(0.0, reach, fr.res / 2)
+            r, c = fr.to_index(p[:, 0, None] + v[:, 0, None] * step, p[:, 1, None] + v[:, 1, None] * step)
+            H, W = self.free.shape
+            inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+            out = ~inside | ~self.free[np.clip(r, 0, H - 1), np.clip(c, 0, W - 1)]
+            hit = out.any(axis=1)
+            k = np.argmax(out, axis=1)
+            ends = p + v * step[k][:, None]
+            self._faces[todo[hit]] = ends[hit]
+        rows = np.flatnonzero(np.isfinite(self._faces[:n, 0]))
+        labels = []
+        if rows.size == 0:
+            return labels, np.zeros((0, 2)), np.zeros((0, 2))
+        lid = rd.label[rows]
+        w = rd.count[rows].astype(float)
+        m = len(rd.labels)
+        cnt = np.bincount(lid, w, minlength=m)
+        fx = np.bincount(lid, w * self._faces[rows, 0], minlength=m)
+        fy = np.bincount(lid, w * self._faces[rows, 1], minlength=m)
+        ax = np.bincount(lid, rd.snx[rows], minlength=m)
+        ay = np.bincount(lid, rd.sny[rows], minlength=m)
+        keep = np.array([cnt[i] > 0 and rd.total[lab] >= min_reads for i, lab in enumerate(rd.labels)], bool)
+        idx = np.flatnonzero(keep)
+        face = np.column_stack([fx[idx], fy[idx]]) / cnt[idx, None]
+        axis = np.column_stack([ax[idx], ay[idx]])
+        axis /= np.maximum(np.hypot(axis[:, 0], axis[:, 1]), 1e-12)[:, None]
+        return [rd.labels[i] for i in idx], face, axis
 
     def segment_door_lists(self, rows: np.ndarray, cols: np.ndarray, min_reads: int | None = None):
         """Door lists of the segments of the given visited cells, without labelling the map.

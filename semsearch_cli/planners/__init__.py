@@ -11,7 +11,7 @@ from .. import deprecation
 from . import base
 from .base import (PLANNERS, Decision, DoorContext, DoorPlanner, NoParams, Planner, Told, Variant, code_of, expand_variants,
                    load_entry_points, load_planner_file, planner_class, register_planner)
-from .doors import advantage, bvp, draft, greedy, learned, nsos, numbering, oracle  # noqa: F401  (registration side effect)
+from .doors import advantage, bvp, draft, greedy, learned, nsos, numbering, oracle, walls  # noqa: F401  (registration side effect)
 from . import llm  # noqa: F401  (registers llm)
 from .indirect import Goal, IndirectContext, IndirectPlanner
 from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals

@@ -159,8 +159,13 @@ class ReplaySearch(DoorSearch):
         v, u, r, c = fr.point_to_cell(st.x, st.y)
         b.add_view(v, u, st.heading)
         event = False
-        for label in ev.get("reads", []):
-            if b.reads.add(sign_label(label), r * fr.width + c, st.x, st.y, st.heading) == b.spec.min_reads:
+        reads = ev.get("reads", [])
+        bearings = ev.get("bearings")
+        if not isinstance(bearings, list) or len(bearings) != len(reads):  # a bag of an older semsearch: not known
+            bearings = [None] * len(reads)
+        for label, bearing in zip(reads, bearings):
+            bearing = float(bearing) if isinstance(bearing, (int, float)) and math.isfinite(bearing) else None
+            if b.reads.add(sign_label(label), r * fr.width + c, st.x, st.y, st.heading, bearing) == b.spec.min_reads:
                 event = True
         found = bool(ev.get("found", False))  # the goal's own sign read (a misread of another as the goal is not)
         if "rng" in ev:  # sensed inside a re-plan: the generator as the sensing left it

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..config import DoorCameraSpec, LaserSpec
@@ -45,6 +47,11 @@ class DoorCamera:
         self.fx, self.fy = np.cos(s.facing), np.sin(s.facing)
         self.sv, self.su = world.frame.to_cell(s.x, s.y)
         self.half = np.radians(spec.fov) / 2
+
+    def bearing(self, i: int, x: float, y: float) -> float:
+        """The direction (radians, counter-clockwise from +x) from (x, y) to sign ``i``: where in
+        its image a camera sees the sign."""
+        return math.atan2(self.sy[i] - y, self.sx[i] - x)
 
     def read(self, x: float, y: float, heading: float, rng: np.random.Generator) -> list[tuple[int, object]]:
         """Signs read from pose (x, y, heading): list of (sign index, label as read)."""

@@ -78,15 +78,16 @@ class DoorSensing:
         b.add_view(v, u, st.heading)
         found = event = False
         reads = t.camera.read(st.x, st.y, st.heading, self.rng)
-        for i, label in reads:
+        bearings = tuple(t.camera.bearing(i, st.x, st.y) for i, _ in reads)
+        for (i, label), bearing in zip(reads, bearings):
             st.read_signs[i] = label
             if i in self.goal_idx and label == self.goal:
                 found = True
-            if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading) == min_reads:
+            if b.reads.add(label, r * fr.width + c, st.x, st.y, st.heading, bearing) == min_reads:
                 event = True
         if self.observer is not None and self.observer.steps:
             rng = rng_word(self.rng) if self._planning else None
-            self.observer.see(DoorFrame(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=b, reads=tuple(reads),
+            self.observer.see(DoorFrame(step=st.steps, x=st.x, y=st.y, heading=st.heading, belief=b, reads=tuple(reads), bearings=bearings,
                                         scan=scan, found=found, rng=rng))
         return found, event
 
@@ -104,8 +105,8 @@ class DoorFrame(Event):
     """One sensing frame of a door search, shown to observers that ask for steps
     (``Observer.steps``): the pose (``x``, ``y`` m, ``heading`` rad) it sensed from during step
     ``step``, the belief after folding it in (``belief``: copy what you keep), the signs it read
-    [(sign index, label as read)] and its laser scan (beam angles rad in the world, ranges in
-    cells, hit flags); ``found``: whether it read the goal's sign; ``rng``: inside a re-plan (a
+    [(sign index, label as read)], the direction from the robot to each (``bearings``, radians) and
+    its laser scan (beam angles rad in the world, ranges in cells, hit flags); ``found``: whether it read the goal's sign; ``rng``: inside a re-plan (a
     turn on the spot), the run's generator state after it (:func:`~.decisions.rng_word`), else
     None. A step senses one frame; turning on the spot senses several within one step. Not
     traced."""
@@ -116,6 +117,7 @@ class DoorFrame(Event):
     heading: float
     belief: DoorBelief
     reads: tuple = ()
+    bearings: tuple = ()
     scan: tuple | None = None
     found: bool = False
     rng: str | None = None
@@ -125,10 +127,12 @@ class DoorFrame(Event):
         return False
 
     def row(self) -> dict:
-        """The frame as the robot has it: its pose, the labels read (a whole number as a number),
-        whether the goal's sign was among them, the generator's state inside a re-plan."""
+        """The frame as the robot has it: its pose, the labels read (a whole number as a number) and
+        the direction to each (radians), whether the goal's sign was among them, the generator's
+        state inside a re-plan."""
         labels = [sign_label(v) for _, v in self.reads]
         return {"step": self.step, "x": float(self.x), "y": float(self.y), "heading": float(self.heading), "reads": labels,
+                **({"bearings": [float(a) for a in self.bearings]} if self.bearings else {}),
                 "found": bool(self.found), **({"rng": self.rng} if self.rng is not None else {})}
 
 
