@@ -50,3 +50,15 @@ def drawn(monkeypatch):
     yield figs
     for f in figs:
         plt.close(f)
+
+
+@pytest.fixture(autouse=True)
+def _planner_registry():
+    """A planner a test registers (a planner file, an entry point) is gone after it: the planner
+    list that other tests pin is the package's own, whichever tests ran before in the process."""
+    from semsearch_cli.planners import PLANNERS
+
+    before = dict(PLANNERS)
+    yield
+    PLANNERS.clear()
+    PLANNERS.update(before)

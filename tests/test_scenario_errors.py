@@ -91,7 +91,7 @@ def test_goal_no_sign_carries(demo_dir, tmp_path):
 
 
 def test_unknown_planner(demo_dir, tmp_path):
-    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "greedy"}, {"name": "astar"}]), "planners[1].name", "valid: bvp, distance_advantage, draft, geometric, greedy, learned, llm, nsos, numbering, oracle_goal, wall_numbers")
+    check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "greedy"}, {"name": "astar"}]), "planners[1].name", "valid: bvp, distance_advantage, draft, geometric, greedy, learned, llm, nsos, numbering, oracle_goal, wall_numbers, wall_rule")
     check_error(scenario_copy(demo_dir, tmp_path, planners=[{"name": "nsso"}]), "unknown planner 'nsso' (did you mean 'nsos'?)")
 
 

@@ -102,9 +102,11 @@ class Told:
     """What a privileged planner is told about its episode that a robot is not, from the world's
     ground truth (never the map): ``goal_xy``, the position (x, y m) of each sign that carries the
     goal's label (one; more under ``duplicates: any``), under the numbering the run has (a bench run
-    of shuffled labels tells where the shuffled goal's sign is)."""
+    of shuffled labels tells where the shuffled goal's sign is); ``walls``, every sign as (label,
+    x m, y m, wall), ``wall`` its stretch of wall (:meth:`~semsearch_cli.world.Signs.walls`)."""
 
     goal_xy: tuple  # ((x, y), ...) m
+    walls: tuple = ()  # ((label, x, y, wall), ...)
 
 
 @dataclass

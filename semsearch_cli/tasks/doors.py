@@ -249,8 +249,11 @@ class DoorSearch(DoorSensing):
         self.views_needed = views_needed(cam.p_read)
         self.sweep_target: tuple[int, int] | None = None
         signs = task.world.signs
-        self.told = Told(tuple((float(signs.x[i]), float(signs.y[i])) for i in sorted(self.goal_idx))) \
-            if getattr(planner, "privileged", "") else None  # a privileged planner's ground truth (oracle_goal)
+        self.told = None
+        if getattr(planner, "privileged", ""):  # a privileged planner's ground truth (oracle_goal, wall_rule)
+            wall = signs.walls()
+            self.told = Told(tuple((float(signs.x[i]), float(signs.y[i])) for i in sorted(self.goal_idx)),
+                             tuple((signs.number[i], float(signs.x[i]), float(signs.y[i]), int(wall[i])) for i in range(len(signs))))
 
     def replan_due(self, path_done, since_plan, event):
         if path_done or (event and self.uses_signs):

@@ -45,6 +45,30 @@ class Signs:
     def __len__(self) -> int:
         return len(self.number)
 
+    def walls(self, across: float = 0.3, gap: float = 12.0) -> np.ndarray:
+        """(n,) int: a stretch of wall per sign, from the ground truth: signs facing the same way
+        (within a degree) whose faces lie within ``across`` m of one line, split where two
+        neighbours along it are more than ``gap`` m apart (a junction's far side is another
+        stretch)."""
+        n = len(self.number)
+        out = np.full(n, -1, np.int64)
+        fx, fy = np.cos(self.facing), np.sin(self.facing)
+        todo = list(range(n))
+        wall = 0
+        while todo:
+            i = todo[0]
+            same = [j for j in todo if fx[i] * fx[j] + fy[i] * fy[j] > np.cos(np.radians(1.0))
+                    and abs((self.x[j] - self.x[i]) * fx[i] + (self.y[j] - self.y[i]) * fy[i]) < across]
+            t = np.array([-(self.x[j] * fy[i]) + self.y[j] * fx[i] for j in same])  # along the wall
+            order = np.argsort(t, kind="stable")
+            cut = np.flatnonzero(np.diff(t[order]) > gap) + 1
+            for part in np.split(order, cut):
+                out[[same[k] for k in part]] = wall
+                wall += 1
+            done = set(same)
+            todo = [j for j in todo if j not in done]
+        return out
+
     def index_of(self, label) -> int:
         """The first sign carrying ``label``, or -1."""
         key = str(label)

@@ -53,6 +53,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from ...world.labels import parse_label
+from ...errors import PlannerError
 from ..base import Decision, DoorPlanner, register_planner
 from .greedy import nearest_candidate
 
@@ -204,3 +205,39 @@ class WallNumbers(DoorPlanner):
         k = int(best[0] if best.size == 1 else ctx.rng.choice(best))
         return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k]), "cost_m": float(cost[k]),
                                                                "predictions": int(len(q)), "belief": float(pi.sum())})
+
+
+@register_planner("wall_rule")
+class WallRule(WallNumbers):
+    """Privileged: ``wall_numbers`` told, for every stretch of wall it has read a sign on, the
+    rest of that stretch's numbers (the rule of the walls it saw, not the map); where the goal's
+    sign is on one of them, it goes for it as ``oracle_goal`` does (beyond: line). The bound between
+    inferring a wall's numbering from the signs read and knowing it (docs/bench.md)."""
+
+    rank = 91
+    privileged = "every sign's position on each stretch of wall it has read a sign on (the walls' numbering), not the map"
+    tuned_on = WallNumbers.tuned_on
+
+    def choose(self, ctx, cands):
+        if len(cands) == 0:
+            return None
+        told = ctx.told
+        if told is None or not told.walls:
+            raise PlannerError("wall_rule is privileged and was told no walls: it runs where the world's signs are known "
+                               "(the simulator, a bench run), not on a robot")
+        b = ctx.belief
+        read = {lab for lab, n in b.reads.total.items() if n >= (self.params.min_reads or b.spec.min_reads)}
+        seen = {w for lab, _, _, w in told.walls if lab in read}
+        goal = [(x, y) for lab, x, y, w in told.walls if w in seen and str(lab) == str(ctx.goal)]
+        if not goal:
+            return super().choose(ctx, cands)
+        gs = b.search(ctx.row, ctx.col, cands.rows, cands.cols, len(cands))
+        d = gs.lengths(cands.rows, cands.cols) * b.frame.res
+        if not np.isfinite(d).any():
+            return None
+        x, y = b.frame.to_world(cands.rows, cands.cols)
+        g = np.asarray(goal, float)
+        cost = d + np.hypot(x[:, None] - g[None, :, 0], y[:, None] - g[None, :, 1]).min(axis=1)
+        best = np.flatnonzero(cost == cost[np.isfinite(cost)].min())
+        k = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+        return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k]), "cost_m": float(cost[k]), "told": True})
