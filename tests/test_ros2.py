@@ -25,6 +25,7 @@ from semsearch_cli.tasks.base import Observer  # noqa: E402
 from semsearch_cli.tasks.doors import DoorFrame  # noqa: E402
 from semsearch_cli.tasks.decisions import Replay  # noqa: E402
 from semsearch_cli.runner.store import read_decisions  # noqa: E402
+from semsearch_cli.world.buildings.numbered import generate_building  # noqa: E402
 
 TS = get_typestore(Stores.ROS2_HUMBLE)
 RUN = "greedy__goal452__ep0__seed0"
@@ -232,6 +233,29 @@ def test_a_run_replayed_from_its_bag_makes_its_decisions_decision_for_decision(r
     assert other.exit_code == 0, other.output
     asked = decisions_of(out / "replayed" / "numbering")
     assert asked and all(0 <= s <= max(s for s, _ in decisions_of(out / "trip" / RUN)) + 1 for s, _ in asked)
+
+
+def test_the_bearings_of_the_reads_go_into_the_bag_and_wall_numbers_replays_from_them(tmp_path):
+    """wall_numbers places signs by the bearing of each read: an exported bag's frame events carry
+    the bearings, and the run replayed from the bag makes its decisions decision for decision; a
+    bag without them (an older semsearch's) replays with the bearings not known."""
+    scenario = generate_building("single", "loop", 3, tmp_path / "b", spacing=2.5)
+    L = Loaded.load(scenario)
+    ep = next(e for e in L.task.episodes
+              if L.task.run(Variant("wall_numbers", ()), e, 0).distance_m != L.task.run(Variant("greedy", ()), e, 0).distance_m)
+    run_batch(L, [RunSpec(ep, Variant("wall_numbers", ()), 0)], tmp_path / "results", BatchOptions(workers=1, decisions=True))
+    res = CliRunner().invoke(app, ["export", str(tmp_path / "results"), "--out", str(tmp_path / "trip"), "--scenario", str(scenario)])
+    assert res.exit_code == 0, res.output
+    (bag,) = [p for p in (tmp_path / "trip").iterdir() if p.is_dir()]
+    frames = [json.loads(m.data) for _, m in messages(bag)["/semsearch/events"]]
+    frames = [f for f in frames if f.get("event") == "frame" and f["reads"]]
+    assert frames and all(len(f["bearings"]) == len(f["reads"]) for f in frames)
+    res = CliRunner().invoke(app, ["ros", "replay", str(bag), "--planner", "wall_numbers", "--out", str(tmp_path / "again"),
+                                   "--scenario", str(scenario)])
+    assert res.exit_code == 0, res.output
+    want = decisions_of(bag)
+    got = [(s, tuple(round(v, 2) for v in t)) for s, t in decisions_of(tmp_path / "again")]
+    assert len(want) > 5 and got == want
 
 
 def test_ros_replay_refuses_a_bag_of_another_scenario_and_a_bag_it_cannot_replay(recorded, tmp_path):
