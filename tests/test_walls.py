@@ -25,19 +25,18 @@ def test_a_bracket_puts_the_goal_between_its_two_neighbours():
     t = np.array([0.0, 2.5, 5.0, 7.5])
     n = np.array([201.0, 202.0, 204.0, 205.0])  # 203 skipped, or across the corridor
     out = stretch_predictions(t, n, 203.0, P)
-    assert [(round(tg, 2), w, gap) for tg, w, gap in out] == [(3.75, P.w_near, 0.0)]
+    assert [(round(tg, 2), w, gap, round(te, 2)) for tg, w, gap, te in out] == [(3.75, P.w_near, 0.0, 3.75)]
 
 
 def test_a_wall_rising_toward_the_goal_is_extrapolated_past_its_last_sign_while_the_goal_is_near():
     t = np.array([0.0, 2.5, 5.0])
     n = np.array([210.0, 211.0, 212.0])
-    (tg, w, gap), = stretch_predictions(t, n, 215.0, P)
-    assert tg == pytest.approx(12.5) and w == P.w_near and gap == 3.0
-    (tg, w, gap), = stretch_predictions(t, n, 220.0, P)  # 8 numbers on: a far extrapolation
+    (tg, w, gap, te), = stretch_predictions(t, n, 215.0, P)
+    assert tg == pytest.approx(12.5) and w == P.w_near and gap == 3.0 and te == 5.0
+    (tg, w, gap, _), = stretch_predictions(t, n, 220.0, P)  # 8 numbers on: a far extrapolation
     assert tg == pytest.approx(25.0) and w == P.w_far
-    assert stretch_predictions(t, n, 240.0, P) == []  # past `far`: nothing
-    (tg, w, _), = stretch_predictions(t, n, 207.0, P)  # below: past the other end
-    assert tg == pytest.approx(-7.5)
+    (tg, w, _, te), = stretch_predictions(t, n, 207.0, P)  # below: past the other end
+    assert tg == pytest.approx(-7.5) and te == 0.0
 
 
 def test_neighbours_tens_of_numbers_apart_or_turning_back_predict_nothing():
@@ -52,7 +51,37 @@ def test_a_rooms_lettered_doors_count_as_one_number_at_their_mean_position():
     t = np.array([0.0, 2.5, 5.0, 7.5])
     n = np.array([210.0, 212.0, 212.0, 213.0])  # 212a, 212b
     out = stretch_predictions(t, n, 211.0, P)
-    assert [round(tg, 3) for tg, _, _ in out] == [round(0.0 + 0.5 * 3.75, 3)]
+    assert [round(tg, 3) for tg, _, _, _ in out] == [round(0.0 + 0.5 * 3.75, 3)]
+
+
+def _belief_with_a_wall(known_to: float):
+    """A corridor from y = 1 m to 3 m along x, its north wall (row 9, y = 3 m) known to x =
+    ``known_to`` m, unknown beyond; signs 210, 211, 212 on it at x = 1, 3.5, 6 m, read facing north."""
+    fr = GridFrame(0.1, 0.0, 0.0, 40, 400)
+    b = DoorBelief(fr, BeliefSpec(), 0.25)
+    seen = np.zeros((40, 400), bool)
+    free = np.zeros((40, 400), bool)
+    k = int(known_to / 0.1)
+    seen[9:31, :k] = True
+    free[10:30, :k] = True  # the corridor (rows 10..29: y 1..3 m)
+    b.fold_grid(0, 0, seen, free)
+    for label, x in ((210, 1.0), (211, 3.5), (212, 6.0)):
+        r, c = fr.to_index(x, 2.0)
+        for _ in range(3):
+            b.reads.add(label, int(r * fr.width + c), x, 2.0, 0.0, float(np.pi / 2))
+    return b
+
+
+def test_a_long_extrapolation_is_kept_only_along_a_wall_the_map_shows():
+    class Ctx:
+        goal = 225  # 13 numbers past 212: past `far`, 32.5 m on along the wall
+    for known_to, kept in ((39.0, True), (8.0, False)):
+        Ctx.belief = _belief_with_a_wall(known_to)
+        q, w = walls.predictions(Ctx, P)
+        if kept:
+            assert len(q) == 1 and w[0] == P.w_wall and q[0] == pytest.approx([38.5, 2.5], abs=0.3)
+        else:
+            assert len(q) == 0
 
 
 def test_reads_keep_the_bearing_and_the_belief_finds_the_wall_face_of_each_sign():
@@ -104,7 +133,7 @@ def test_the_sign_faces_of_a_run_are_where_the_signs_are(corridor, monkeypatch):
 
 def test_with_nothing_predicted_it_is_nearest_frontier_step_for_step(corridor, monkeypatch):
     L = corridor
-    monkeypatch.setattr(walls, "predictions", lambda ctx, p: (np.zeros((0, 2)), np.zeros(0)))
+    monkeypatch.setattr(walls, "predictions", lambda ctx, p: (np.zeros((0, 2)), np.zeros(0)))  # nothing predicted
     for ep in L.task.episodes[:3]:
         a = L.task.run(Variant("wall_numbers", ()), ep, 0)
         b = L.task.run(Variant("greedy", ()), ep, 0)

@@ -70,7 +70,11 @@ class WallParams(BaseModel):
     far: float = Field(10.0, ge=0.0, description="numbers: one over more than near and at most this many weighs w_far; "
                        "farther, none is made")
     w_near: float = Field(0.95, ge=0.0, le=1.0, description="the weight of a near extrapolation (and of a bracket)")
-    w_far: float = Field(0.3, ge=0.0, le=1.0, description="the weight of a far extrapolation")
+    w_far: float = Field(0.15, ge=0.0, le=1.0, description="the weight of a far extrapolation")
+    supported: float = Field(0.5, ge=0.0, le=1.0, description="share of the wall line from the last sign to the "
+                             "prediction that the map knows as wall, above which an extrapolation of any length weighs "
+                             "w_wall")
+    w_wall: float = Field(0.75, ge=0.0, le=1.0, description="the weight of an extrapolation along a wall the map shows")
     prior: float = Field(0.05, gt=0.0, description="the weight of 'no prediction holds'")
     wall_gap: float = Field(0.75, gt=0.0, description="m: faces within this of one line share a wall")
     max_gap: float = Field(12.0, gt=0.0, description="m: a gap along a wall longer than this starts a new stretch")
@@ -100,9 +104,10 @@ def walls(t_face: np.ndarray, o: np.ndarray, v: np.ndarray, wall_gap: float, max
     return out
 
 
-def stretch_predictions(t: np.ndarray, n: np.ndarray, g: float, p: WallParams) -> list[tuple[float, float, float]]:
-    """[(t of the goal along the stretch, weight, numbers from the nearest sign: 0 for a bracket)]
-    from one stretch's signs (``t`` sorted)."""
+def stretch_predictions(t: np.ndarray, n: np.ndarray, g: float, p: WallParams) -> list[tuple[float, float, float, float]]:
+    """[(t of the goal along the stretch, weight, numbers from the nearest sign (0 for a bracket),
+    t of the sign it is extrapolated from (a bracket: the goal's own t))] from one stretch's signs
+    (``t`` sorted)."""
     # merge repeated numbers (a room's lettered doors): their mean position
     un, inv = np.unique(n, return_inverse=True)
     if len(un) < len(n):
@@ -115,7 +120,8 @@ def stretch_predictions(t: np.ndarray, n: np.ndarray, g: float, p: WallParams) -
     dt, dn = np.diff(t), np.diff(n)
     ok = (dt > 0.3) & (dn != 0) & (np.abs(dn) <= p.max_slope * np.maximum(dt, 0.3))
     for j in np.flatnonzero(ok & (np.minimum(n[:-1], n[1:]) < g) & (g < np.maximum(n[:-1], n[1:]))):
-        out.append((float(t[j] + (g - n[j]) * dt[j] / dn[j]), p.w_near, 0.0))
+        tg = float(t[j] + (g - n[j]) * dt[j] / dn[j])
+        out.append((tg, p.w_near, 0.0, tg))
     for end in (1, -1):  # the high-t end, then the low-t end
         m = min(3, len(t))
         sl = slice(len(t) - m, None) if end == 1 else slice(0, m)
@@ -129,9 +135,23 @@ def stretch_predictions(t: np.ndarray, n: np.ndarray, g: float, p: WallParams) -
         t_end, n_end = (te[-1], ne[-1]) if end == 1 else (te[0], ne[0])
         tg = t_end + (g - n_end) / slope
         gap = abs(g - n_end)
-        if (tg - t_end) * end > 0 and gap <= p.far:
-            out.append((float(tg), p.w_near if gap <= p.near else p.w_far, float(gap)))
+        if (tg - t_end) * end > 0:
+            out.append((float(tg), p.w_near if gap <= p.near else p.w_far, float(gap), float(t_end)))
     return out
+
+
+def wall_support(b, p0: np.ndarray, p1: np.ndarray, v: np.ndarray) -> float:
+    """The share of the wall line from ``p0`` to ``p1`` (faces, m) that the map knows as wall:
+    points every half cell, a quarter cell beyond the face along ``v`` (the face is where a ray
+    first met a cell that is not free, at most half a cell into it: still inside a one-cell wall)."""
+    fr = b.frame
+    n = max(2, int(np.hypot(*(p1 - p0)) / (fr.res / 2)))
+    pts = p0[None, :] + (p1 - p0)[None, :] * np.linspace(0.0, 1.0, n)[:, None] + v[None, :] * (fr.res * 0.25)
+    r, c = fr.to_index(pts[:, 0], pts[:, 1])
+    H, W = b.free.shape
+    ok = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+    r, c = np.clip(r, 0, H - 1), np.clip(c, 0, W - 1)
+    return float((ok & b.seen[r, c] & ~b.free[r, c]).mean())
 
 
 def predictions(ctx, p: WallParams) -> tuple[np.ndarray, np.ndarray]:
@@ -153,18 +173,25 @@ def predictions(ctx, p: WallParams) -> tuple[np.ndarray, np.ndarray]:
     u = np.column_stack([-v[:, 1], v[:, 0]])  # along the wall
     o = (face * v).sum(axis=1)  # the wall line's offset, each in its own v
     t = (face * u).sum(axis=1)
-    qs, ws = [], []
+    qs, ws, gaps, support = [], [], [], []
     for s in walls(t, o, v, p.wall_gap, p.max_gap):
         vv, uu = v[s[0]], u[s[0]]
         ts = face[s] @ uu  # along the first sign's frame
         oo = float(np.median(face[s] @ vv))
         order = np.argsort(ts, kind="stable")
-        for tg, w, _ in stretch_predictions(ts[order], n[s][order], float(goal.number), p):
+        for tg, w, gap_, te in stretch_predictions(ts[order], n[s][order], float(goal.number), p):
             qs.append(uu * tg + vv * (oo - 0.5))  # half a metre off the wall, into the corridor
             ws.append(w)
+            gaps.append(gap_)
+            support.append(wall_support(b, uu * te + vv * oo, uu * tg + vv * oo, vv))
     if not qs:
         return none
-    q, w = np.array(qs), np.array(ws)
+    q, w, gaps, support = np.array(qs), np.array(ws), np.array(gaps), np.array(support)
+    w = np.where((gaps > p.near) & (support > p.supported), p.w_wall, w)  # the map shows the wall running on to it
+    keep = (gaps <= p.far) | (support > p.supported)
+    if not keep.any():
+        return none
+    q, w = q[keep], w[keep]
     if p.passed > 0:
         fr = b.frame
         k = int(math.ceil(p.passed / fr.res))
