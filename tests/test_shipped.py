@@ -148,6 +148,8 @@ def test_the_wheel_holds_every_data_file_the_code_opens(wheel, tmp_path, monkeyp
 
     sys.addaudithook(hook)  # for the rest of the session; it records only opens under data/
     monkeypatch.chdir(tmp_path)
+    # a cache of its own: `bench list` reads sources.json only for a track this machine has not fetched
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
     for args in (["bench", "list"], ["scenarios"], ["planners"], ["validate", "hotel"], ["validate", "hospital"],
                  ["validate", "indirect_quick"], ["validate", "office"], ["init", "hotel", "mine"],
                  ["bench", "run", "doors-v1", "--planner", "learned", "--limit", "1", "--out", "b"]):
