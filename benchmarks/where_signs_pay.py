@@ -2,7 +2,7 @@
 minus SPL under shuffled labels, paired over episodes) and the share of the greedy-to-oracle_goal
 SPL gap closed, per sign-reading planner, as functions of the door cameras' range and read
 probability (interventions: the doors-v1 val floors run again with one sensor parameter changed)
-and of the floor's size, corridor length, signs per metre, skipped and lettered shares, numbering
+and of the floor's size, its longest stretch of wall carrying signs, signs per metre of such wall, skipped and lettered shares, numbering
 convention and predictability (the 800 val episodes binned by their floor's value). Every
 interval is a 95% BCa bootstrap over episodes (a floor's start/goal problem).
 
@@ -40,8 +40,9 @@ from semsearch_cli import api, bench  # noqa: E402
 from semsearch_cli.bench.board import gap_closed, load, paired_diff  # noqa: E402
 from semsearch_cli.bench.run import materialise  # noqa: E402
 from semsearch_cli.config.scenario import with_param  # noqa: E402
+from semsearch_cli.metrics import outside_the_run  # noqa: E402
 from semsearch_cli.report.stats import mean_ci  # noqa: E402
-from semsearch_cli.runner import BatchOptions, Loaded  # noqa: E402
+from semsearch_cli.runner import BatchOptions, Loaded, read_runs  # noqa: E402
 
 READERS = ("wall_numbers", "numbering")  # the sign-reading planners measured
 REFERENCES = ("greedy", "oracle_goal")  # the gap's ends
@@ -95,9 +96,13 @@ def floor_factors() -> pd.DataFrame:
         w = Loaded.load(f.scenario).task.world
         s = w.signs
         wall = s.walls()
-        along = -s.x * np.sin(s.facing) + s.y * np.cos(s.facing)
         spacing = float(f.recipe.get("spacing", 2.5))
-        lengths = np.array([np.ptp(along[wall == k]) + spacing for k in np.unique(wall)])
+        lengths = []
+        for k in np.unique(wall):  # along the wall as Signs.walls() measures it: its first sign's facing
+            m = wall == k
+            f0 = s.facing[m][0]
+            lengths.append(np.ptp(-s.x[m] * np.sin(f0) + s.y[m] * np.cos(f0)) + spacing)
+        lengths = np.array(lengths)
         r = f.recipe
         out.append({"floor": f.id, "free area (m²)": float(w.free.sum()) * w.frame.res ** 2,
                     "longest signed wall (m)": float(lengths.max()),
@@ -111,11 +116,12 @@ def stats(rows: pd.DataFrame, units) -> list[dict]:
     """Per sign reader, on ``units`` (episodes): SPL, semantic gain, SPL and distance gap closed."""
     d = rows[rows["unit"].isin(units)]
     pick = {(p, n): d[(d["planner"] == p) & (d["numbering"] == n)] for p in REFERENCES + READERS for n in ("true", "shuffled")}
-    g, o = pick[("greedy", "true")], pick[("oracle_goal", "true")]
     res = []
-    for p in READERS:
-        t, s = pick[(p, "true")], pick[(p, "shuffled")]
-        res.append({"planner": p, "episodes": t["unit"].nunique(),
+    for p in READERS:  # every column over the episodes all four sides ran
+        sides = (pick[("greedy", "true")], pick[("oracle_goal", "true")], pick[(p, "true")], pick[(p, "shuffled")])
+        common = set.intersection(*(set(x["unit"]) for x in sides))
+        g, o, t, s = (x[x["unit"].isin(common)] for x in sides)
+        res.append({"planner": p, "episodes": len(common),
                     "greedy SPL": mean_ci(g["spl"].to_numpy(float), g["unit"].to_numpy())[0],
                     "oracle SPL": mean_ci(o["spl"].to_numpy(float), o["unit"].to_numpy())[0],
                     "SPL": mean_ci(t["spl"].to_numpy(float), t["unit"].to_numpy()),
@@ -129,14 +135,17 @@ def _bins(values: pd.Series, name: str) -> tuple[pd.Series, list[str]]:
     """Each floor's bin and the bins in order: thirds of the floors by value; the lettered share
     as none and the lettered floors' halves; the convention as itself."""
     if name == "convention":  # the schemes grouped: few val floors have any one parity scheme
-        fam = values.map(lambda c: c if c in ("loop", "random") else "parity (6 schemes)")
-        return fam, ["loop", "parity (6 schemes)", "random"]
+        other = sorted(set(values) - {"loop", "random"})
+        lab = f"parity ({len(other)} schemes)"
+        return values.map(lambda c: c if c in ("loop", "random") else lab), ["loop", lab, "random"]
     fmt = "{:.0f}" if values.max() > 20 else "{:.2f}"
     if name == "lettered share":  # a third of the floors have none
         has = values > 0
         med = fmt.format(values[has].median())
         lab = ["none", f"≤ {med}", f"> {med}"]
         return pd.Series(np.where(~has, lab[0], np.where(values <= values[has].median(), lab[1], lab[2])), values.index), lab
+    if values.isna().any():
+        raise ValueError(f"{name}: floors {', '.join(values.index[values.isna()])} have no value")
     q = values.quantile([1 / 3, 2 / 3]).to_numpy()
     lab = [f"≤ {fmt.format(q[0])}", f"{fmt.format(q[0])}–{fmt.format(q[1])}", f"> {fmt.format(q[1])}"]
     return pd.Series(np.select([values <= q[0], values <= q[1]], lab[:2], lab[2]), values.index), lab
@@ -168,7 +177,8 @@ def figure(name: str, levels: list[tuple[str, list[dict]]], path: Path) -> None:
         for ax, key, scale in ((axes[0], "semantic gain", 1.0), (axes[1], "SPL gap closed", 100.0)):
             v = np.array([[next(r for r in res if r["planner"] == p)[key][j] for j in range(3)] for _, res in levels]) * scale
             off = (k - 0.5) * 0.12
-            ax.errorbar(x + off, v[:, 0], yerr=[v[:, 0] - v[:, 1], v[:, 2] - v[:, 0]], fmt="o-", capsize=3, label=p)
+            err = [np.fmax(v[:, 0] - v[:, 1], 0), np.fmax(v[:, 2] - v[:, 0], 0)]  # a BCa bound past its point: no bar that side
+            ax.errorbar(x + off, v[:, 0], yerr=err, fmt="o-", capsize=3, label=p)
     for ax, lab in ((axes[0], "semantic gain (SPL, true − shuffled)"), (axes[1], "greedy→oracle_goal SPL gap closed (%)")):
         ax.axhline(0, color="0.6", lw=0.8)
         ax.set_xticks(x, [lev for lev, _ in levels], rotation=20 if len(levels) > 4 else 0, fontsize=8)
@@ -184,13 +194,15 @@ def figure(name: str, levels: list[tuple[str, list[dict]]], path: Path) -> None:
 def level_rows(levels_dir: Path, param: str, value: float) -> pd.DataFrame:
     frames = []
     for f in sorted((levels_dir / f"{param}={value:g}").glob("*/*/rows/runs.csv")):
-        r = pd.read_csv(f, dtype={"goal": str}, keep_default_na=False)
+        r = read_runs(f)
+        r = r[(r["stage"] == "") & ~outside_the_run(r)]  # as the board: a run that failed for a cause outside it is no run
         numbering, fid = f.parts[-4], f.parts[-3]
         scen = f.parent.parent / "scenario"
         kept = pd.read_csv(scen / yaml.safe_load((scen / "scenario.yaml").read_text())["episodes"]["file"])["episode"]
         orig = kept.to_numpy()[r["episode"].to_numpy(int)]  # the runner numbers the kept episodes 0, 1, ...: the split's numbers
-        frames.append(r.assign(numbering=numbering, floor=fid, unit=[f"{fid}/{e}" for e in orig],
-                               spl=pd.to_numeric(r["spl"]), distance_m=pd.to_numeric(r["distance_m"])))
+        frames.append(r.assign(numbering=numbering, floor=fid, unit=[f"{fid}/{e}" for e in orig]))
+    if not frames:
+        raise SystemExit(f"{levels_dir}: no rows of {param}={value:g} (run `where_signs_pay.py run --out {levels_dir}` first)")
     return pd.concat(frames, ignore_index=True)
 
 
