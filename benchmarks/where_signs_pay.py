@@ -45,6 +45,7 @@ from semsearch_cli.report.stats import mean_ci  # noqa: E402
 from semsearch_cli.runner import BatchOptions, Loaded, read_runs  # noqa: E402
 
 READERS = ("wall_numbers", "numbering")  # the sign-reading planners measured
+LEVEL_READERS = ("wall_numbers",)  # those run again at each intervention's levels (time: 2 cores)
 REFERENCES = ("greedy", "oracle_goal")  # the gap's ends
 # the interventions: (parameter, the split's own value, the values run again)
 LEVELS = (("door_camera.range", 3.0, (6.0, 10.0)), ("door_camera.p_read", 0.95, (0.5, 0.8)))
@@ -65,7 +66,7 @@ def _one(task: tuple) -> str:
     eps_file = scen.parent / doc["episodes"]["file"]
     eps = pd.read_csv(eps_file, dtype=str, keep_default_na=False)
     eps.groupby("goal", sort=False).head(starts).to_csv(eps_file, index=False, lineterminator="\n")
-    doc["planners"] = [{"name": p} for p in (REFERENCES + READERS if numbering == "true" else READERS)]
+    doc["planners"] = [{"name": p} for p in (REFERENCES + LEVEL_READERS if numbering == "true" else LEVEL_READERS)]
     scen.write_text(f"# doors-v1 val {fid}, {numbering}, {param}={value:g} (benchmarks/where_signs_pay.py)\n"
                     + yaml.safe_dump(doc, sort_keys=False))
     res = api.run(scen, BatchOptions(out=dest / "rows", workers=1), plots=False)
@@ -112,12 +113,12 @@ def floor_factors() -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def stats(rows: pd.DataFrame, units) -> list[dict]:
+def stats(rows: pd.DataFrame, units, readers=READERS) -> list[dict]:
     """Per sign reader, on ``units`` (episodes): SPL, semantic gain, SPL and distance gap closed."""
     d = rows[rows["unit"].isin(units)]
     pick = {(p, n): d[(d["planner"] == p) & (d["numbering"] == n)] for p in REFERENCES + READERS for n in ("true", "shuffled")}
     res = []
-    for p in READERS:  # every column over the episodes all four sides ran
+    for p in readers:  # every column over the episodes all four sides ran
         sides = (pick[("greedy", "true")], pick[("oracle_goal", "true")], pick[(p, "true")], pick[(p, "shuffled")])
         common = set.intersection(*(set(x["unit"]) for x in sides))
         g, o, t, s = (x[x["unit"].isin(common)] for x in sides)
@@ -173,7 +174,8 @@ def table(name: str, levels: list[tuple[str, list[dict]]]) -> str:
 def figure(name: str, levels: list[tuple[str, list[dict]]], path: Path) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
     x = np.arange(len(levels))
-    for k, p in enumerate(READERS):
+    readers = [r["planner"] for r in levels[0][1]]
+    for k, p in enumerate(readers):
         for ax, key, scale in ((axes[0], "semantic gain", 1.0), (axes[1], "SPL gap closed", 100.0)):
             v = np.array([[next(r for r in res if r["planner"] == p)[key][j] for j in range(3)] for _, res in levels]) * scale
             off = (k - 0.5) * 0.12
@@ -216,7 +218,8 @@ def tables(val: Path, shuffled: Path, levels_dir: Path | None, figures: Path | N
         for param, default, values in LEVELS:
             extra = {v: level_rows(levels_dir, param, v) for v in values}
             units = set.intersection(*(set(e["unit"]) for e in extra.values()))
-            levels = [(f"{default:g}", stats(rows, units))] + [(f"{v:g}", stats(e, units)) for v, e in extra.items()]
+            levels = ([(f"{default:g}", stats(rows, units, LEVEL_READERS))]
+                      + [(f"{v:g}", stats(e, units, LEVEL_READERS)) for v, e in extra.items()])
             levels.sort(key=lambda t: float(t[0]))
             name = {"door_camera.range": "door camera range (m)", "door_camera.p_read": "p_read"}[param]
             out += ["", f"### {name}", "", table(name, levels)]
