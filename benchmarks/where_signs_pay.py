@@ -137,7 +137,7 @@ def _bins(values: pd.Series, name: str) -> tuple[pd.Series, list[str]]:
     as none and the lettered floors' halves; the convention as itself."""
     if name == "convention":  # the schemes grouped: few val floors have any one parity scheme
         other = sorted(set(values) - {"loop", "random"})
-        lab = f"parity ({len(other)} schemes)"
+        lab = f"parity, {len(other)} schemes"
         return values.map(lambda c: c if c in ("loop", "random") else lab), ["loop", lab, "random"]
     fmt = "{:.0f}" if values.max() > 20 else "{:.2f}"
     if name == "lettered share":  # a third of the floors have none
@@ -180,7 +180,7 @@ def figure(name: str, levels: list[tuple[str, list[dict]]], path: Path) -> None:
             v = np.array([[next(r for r in res if r["planner"] == p)[key][j] for j in range(3)] for _, res in levels]) * scale
             off = (k - 0.5) * 0.12
             err = [np.fmax(v[:, 0] - v[:, 1], 0), np.fmax(v[:, 2] - v[:, 0], 0)]  # a BCa bound past its point: no bar that side
-            ax.errorbar(x + off, v[:, 0], yerr=err, fmt="o-", capsize=3, label=p)
+            ax.errorbar(x + off, v[:, 0], yerr=err, fmt="o" if name == "convention" else "o-", capsize=3, label=p)
     for ax, lab in ((axes[0], "semantic gain (SPL, true − shuffled)"), (axes[1], "greedy→oracle_goal SPL gap closed (%)")):
         ax.axhline(0, color="0.6", lw=0.8)
         ax.set_xticks(x, [lev for lev, _ in levels], rotation=20 if len(levels) > 4 else 0, fontsize=8)
