@@ -87,6 +87,13 @@ def test_oracle_goal_is_the_ceiling_and_the_board_keeps_it_apart(tmp_path):
     assert ranked.loc["costly_nearest", "tuned on"] == "none"  # its class states nothing: the default
     assert ranked.loc["costly_nearest", "SPL gap closed"].startswith("0.0%")  # greedy's twin closes none of it
     assert "SPL gap closed" not in t["references"].columns or not t["references"]["SPL gap closed"].astype(str).str.len().any()
+    # a folder that ran no privileged planner (the shuffled ablation) has no privileged column: its rows were told nothing
+    api.bench_run("doors-v1", ["numbering"], tmp_path / "s", numbering="shuffled", options=opts, limit=4)
+    t = tables(load([out, tmp_path / "s"]))
+    ranked = t["planners"].set_index("planner")
+    assert list(t["references"]["planner"]) == ["oracle_goal"]
+    assert "privileged" not in ranked.loc["numbering", "official"], ranked.loc["numbering", "official"]
+    assert ranked.loc["numbering", "semantic gain"] != ""
 
 
 def test_a_runs_csv_is_widened_in_place_keeping_its_rows(tmp_path):

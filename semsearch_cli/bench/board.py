@@ -138,6 +138,8 @@ def load(folders) -> pd.DataFrame:
     if not frames:
         raise ScenarioError(str(folders[0]), "", "the bench folders hold no rows")
     rows = pd.concat(frames, ignore_index=True)
+    if PRIVILEGED in rows.columns:  # a folder that ran no privileged planner has no such column: its rows were told nothing
+        rows[PRIVILEGED] = rows[PRIVILEGED].fillna("")
     _once(rows)
     return rows
 
