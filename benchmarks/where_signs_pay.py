@@ -143,7 +143,7 @@ def _bins(values: pd.Series, name: str) -> tuple[pd.Series, list[str]]:
     if name == "lettered share":  # a third of the floors have none
         has = values > 0
         med = fmt.format(values[has].median())
-        lab = ["none", f"≤ {med}", f"> {med}"]
+        lab = ["none", f"(0, {med}]", f"> {med}"]
         return pd.Series(np.where(~has, lab[0], np.where(values <= values[has].median(), lab[1], lab[2])), values.index), lab
     if values.isna().any():
         raise ValueError(f"{name}: floors {', '.join(values.index[values.isna()])} have no value")
@@ -172,24 +172,33 @@ def table(name: str, levels: list[tuple[str, list[dict]]]) -> str:
 
 
 def figure(name: str, levels: list[tuple[str, list[dict]]], path: Path) -> None:
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
-    x = np.arange(len(levels))
+    """Three panels: the semantic gain, the SPL gap closed and the distance gap closed by level,
+    one series per planner, 95% intervals as bars; a numeric factor (an intervention) on a
+    numeric axis."""
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.4), constrained_layout=True)
+    try:
+        x = np.array([float(lev) for lev, _ in levels])
+        numeric = True
+    except ValueError:
+        x, numeric = np.arange(len(levels), dtype=float), False
     readers = [r["planner"] for r in levels[0][1]]
+    panels = (("semantic gain", 1.0, "semantic gain (SPL, true − shuffled)"),
+              ("SPL gap closed", 100.0, "SPL gap closed (%)"), ("distance gap closed", 100.0, "distance gap closed (%)"))
     for k, p in enumerate(readers):
-        for ax, key, scale in ((axes[0], "semantic gain", 1.0), (axes[1], "SPL gap closed", 100.0)):
+        off = 0.0 if len(readers) == 1 else (k - (len(readers) - 1) / 2) * (0.02 * np.ptp(x) if numeric else 0.12)
+        for ax, (key, scale, _) in zip(axes, panels):
             v = np.array([[next(r for r in res if r["planner"] == p)[key][j] for j in range(3)] for _, res in levels]) * scale
-            off = (k - 0.5) * 0.12
             err = [np.fmax(v[:, 0] - v[:, 1], 0), np.fmax(v[:, 2] - v[:, 0], 0)]  # a BCa bound past its point: no bar that side
             ax.errorbar(x + off, v[:, 0], yerr=err, fmt="o" if name == "convention" else "o-", capsize=3, label=p)
-    for ax, lab in ((axes[0], "semantic gain (SPL, true − shuffled)"), (axes[1], "greedy→oracle_goal SPL gap closed (%)")):
+    for ax, (_, _, lab) in zip(axes, panels):
         ax.axhline(0, color="0.6", lw=0.8)
-        ax.set_xticks(x, [lev for lev, _ in levels], rotation=20 if len(levels) > 4 else 0, fontsize=8)
+        ax.set_xticks(x, [lev for lev, _ in levels], rotation=0 if numeric else 15, fontsize=8)
         ax.set_xlabel(name)
         ax.set_ylabel(lab)
     axes[0].legend(fontsize=8)
-    fig.suptitle(f"doors-v1 val: where signs pay, by {name} (95% BCa over episodes)", fontsize=10)
+    fig.suptitle(f"doors-v1 val: where signs pay, by {name}; 95% BCa intervals over episodes", fontsize=10)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
