@@ -11,8 +11,9 @@ restricted to the episodes the other levels ran (the first ``--starts`` starts o
 levels of a factor are paired on the same episodes.
 
 Usage:
-  python benchmarks/where_signs_pay.py run --out OUT [--starts 1] [--workers 2]
-  python benchmarks/where_signs_pay.py tables --val TRUE --shuffled SHUFFLED --levels OUT \\
+  python benchmarks/where_signs_pay.py run --out OUT [--starts 1] [--workers 2] [--readers wall_numbers]
+  python benchmarks/where_signs_pay.py run --out OUT2 --readers numbering --no-references
+  python benchmarks/where_signs_pay.py tables --val TRUE --shuffled SHUFFLED --levels OUT [OUT2] \\
       [--figures docs/figures/where-signs-pay] [--md FILE]
 
 TRUE and SHUFFLED are bench folders of doors-v1 val (`semsearch bench run doors-v1 --planner
@@ -45,7 +46,6 @@ from semsearch_cli.report.stats import mean_ci  # noqa: E402
 from semsearch_cli.runner import BatchOptions, Loaded, read_runs  # noqa: E402
 
 READERS = ("wall_numbers", "numbering")  # the sign-reading planners measured
-LEVEL_READERS = ("wall_numbers",)  # those run again at each intervention's levels (time: 2 cores)
 REFERENCES = ("greedy", "oracle_goal")  # the gap's ends
 # the interventions: (parameter, the split's own value, the values run again)
 LEVELS = (("door_camera.range", 3.0, (6.0, 10.0)), ("door_camera.p_read", 0.95, (0.5, 0.8)))
@@ -58,7 +58,7 @@ LEVELS = (("door_camera.range", 3.0, (6.0, 10.0)), ("door_camera.p_read", 0.95, 
 def _one(task: tuple) -> str:
     """One floor, numbering and parameter value: the floor materialised as the bench runs it,
     the parameter set, the first ``starts`` starts per goal kept, its planners run (resumable)."""
-    out, param, value, numbering, fid, starts = task
+    out, param, value, numbering, fid, starts, planners = task
     sp = bench.open_split("doors-v1", "val")
     dest = out / f"{param}={value:g}" / numbering / fid
     scen = materialise(sp, sp.floor(fid), numbering, dest / "scenario")
@@ -66,16 +66,19 @@ def _one(task: tuple) -> str:
     eps_file = scen.parent / doc["episodes"]["file"]
     eps = pd.read_csv(eps_file, dtype=str, keep_default_na=False)
     eps.groupby("goal", sort=False).head(starts).to_csv(eps_file, index=False, lineterminator="\n")
-    doc["planners"] = [{"name": p} for p in (REFERENCES + LEVEL_READERS if numbering == "true" else LEVEL_READERS)]
+    doc["planners"] = [{"name": p} for p in planners]
     scen.write_text(f"# doors-v1 val {fid}, {numbering}, {param}={value:g} (benchmarks/where_signs_pay.py)\n"
                     + yaml.safe_dump(doc, sort_keys=False))
     res = api.run(scen, BatchOptions(out=dest / "rows", workers=1), plots=False)
     return f"{param}={value:g} {numbering} {fid}: {len(res.runs)} runs"
 
 
-def run(out: Path, starts: int, workers: int) -> int:
+def run(out: Path, starts: int, workers: int, readers: tuple[str, ...], references: bool) -> int:
+    """The interventions into ``out``: ``readers`` under both numberings, and greedy and
+    oracle_goal under the true one when ``references`` (a folder of its own per set of planners)."""
     sp = bench.open_split("doors-v1", "val")
-    tasks = [(out, param, v, numbering, f.id, starts) for param, _, values in LEVELS for v in values
+    planners = {"true": (REFERENCES if references else ()) + readers, "shuffled": readers}
+    tasks = [(out, param, v, numbering, f.id, starts, planners[numbering]) for param, _, values in LEVELS for v in values
              for numbering in ("true", "shuffled") for f in sp.floors]
     with mp.get_context("spawn").Pool(workers) as pool:
         for i, said in enumerate(pool.imap_unordered(_one, tasks), 1):
@@ -202,9 +205,9 @@ def figure(name: str, levels: list[tuple[str, list[dict]]], path: Path) -> None:
     plt.close(fig)
 
 
-def level_rows(levels_dir: Path, param: str, value: float) -> pd.DataFrame:
+def level_rows(levels_dirs: list[Path], param: str, value: float) -> pd.DataFrame:
     frames = []
-    for f in sorted((levels_dir / f"{param}={value:g}").glob("*/*/rows/runs.csv")):
+    for f in sorted(f for d in levels_dirs for f in (d / f"{param}={value:g}").glob("*/*/rows/runs.csv")):
         r = read_runs(f)
         r = r[(r["stage"] == "") & ~outside_the_run(r)]  # as the board: a run that failed for a cause outside it is no run
         numbering, fid = f.parts[-4], f.parts[-3]
@@ -213,22 +216,24 @@ def level_rows(levels_dir: Path, param: str, value: float) -> pd.DataFrame:
         orig = kept.to_numpy()[r["episode"].to_numpy(int)]  # the runner numbers the kept episodes 0, 1, ...: the split's numbers
         frames.append(r.assign(numbering=numbering, floor=fid, unit=[f"{fid}/{e}" for e in orig]))
     if not frames:
-        raise SystemExit(f"{levels_dir}: no rows of {param}={value:g} (run `where_signs_pay.py run --out {levels_dir}` first)")
+        raise SystemExit(f"{', '.join(map(str, levels_dirs))}: no rows of {param}={value:g} (run `where_signs_pay.py run` first)")
     return pd.concat(frames, ignore_index=True)
 
 
-def tables(val: Path, shuffled: Path, levels_dir: Path | None, figures: Path | None, md: Path | None) -> int:
+def tables(val: Path, shuffled: Path, levels_dirs: list[Path] | None, figures: Path | None, md: Path | None) -> int:
     rows = pd.concat([load([val]), load([shuffled])], ignore_index=True)
     rows = rows[~rows["unavailable"]]
     out = [f"doors-v1 val: {rows['unit'].nunique()} episodes; sign readers {', '.join(READERS)}; "
            "[95% BCa over episodes]"]
     slug = {}
-    if levels_dir is not None:
+    if levels_dirs:
         for param, default, values in LEVELS:
-            extra = {v: level_rows(levels_dir, param, v) for v in values}
+            extra = {v: level_rows(levels_dirs, param, v) for v in values}
+            ran = set.intersection(*({(p, n) for p, n in zip(e["planner"], e["numbering"])} for e in extra.values()))
+            readers = tuple(p for p in READERS if {(p, "true"), (p, "shuffled")} <= ran)
             units = set.intersection(*(set(e["unit"]) for e in extra.values()))
-            levels = ([(f"{default:g}", stats(rows, units, LEVEL_READERS))]
-                      + [(f"{v:g}", stats(e, units, LEVEL_READERS)) for v, e in extra.items()])
+            levels = ([(f"{default:g}", stats(rows, units, readers))]
+                      + [(f"{v:g}", stats(e, units, readers)) for v, e in extra.items()])
             levels.sort(key=lambda t: float(t[0]))
             name = {"door_camera.range": "door camera range (m)", "door_camera.p_read": "p_read"}[param]
             out += ["", f"### {name}", "", table(name, levels)]
@@ -258,15 +263,17 @@ def main() -> int:
     r.add_argument("--out", type=Path, required=True)
     r.add_argument("--starts", type=int, default=1)
     r.add_argument("--workers", type=int, default=2)
+    r.add_argument("--readers", default="wall_numbers", help="sign readers run at each level, comma-separated")
+    r.add_argument("--no-references", action="store_true", help="leave greedy and oracle_goal out (another folder has them)")
     t = sub.add_parser("tables")
     t.add_argument("--val", type=Path, required=True)
     t.add_argument("--shuffled", type=Path, required=True)
-    t.add_argument("--levels", type=Path)
+    t.add_argument("--levels", type=Path, nargs="+", help="the folders of `run` (one per set of planners)")
     t.add_argument("--figures", type=Path)
     t.add_argument("--md", type=Path)
     a = ap.parse_args()
     if a.cmd == "run":
-        return run(a.out, a.starts, a.workers)
+        return run(a.out, a.starts, a.workers, tuple(a.readers.split(",")), not a.no_references)
     return tables(a.val, a.shuffled, a.levels, a.figures, a.md)
 
 
