@@ -35,7 +35,7 @@ from .report.figures.distances import plot_alpha_sweep, plot_sweep
 from .report.tables import summarise, sweep_table
 from .runner import Batch, BatchOptions, Loaded, expand, folder_lock, make_executor, run_rows, workers_for
 from .runner.store import read_runs
-from .runner.verify import UNFINISHED, Verdict, records_in, verify_folder
+from .runner.verify import UNFINISHED, Verdict, check_folder_engine, records_in, verify_folder
 from .tasks import TASKS
 from .tasks.decisions import Seat
 from .tasks.doors import DoorTask
@@ -196,6 +196,7 @@ def export(folder: str | Path, out: str | Path, fmt: str = "mcap", run: str | No
     if not ros2.available():
         raise MissingExtra("semsearch export", "ros")
     folder = Path(folder)
+    check_folder_engine(folder)
     _, loaded = _rows_scenario(folder, scenario)
     ros2.exportable(loaded)  # before the output folder is made
     with folder_lock(Path(out)):
@@ -335,6 +336,7 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
     cpus = os.cpu_count() or 1
     if workers is not None and workers > cpus:
         raise ScenarioError("<command line>", "--workers", f"{workers} replaying processes on {cpus} CPUs: at most {cpus}")
+    check_folder_engine(folder)  # another engine's runs replay with the release that made them
     if bench.is_bench(folder):
         if scenario is not None:
             raise ScenarioError("<command line>", "--scenario", f"{folder} is a bench folder: its floors are the suite's "

@@ -10,13 +10,14 @@ import pandas as pd
 from .errors import UNAVAILABLE
 from .planners.base import COST_COLUMNS  # noqa: F401  (the rows' cost columns, read with the others from here)
 
-# the columns of runs.csv as 0.2.0 wrote them, for every kind: the ones every kind writes, and the
+# the columns of runs.csv as 0.2.0 wrote them (and ``engine``, the simulator engine that made the row,
+# from 0.3.0; a row without it was made by engine 1: semsearch_cli.engine), for every kind: the ones every kind writes, and the
 # built-in kinds' own (room and time_s: indirect search; stage and map: chains), each in its place.
 # A runs.csv holds all of them through 0.2.x; a kind's columns beyond these (a kind from another
 # package, Task.columns) follow them, in the folders of that kind (columns_for).
 COLUMNS = ["kind", "scenario", "planner", "params", "goal", "episode", "seed", "start_x", "start_y", "start_heading",
            "room", "stage", "map", "outcome", "cause", "success", "distance_m", "shortest_m", "ratio", "spl", "soft_spl",
-           "left_m", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint", "code"]
+           "left_m", "time_s", "steps", "decisions", "navigator", "wall_s", "message", "fingerprint", "code", "engine"]
 BUILT_IN_KIND_COLUMNS = ("room", "stage", "map", "time_s")
 SHARED = [c for c in COLUMNS if c not in BUILT_IN_KIND_COLUMNS]  # what every kind's run row holds (run_row)
 # what a semsearch-bench run adds to each row (semsearch bench run): the suite, its split and that

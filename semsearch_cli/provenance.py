@@ -19,6 +19,7 @@ from pathlib import Path
 
 from . import __version__
 from .checkout import checkout_commit
+from .engine import ENGINE
 
 PACKAGE = Path(__file__).resolve().parent
 DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "scikit-image", "opencv-python-headless", "matplotlib", "pydantic")
@@ -93,9 +94,10 @@ def git_commit() -> str | None:
 
 
 def version_line() -> str:
-    """``semsearch 0.2.0 (code 1a2b..., commit abc...)``: what ``semsearch --version`` prints."""
+    """``semsearch 0.3.0 (engine 2, code 1a2b..., commit abc...)``: what ``semsearch --version``
+    prints (the engine: :mod:`semsearch_cli.engine`)."""
     commit = git_commit()
-    return f"semsearch {__version__} (code {code_hash()}" + (f", commit {commit}" if commit else "") + ")"
+    return f"semsearch {__version__} (engine {ENGINE}, code {code_hash()}" + (f", commit {commit}" if commit else "") + ")"
 
 
 def environment() -> dict:
@@ -110,5 +112,5 @@ def environment() -> dict:
 
 
 def describe() -> dict:
-    """semsearch's version, code hash, commit and environment, for meta.json."""
-    return {"version": __version__, "code": code_hash(), "commit": git_commit(), **environment()}
+    """semsearch's version, simulator engine, code hash, commit and environment, for meta.json."""
+    return {"version": __version__, "engine": ENGINE, "code": code_hash(), "commit": git_commit(), **environment()}

@@ -24,6 +24,7 @@ from typer.testing import CliRunner
 from semsearch_cli import api, bench
 from semsearch_cli.bench.board import at_budget, paired_diff, uis_budgets
 from semsearch_cli.bench.predictability import predictability
+from semsearch_cli.engine import ENGINE
 from semsearch_cli.bench.suites import build, read_split
 from semsearch_cli.cli import app
 from semsearch_cli.planners import PLANNERS, Variant
@@ -334,7 +335,7 @@ def test_the_board_opens_in_a_browser_and_sorts_by_a_column(tmp_path):
     found = re.search(r'data-probe="([^"]*)"', res.stdout)
     assert found, res.stderr[-2000:]
     probe = json.loads(html_lib.unescape(found.group(1)))
-    assert probe["headings"] == ["doors-v1 val"] and probe["images"] >= 1 and probe["broken"] == 0
+    assert probe["headings"] == [f"doors-v1 val, engine {ENGINE}"] and probe["images"] >= 1 and probe["broken"] == 0
     assert probe["up"] == sorted(probe["before"]) and probe["down"] == sorted(probe["before"], reverse=True)
     assert len(files) >= 2
 

@@ -13,6 +13,7 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli import __version__
+from semsearch_cli.engine import ENGINE
 from semsearch_cli.cli import app
 from semsearch_cli.runner import BatchOptions, expand, Loaded, run_batch
 from semsearch_cli.tasks.episodes import region_mask
@@ -199,7 +200,7 @@ def test_meta_json_records_the_provenance(tmp_path):
 
 def test_version_and_the_planner_list():
     res = CliRunner().invoke(app, ["--version"])
-    assert res.exit_code == 0 and res.output.startswith(f"semsearch {__version__} (code ")
+    assert res.exit_code == 0 and res.output.startswith(f"semsearch {__version__} (engine {ENGINE}, code ")
     # a process of its own, as a user runs it (a process registers a planner name from one file only), from the
     # checkout: the planner file's path is shown relative to the working folder, whatever the clone's path
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "planners",

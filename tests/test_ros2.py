@@ -349,3 +349,30 @@ def test_a_robots_own_bag_replays_from_its_map_poses_and_detections(recorded, tm
     assert res.exit_code == 0, res.output
     via_tf = [(round(g.pose.position.x, 6), round(g.pose.position.y, 6)) for _, g in messages(tmp_path / "out_tf")["/semsearch/goal"]]
     assert via_tf == [(round(x, 6), round(y, 6)) for x, y in targets]  # the same targets, the poses composed to within rounding
+
+
+def test_a_bag_names_its_engine_and_a_bag_of_another_engine_is_refused(recorded, tmp_path):
+    """/semsearch/setup names the simulator engine; a bag of another engine is refused by `ros
+    replay` before its scenario is looked for, naming the release that replays it (issue 54)."""
+    from semsearch_cli.engine import ENGINE, release
+    from semsearch_cli.ros2.replay import BagStream
+    out, _, _, scenario = recorded
+    res = CliRunner().invoke(app, ["export", str(out / "results"), "--out", str(tmp_path / "bags"), "--scenario", str(scenario),
+                                   "--run", RUN])
+    assert res.exit_code == 0, res.output
+    other = 2 if ENGINE == 1 else 1
+    m = Messages()
+    stream = BagStream(tmp_path / "bags" / RUN, m)
+    w = BagWriter(tmp_path / "other", "mcap", Messages())
+    item = stream.next()
+    setup = json.loads(item[2].data)
+    assert setup["engine"] == ENGINE
+    w.write(item[0], item[1], w.msgs.string({**setup, "engine": other}))
+    while (item := stream.next()) is not None:
+        w.write(item[0], item[1], item[2])
+    stream.close()
+    w.close()
+    res = CliRunner().invoke(app, ["ros", "replay", str(tmp_path / "other"), "--planner", "greedy", "--out", str(tmp_path / "a")])
+    text = " ".join(res.output.split())
+    assert res.exit_code == 2 and f"made by simulator engine {other}" in text and release(other) in text, res.output
+    assert not (tmp_path / "a").exists()

@@ -13,6 +13,7 @@ import yaml
 from typer.testing import CliRunner
 
 from semsearch_cli import __version__, shipped
+from semsearch_cli.engine import ENGINE
 from semsearch_cli.cli import app
 from semsearch_cli.runner import Loaded
 
@@ -122,7 +123,7 @@ def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_
     assert res.returncode == 0 and "kth: ok" in res.stdout, res.stderr
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "--version"],
                          capture_output=True, text=True, cwd=elsewhere, env=env)
-    assert res.stdout.startswith(f"semsearch {__version__} (code ") and f"commit {head}" in res.stdout, res.stdout
+    assert res.stdout.startswith(f"semsearch {__version__} (engine {ENGINE}, code ") and f"commit {head}" in res.stdout, res.stdout
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "bench", "list"],
                          capture_output=True, text=True, cwd=elsewhere, env=env)
     assert res.returncode == 0 and "doors-real-v1" in res.stdout, res.stdout + res.stderr

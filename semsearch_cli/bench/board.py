@@ -1,6 +1,7 @@
 """``semsearch bench board``: the results page of one or more bench folders (HTML and Markdown).
 
-Per suite and split, every planner's success, SPL, SoftSPL and mean distance over the episodes,
+Per suite, split and simulator engine (rows of two engines are never paired or pooled), every
+planner's success, SPL, SoftSPL and mean distance over the episodes,
 each with a 95% interval over episodes (the unit: a floor's episode, its repeats averaged); the
 paired difference in SPL to ``nsos[alpha=0.9]`` on the same episodes; the semantic gain (SPL under
 the true numbering minus SPL under shuffled labels, paired episode by episode) overall and per
@@ -144,7 +145,7 @@ def load(folders) -> pd.DataFrame:
     return rows
 
 
-RUN_KEY = ["suite", "split", "suite_hash", "numbering", "planner", "floor", "goal", "episode", "seed"]
+RUN_KEY = ["suite", "split", "suite_hash", "engine", "numbering", "planner", "floor", "goal", "episode", "seed"]
 
 
 def _once(rows: pd.DataFrame) -> None:
@@ -449,8 +450,12 @@ def board(folders, out: str | Path) -> list[Path]:
              "sides ran the same episodes. Semantic gain: SPL under the floor's true numbering minus SPL under its labels "
              "shuffled among its signs. Click a column's header to sort.")
     written = []
-    for (suite, split, hash_), g in rows.groupby(["suite", "split", "suite_hash"], sort=False):
-        doc.heading(2, f"{suite} {split}" + ("" if g["official"].all() else f" ({hash_[:16]})"))
+    engines = sorted(set(rows["engine"]))
+    if len(engines) > 1:
+        doc.para(f"These folders hold rows of simulator engines {', '.join(map(str, engines))}: each engine's rows are a board "
+                 "of their own, never paired or pooled with another engine's (docs/engines.md).")
+    for (suite, split, hash_, engine), g in rows.groupby(["suite", "split", "suite_hash", "engine"], sort=False):
+        doc.heading(2, f"{suite} {split}" + ("" if g["official"].all() else f" ({hash_[:16]})") + f", engine {engine}")
         eps = float(g["split_episodes"].max())
         done = g[~g["unavailable"] & (g["numbering"] == "true")]
         ran = set(g.loc[g["numbering"] == "true", "planner"])  # a planner none of whose runs could run is not whole either
@@ -458,7 +463,7 @@ def board(folders, out: str | Path) -> list[Path]:
         official = ("not official (no published hash matches)" if not g["official"].all() else
                     "official (the published hash)" if whole and all(whole) else
                     "the published hash, but partial: a planner lacks runs of the split (a --limit run), so not official")
-        doc.para(f"suite hash {hash_[:16]}; the split: {f'{eps:.0f} episodes' if np.isfinite(eps) else 'episodes unknown'} "
+        doc.para(f"simulator engine {engine}; suite hash {hash_[:16]}; the split: {f'{eps:.0f} episodes' if np.isfinite(eps) else 'episodes unknown'} "
                  f"(each planner's own count in its row); numberings run: {', '.join(sorted(set(g['numbering'])))}; {official}")
         if (g["kind"] == "indirect").all():
             _indirect_section(doc, g)
@@ -481,13 +486,14 @@ def board(folders, out: str | Path) -> list[Path]:
             doc.heading(3, "SPL under the true numbering minus under each permutation")
             doc.table(t["numberings"].set_index("planner"), fmt="{}")
         if len(t["floors"]) and t["floors"]["predictability"].notna().any():
-            fig = out / f"gain_vs_predictability_{suite}_{split}_{hash_[:8]}.png"
+            stem = f"{suite}_{split}_{hash_[:8]}" + ("" if engine == 1 else f"_engine{engine}")
+            fig = out / f"gain_vs_predictability_{stem}.png"
             written += plot_gain_vs_predictability(t["floors"], fig)
             doc.figure(fig, f"{suite} {split}: each floor's semantic gain (mean SPL over its episodes, true minus shuffled) "
                        "against its predictability (docs/bench.md), marked by numbering convention, with the least-squares "
                        "line over the floors.")
-            t["floors"].to_csv(out / f"floors_{suite}_{split}_{hash_[:8]}.csv", index=False)
-            written.append(out / f"floors_{suite}_{split}_{hash_[:8]}.csv")
+            t["floors"].to_csv(out / f"floors_{stem}.csv", index=False)
+            written.append(out / f"floors_{stem}.csv")
     atomic_text(out / "board.md", doc.markdown(out))
     atomic_text(out / "index.html", doc.html("semsearch-bench results", sortable=True))
     return [out / "index.html", out / "board.md", *written]

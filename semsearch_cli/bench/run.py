@@ -34,7 +34,7 @@ from ..planners.base import expand_variants, preflight
 from ..runner import Batch, BatchOptions, Loaded, folder_lock, make_executor, read_runs
 from ..runner.batch import BENCH_FILE as _BENCH_MARK
 from ..runner.specs import RunList
-from ..runner.verify import Verdict, verify_folder
+from ..runner.verify import Verdict, check_folder_engine, verify_folder
 from ..tasks.episodes import Episode
 from .numbering import NUMBERINGS, relabel
 from .predictability import predictability
@@ -338,6 +338,7 @@ def verify_bench(folder: str | Path, salt_file: str | Path | None = None, worker
     named. Returns the split and each floor's :class:`~semsearch_cli.runner.verify.Verdict`."""
     folder = Path(folder)
     meta = read_bench(folder)
+    check_folder_engine(folder)  # before the split: another engine's runs replay with the release that made them
     sp = open_split(meta["suite"], meta["split"], salt_file)
     if sp.hash != meta.get("hash"):
         raise ScenarioError(str(folder / BENCH_FILE), "hash", f"the results were made on {meta['suite']} {meta['split']} of hash "

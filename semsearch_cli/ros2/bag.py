@@ -30,8 +30,9 @@ START_NS = 1_000_000_000  # the first step's stamp (1 s: some tools read 0 as "n
 # topic -> (message type, when it is published, what it holds)
 TOPICS = {
     "/semsearch/setup": ("std_msgs/msg/String", "once, first",
-                         'JSON {"scenario", "file", "fingerprint", "rng_inc", "goal", "planner", "episode", "seed"}: the run '
-                         'this bag records (its scenario\'s name, file name and fingerprint; its generator\'s increment)'),
+                         'JSON {"scenario", "file", "fingerprint", "engine", "rng_inc", "goal", "planner", "episode", "seed"}: '
+                         'the run this bag records (its scenario\'s name, file name and fingerprint; the simulator engine it '
+                         'ran on; its generator\'s increment)'),
     "/map": ("nav_msgs/msg/OccupancyGrid", "at the start, at each decision and at the end",
              "the belief over the whole grid: -1 never seen, 0 free, 100 occupied"),
     "/semsearch/map_updates": ("map_msgs/msg/OccupancyGridUpdate", "each frame that changed the map",

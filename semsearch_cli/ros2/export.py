@@ -16,10 +16,11 @@ from typing import Callable
 import numpy as np
 
 from ..config.base import sign_label
+from ..engine import ENGINE
 from ..errors import ScenarioError, did_you_mean
 from ..runner.specs import Loaded, file_stem
 from ..runner.store import json_safe, read_runs
-from ..runner.verify import replay_run
+from ..runner.verify import check_engine, replay_run
 from ..tasks.base import Observer
 from ..tasks.doors import DoorDecision, DoorFrame, DoorPlan, DoorStep, DoorTask
 from ..tasks.episodes import episode_seed
@@ -165,6 +166,7 @@ def recorded_runs(folder: Path) -> list[tuple[str, dict, Path]]:
     that has a record (``semsearch run --decisions``); chain stages are left out (a chain's
     run is exported as its first stage's search is not: one search per bag)."""
     rows = read_runs(folder / "runs.csv", as_written=True)
+    check_engine(rows, folder / "runs.csv")  # another engine's runs replay with the release that made them
     out = []
     for row in rows[rows["stage"] == ""].to_dict("records"):
         name = file_stem(str(row["planner"]), row["goal"], int(row["seed"]), int(row["episode"]))
@@ -195,7 +197,7 @@ def export_run(loaded: Loaded, name: str, row: dict, record_file: Path, out: Pat
     try:
         bag = BagWriter(tmp, fmt, Messages())
         rec = BagRecorder(bag, loaded.world, ep.goal, loaded.sc.robot.step, loaded.sc.laser.range)
-        setup = {"scenario": loaded.sc.name, "file": loaded.path.stem, "fingerprint": loaded.fingerprint,
+        setup = {"scenario": loaded.sc.name, "file": loaded.path.stem, "fingerprint": loaded.fingerprint, "engine": ENGINE,
                  # the run's generator's increment (fixed for a run; seeded as Task.run seeds it): with the
                  # states the events carry (rng_word), the replay's generator is the run's
                  "rng_inc": np.random.default_rng(episode_seed(ep, int(row["seed"]), loaded.sc.experiment.base_seed))

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config.base import sign_label
+from ..engine import engine_of, refusal as engine_refusal  # (robot.refusal: a message a robot may not send)
 from ..geometry import GridFrame
 from ..errors import BudgetSpent, MissingExtra, PlannerError, ScenarioError
 from ..optional import lazy_module
@@ -221,6 +222,9 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
     try:
         if "/semsearch/events" in stream.topics:
             setup = _setup(stream, bag)
+            why = engine_refusal(setup["engine"], f"the bag {bag.name}")
+            if why:
+                raise ScenarioError(str(bag), "/semsearch/setup.engine", why)
             if loaded is None or setup["fingerprint"] != loaded.fingerprint:
                 have = f"{loaded.path.name}'s is {loaded.fingerprint}" if loaded is not None else "no scenario given"
                 raise ScenarioError(str(bag), "/semsearch/setup", f"the bag was recorded on another scenario (fingerprint "
@@ -270,11 +274,20 @@ def recorded_scenario(bag: Path) -> str | None:
         item = stream.peek()
         if item is None or item[0] != "/semsearch/setup":
             return None
-        return json.loads(item[2].data).get("file")
+        setup = json.loads(item[2].data)
     except (ValueError, KeyError, AttributeError):  # a setup that is not ours to read
         return None
     finally:
         stream.close()
+    if not isinstance(setup, dict):
+        return None
+    try:  # another engine's bag: refused before its scenario is looked for (the release that made it replays it)
+        why = engine_refusal(engine_of(setup.get("engine")), f"the bag {bag.name}")
+    except ValueError:
+        why = None  # named by the replay's own check of the setup
+    if why:
+        raise ScenarioError(str(bag), "/semsearch/setup.engine", why)
+    return setup.get("file")
 
 
 SETUP_KEYS = {"fingerprint": str, "goal": (str, int), "rng_inc": int}  # what a replay reads of /semsearch/setup
@@ -297,6 +310,11 @@ def _setup(stream: BagStream, bag: Path) -> dict:
         if not isinstance(setup.get(key), kind) or isinstance(setup.get(key), bool):
             raise ScenarioError(str(bag), f"/semsearch/setup.{key}", f"is {setup.get(key)!r}: not a setup `semsearch export` "
                                 "wrote")
+    try:  # a bag exported before engines were recorded: engine 1
+        setup["engine"] = engine_of(setup.get("engine"))
+    except ValueError:
+        raise ScenarioError(str(bag), "/semsearch/setup.engine", f"is {setup.get('engine')!r}: not a setup `semsearch export` "
+                            "wrote") from None
     if not 0 <= setup["rng_inc"] < 2**128:
         raise ScenarioError(str(bag), "/semsearch/setup.rng_inc", f"{setup['rng_inc']} is not a generator's increment (0 to 2**128)")
     return setup

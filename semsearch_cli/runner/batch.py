@@ -11,6 +11,7 @@ from typing import Callable, Sequence
 
 import pandas as pd
 
+from ..engine import ENGINE, release
 from ..errors import DISK_FULL, BatchStopped, ScenarioError
 from ..files import check_outputs, temp_path
 from ..metrics import PRIVILEGED, columns_for, outside_the_run
@@ -53,7 +54,14 @@ def check_folder(loaded: Loaded, out: Path, force: bool = False, codes: dict | N
     runs_csv = out / "runs.csv"
     done = run_rows(read_runs(runs_csv, as_written=True))
     fp = loaded.fingerprint
-    foreign = len(done) and ("fingerprint" not in done.columns or (done["fingerprint"].astype(str) != fp).any())
+    other = sorted({int(e) for e in done["engine"]} - {ENGINE}) if len(done) else []
+    if other and not force:
+        raise ScenarioError(str(runs_csv), "engine", f"these rows were made by simulator engine {other[0]} and this semsearch runs "
+                            f"engine {ENGINE}, whose runs differ, so they are not resumed or mixed with new ones: write into a "
+                            f"fresh folder with --out, add to them with the release that made them ({release(other[0])}), "
+                            "or re-run everything here with --force (the old runs.csv is kept as runs.<n>.csv.bak, its runs' "
+                            "paths, traces and frames in runs.<n>.bak/)")
+    foreign = len(done) and (bool(other) or "fingerprint" not in done.columns or (done["fingerprint"].astype(str) != fp).any())
     if foreign and not force:
         raise ScenarioError(str(runs_csv), "fingerprint", f"these rows were made with another scenario, with {loaded.path} before it was edited, "
                             "or by an older semsearch, so they cannot be resumed; write into a fresh folder with --out, "
@@ -267,6 +275,7 @@ class Batch:
                 for r in rows:
                     r["fingerprint"] = fp
                     r["code"] = codes.get(r["planner"], "")
+                    r["engine"] = ENGINE
                     r[PRIVILEGED] = told.get(r["planner"], "")
                     r.update(self.stamp)
                 writer.write(rows)

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engine import ENGINE
 from ..errors import UNAVAILABLE, MissingExtra, RunTimeout, Unavailable
 from ..kernels import announce_compiling
 from ..tasks import FrameRecorder, Observers, RunResult, TraceObserver
@@ -88,9 +89,10 @@ def execute(loaded: Loaded, spec: RunSpec, watch: Watch = Watch()) -> tuple[list
 
 
 def identity(loaded: Loaded, spec: RunSpec) -> dict:
-    """What names a run in its decisions record: the scenario (name, fingerprint), the planner
+    """What names a run in its decisions record: the scenario (name, fingerprint), the simulator
+    engine (:data:`semsearch_cli.engine.ENGINE`), the planner
     variant's label, the goal (as written), the episode and the repeat."""
-    return {"scenario": loaded.sc.name, "fingerprint": loaded.fingerprint, "planner": spec.variant.label,
+    return {"scenario": loaded.sc.name, "fingerprint": loaded.fingerprint, "engine": ENGINE, "planner": spec.variant.label,
             "goal": str(spec.episode.goal), "episode": int(spec.episode.index), "seed": int(spec.seed)}
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config import Scenario, all_fields, load_scenario, parse_scenario
+from ..engine import ENGINE
 from ..errors import ScenarioError
 from ..files import safe_chars
 from ..planners import Variant
@@ -108,7 +109,8 @@ class Loaded:
         """A hash of what decides a run's outcome: the resolved scenario without the run list
         (planners, goals, seeds, output folder), with every file it names (map image, doors,
         logs, ...) standing for its bytes, not its path (a scenario moved with its files keeps
-        its fingerprint). Rows carry it, and a batch resumes only rows that match."""
+        its fingerprint), and the simulator engine (:mod:`semsearch_cli.engine`) from engine 2 on.
+        Rows carry it, and a batch resumes only rows that match."""
         if self._fingerprint is None:
             # one canonical form whatever the kind's model: every kind's sections (null where this
             # kind has none), and ``kind`` only as written (null when the sections said it)
@@ -121,6 +123,8 @@ class Loaded:
             for key in ("seeds", "out", "run_time_limit"):
                 d["experiment"].pop(key, None)
             d = files_by_content(d, self.path.parent)
+            if ENGINE > 1:  # engine 1's fingerprints are as they always were; a later engine's differ from them
+                d["engine"] = ENGINE
             h = hashlib.sha256(json.dumps(d, sort_keys=True).encode())
             self._fingerprint = h.hexdigest()[:16]
         return self._fingerprint

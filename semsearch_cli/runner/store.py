@@ -99,6 +99,13 @@ def read_runs(path: Path, as_written: bool = False) -> pd.DataFrame:
             raise ScenarioError(str(path), c, f"expected {want}"
                                 f", found {df[c].iloc[k]} on line {df.index[k] + 2} (edited by hand?); fix it, or write "
                                 "into another folder with --out")
+    engine = df["engine"].to_numpy(float)  # empty: a row widened from a runs.csv written before the column (engine 1)
+    bad = ~np.isnan(engine) & ((engine < 1) | (engine != np.floor(engine)))
+    if bad.any():
+        k = int(bad.nonzero()[0][0])
+        raise ScenarioError(str(path), "engine", f"expected a simulator engine (a whole number >= 1), found {df['engine'].iloc[k]} "
+                            f"on line {df.index[k] + 2} (edited by hand?); fix it, or write into another folder with --out")
+    df["engine"] = np.where(np.isnan(engine), 1, engine).astype(np.int64)
     return df
 
 
@@ -116,14 +123,14 @@ def _lossless(col: pd.Series) -> pd.Series:
 
 # columns added after the first release, with what rows written before them stand for
 LATER = {"episode": 0, "start_x": float("nan"), "start_y": float("nan"), "start_heading": float("nan"), "room": "",
-         "cause": None, "soft_spl": float("nan"), "left_m": float("nan"), "fingerprint": "", "code": ""}
+         "cause": None, "soft_spl": float("nan"), "left_m": float("nan"), "fingerprint": "", "code": "", "engine": 1}
 TEXT = ["stage", "map", "message", "room", "cause", "code"]
 KEY_TEXT = ("planner", "params", "goal")  # read as written: never a number, never missing
 MISSING = ["", "nan", "NaN", "NA", "N/A", "null", "None", "<NA>"]  # what pandas reads as missing in the other columns
 UNREACHABLE = ("shortest_m", "left_m", "ratio")  # +inf where nothing achieves the goal (an absent object)
 MEASURED = ("episode", "seed", "distance_m", "wall_s")  # never negative; a distance missing only in a failed run's row
 NUMBERS = ["episode", "seed", "start_x", "start_y", "start_heading", "success", "distance_m", "shortest_m", "ratio", "spl",
-           "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s", *COST_COLUMNS]
+           "soft_spl", "left_m", "time_s", "steps", "decisions", "wall_s", "engine", *COST_COLUMNS]
 
 
 def _whole_lines(fh) -> int:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 
+from ..engine import ENGINE, engine_of, refusal
 from ..errors import PlannerError, ScenarioError
 from ..planners import Variant
 from ..tasks.decisions import Replay, ReplayError
@@ -92,6 +93,26 @@ def _below_shortest(row: dict, episode) -> str:
     return ""
 
 
+def check_engine(rows, path: Path) -> None:
+    """Refuse rows (read by :func:`~semsearch_cli.runner.store.read_runs`) that another simulator
+    engine made: a :class:`ScenarioError` naming the release that replays them
+    (:func:`semsearch_cli.engine.refusal`). What replays a run (verify, export, a bag's replay)
+    checks this first: another engine's run does not replay here, and that is no failure of the run."""
+    engines = sorted({int(e) for e in rows["engine"]} - {ENGINE}) if len(rows) else []
+    if engines:
+        raise ScenarioError(str(path), "engine", refusal(engines[0], f"{'this folder' if path.name == 'runs.csv' else path}"))
+
+
+def check_folder_engine(folder: Path) -> None:
+    """:func:`check_engine` over every runs.csv of a results folder or a bench folder (its
+    floors'), before its scenario or suite is looked for: another engine's folder is named with
+    the release that replays it, whatever else it lacks here."""
+    folder = Path(folder)
+    for f in [folder / "runs.csv", *sorted(folder.glob("*/runs.csv"))]:
+        if f.is_file():
+            check_engine(read_runs(f, as_written=True), f)
+
+
 def records_in(folder: Path) -> dict[str, Path]:
     """Every entry of ``folder/decisions`` by name (a record is ``<run>.json``; the hidden
     temporary files of a write that was cut short are left out)."""
@@ -118,6 +139,7 @@ def verify_folder(folder: Path, loaded: Loaded, progress=None, workers: int = 1,
     rows = read_runs(folder / "runs.csv", as_written=True)
     if not len(rows):
         raise ScenarioError(str(folder / "runs.csv"), "", "holds no rows to verify")
+    check_engine(rows, folder / "runs.csv")
     own = rows[rows["stage"] == ""]
     fp = loaded.fingerprint
     other = own["fingerprint"].astype(str) != fp
@@ -245,6 +267,12 @@ def replay_run(task, f: Path, planner: str, goal: str, episode: int, seed: int, 
     named = (str(record.get("planner")), str(record.get("goal")), record.get("episode"), record.get("seed"))
     if named != (planner, goal, episode, seed):
         return f"{f.name} records another run ({run_name(*named)})"
+    try:
+        engine = engine_of(record.get("engine"))
+    except ValueError:
+        return f"{f.name} names no simulator engine semsearch writes (engine {record.get('engine')!r}; edited by hand?)"
+    if engine != ENGINE:
+        return refusal(engine, f.name)
     if fingerprint is not None and record.get("fingerprint") != fingerprint:
         return f"{f.name} was recorded on another scenario (fingerprint {record.get('fingerprint')}, this one's {fingerprint})"
     ep = episodes.get((goal, episode))

@@ -4,10 +4,13 @@ offline (``{name: llm, replay: DIR}``).
 ``semsearch run --transcripts`` writes ``transcripts/<run>.jsonl`` (a chain's later stages
 ``<run>__stage<k>.jsonl``), one JSON object a line, schema ``semsearch-transcript`` version 1:
 
-- the first line, ``{"type": "header", "format": "semsearch-transcript", "version": 1, "kind":
-  "doors", "run": {"scenario", "kind", "planner", "goal", "episode", "seed", "stage"}, "params":
+- the first line, ``{"type": "header", "format": "semsearch-transcript", "version": 1, "engine": 1,
+  "kind": "doors", "run": {"scenario", "kind", "planner", "goal", "episode", "seed", "stage"}, "params":
   {...}, "prompt_sha256": "..."}``: the kind of search (doors, objects, indirect), the run, the
   planner's parameters (the key's variable's name, never the key) and the prompt template's hash;
+  ``engine``: the simulator engine the run ran on (:mod:`semsearch_cli.engine`; a header without it:
+  engine 1). A transcript of another engine does not replay here (its observations were another
+  simulator's): reading it names the release that replays it;
 - one ``{"type": "call", "decision": k, "attempt": a, "observation": "...", "messages": [...],
   "reply": "..." or null, "error": "", "choice": ..., "valid": true, "reason": "", "tokens_in":
   n, "tokens_out": n, "latency_s": s, "model": "..."}`` per call to the model: decision ``k``
@@ -25,6 +28,7 @@ import hashlib
 import json
 from pathlib import Path
 
+from ...engine import ENGINE, engine_of, refusal
 from ...errors import PlannerError
 
 FORMAT = "semsearch-transcript"
@@ -33,7 +37,7 @@ RUN_KEYS = ("scenario", "goal", "episode", "seed", "stage")  # what finds a run'
 
 
 def header(kind: str, run: dict, params: dict, prompt_sha256: str) -> dict:
-    return {"type": "header", "format": FORMAT, "version": VERSION, "kind": kind, "run": dict(run), "params": params,
+    return {"type": "header", "format": FORMAT, "version": VERSION, "engine": ENGINE, "kind": kind, "run": dict(run), "params": params,
             "prompt_sha256": prompt_sha256}
 
 
@@ -58,6 +62,12 @@ def read(path: Path) -> list[dict]:
         raise PlannerError(f"transcript {path}: not a {FORMAT} file (its first line is no header)")
     if out[0].get("version") != VERSION:
         raise PlannerError(f"transcript {path}: version {out[0].get('version')!r}; this semsearch reads version {VERSION}")
+    try:
+        engine = engine_of(out[0].get("engine"))
+    except ValueError:
+        raise PlannerError(f"transcript {path}: engine {out[0].get('engine')!r} is no simulator engine (edited by hand?)") from None
+    if engine != ENGINE:
+        raise PlannerError(refusal(engine, f"transcript {path}"))
     return out
 
 
