@@ -123,3 +123,20 @@ def test_a_board_never_pairs_rows_of_two_engines(tmp_path):
     assert "never paired or pooled" in page
     res = CliRunner().invoke(app, ["verify", str(second)])
     assert res.exit_code == 2 and f"made by simulator engine {OTHER}" in _one(res.output), res.output
+
+
+def test_a_transcript_of_another_engine_does_not_replay(tmp_path):
+    from semsearch_cli.errors import PlannerError
+    from semsearch_cli.planners.llm import transcript
+    head = transcript.header("doors", {"scenario": "demo", "goal": "452", "episode": 0, "seed": 0, "stage": ""}, {}, "x")
+    assert head["engine"] == ENGINE
+    f = tmp_path / "t.jsonl"
+    f.write_text(json.dumps(head) + "\n")
+    assert transcript.read(f)[0]["engine"] == ENGINE
+    f.write_text(json.dumps({**head, "engine": OTHER}) + "\n")
+    with pytest.raises(PlannerError, match=f"made by simulator engine {OTHER}"):
+        transcript.read(f)
+    del head["engine"]  # written before engines were recorded: engine 1
+    f.write_text(json.dumps(head) + "\n")
+    if ENGINE == 1:
+        assert transcript.read(f)

@@ -110,3 +110,17 @@ def test_a_change_far_away_moves_only_its_own_part_of_the_history():
     assert np.array_equal(sk.tdel.reshape(H, W)[:, :80], left)
     assert np.array_equal(sk.skeleton, brute_thin(free))
     assert (sk.tdel.reshape(H, W)[sk.skeleton] == KEPT).all()
+
+
+def test_a_front_that_outgrows_its_copy_is_thinned_again_on_a_larger_one(monkeypatch):
+    """A copy of two cells around the changes: every update of a hall outgrows it and runs again."""
+    monkeypatch.setattr(Skeleton, "MARGIN", 2)
+    H, W = 50, 70
+    free = np.zeros((H, W), bool)
+    sk = Skeleton((H, W))
+    free[5:45, 5:65] = True
+    sk.update(free, (5, 44, 5, 64))
+    free[20:22, 30:33] = False  # a pillar: the hall's history changes far from it
+    sk.update(free, (20, 21, 30, 32))
+    assert sk.last[2] > 1
+    assert np.array_equal(sk.skeleton, brute_thin(free))
