@@ -49,7 +49,7 @@ def release(engine: int) -> str:
         return "this release"
     if engine in RELEASES:
         return f"pip install 'semsearch=={RELEASES[engine]}'"
-    return f"a semsearch newer than this one (engine {engine}; this release runs engine {ENGINE})"
+    return f"a newer semsearch, one that runs engine {engine}"
 
 
 def refusal(engine: int, what: str) -> str | None:
