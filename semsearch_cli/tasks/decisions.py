@@ -25,7 +25,7 @@ belief it is shown) does not replay, and ``semsearch verify`` names its runs.
 The record of a run (``decisions/<run>.json``)::
 
     {"format": "semsearch-decisions", "version": 1, "kind": "doors", "planner": "nsos[alpha=0.9]",
-     "goal": "148", "episode": 0, "seed": 0, "fingerprint": "...",
+     "goal": "148", "episode": 0, "seed": 0, "fingerprint": "...", "engine": 1,
      "seats": {"nsos[alpha=0.9]": {"replan_on_signs": false}},
      "decisions": [[412, 1033], 0, [398, 1100], null], "rng": {"3": "<state>.<has_uint32>.<uinteger>"}}
 
