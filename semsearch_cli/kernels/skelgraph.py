@@ -1,0 +1,801 @@
+"""Shortest paths along the skeleton on a contracted graph, repaired where the map changed
+(engine 2).
+
+**The graph.** Its cells are the skeleton cells where the robot fits (``skeleton & passable``). A
+move joins two of them that are 8-neighbours (1 or sqrt(2) cells long); a diagonal move needs both
+orthogonal cells passable, as on the grid (no corner cutting). A cell's degree is the number of
+such moves. The nodes are the cells of degree other than 2 (ends, junctions, lone cells) and, on a
+cycle of cells of degree 2 only, one cell of it; every other cell lies inside exactly one chain of
+degree-2 cells between two nodes: an edge, whose length is the sum of its moves. A node keeps its
+edges by the direction they leave it in (8 slots), an interior cell its edge and its position
+along it (the length from the edge's first node), so nothing is stored per edge but its two ends.
+
+**Repair.** When skeleton or passable cells change, the cells whose moves can have changed are the
+graph cells (before or after) within one cell of them: the affected cells. Every edge through an
+affected cell, or ending at one that was a node, is dropped (an interior cell's record is valid
+only while its edge's serial number matches, so dropping costs nothing per cell), the affected
+cells are judged again, and chains are traced again from every node that lost an edge and every
+new node. A cycle left without a node gets its first affected cell as one. The cost is the
+changed chains' length, not the map's.
+
+**Searches.** The robot is joined to the graph by a Dijkstra over the passable cells 4-connected
+to it within a radius (its join region, under the grid's cost); every graph cell there is a seed.
+A Dijkstra over the nodes (edges cost their length: the cost of the skeleton is 1 per cell) then
+gives every graph cell's distance: a node's own, or for an interior cell the best of its edge's two
+nodes plus the way along the edge, and of the seeds on its edge. A target on the graph is reached
+along it or directly in the robot's join region; a target off the graph is joined to it by a
+Dijkstra toward the target over its own join region (and also reached through the robot's region
+where the two overlap).
+
+**Ties.** Nodes settle in the order of (cost, cell index); every choice between equal costs keeps
+the first in a fixed order of evaluation (the direct way, then the graph; an edge's first node,
+then its second, then seeds in order); so equal paths resolve alike on every machine.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .memory import lazy_zeros
+
+SQRT2 = math.sqrt(2.0)
+# moves: north, south, west, east, north-west, north-east, south-west, south-east
+_DR = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
+_DC = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
+_OPP = np.array([1, 0, 3, 2, 7, 6, 5, 4], np.int64)
+_STEP = np.array([1.0, 1.0, 1.0, 1.0, SQRT2, SQRT2, SQRT2, SQRT2])
+INF = np.inf
+
+
+@njit(cache=True, inline="always")
+def _move(gcell, passable, H, W, p, k):
+    """The cell the move k leads to from graph cell p, or -1 when that is not an allowed move."""
+    r = p // W
+    c = p - r * W
+    nr = r + _DR[k]
+    nc = c + _DC[k]
+    if nr < 0 or nr >= H or nc < 0 or nc >= W:
+        return -1
+    q = nr * W + nc
+    if not gcell[q]:
+        return -1
+    if k >= 4 and not (passable[r * W + nc] and passable[nr * W + c]):
+        return -1
+    return q
+
+
+@njit(cache=True)
+def _degree(gcell, passable, H, W, p):
+    n = 0
+    for k in range(8):
+        if _move(gcell, passable, H, W, p, k) >= 0:
+            n += 1
+    return n
+
+
+@njit(cache=True, inline="always")
+def _edge_at(gedge, gser, eser, q):
+    """The live edge whose interior holds cell q, or -1."""
+    e = gedge[q] - 1
+    if e >= 0 and eser[e] == gser[q]:
+        return e
+    return -1
+
+
+@njit(cache=True)
+def _affected(gcell, skeleton, passable, H, W, changed, mark, gen):
+    """Graph cells (as they were, or as they will be) within one cell of a changed cell, sorted."""
+    out = np.empty(9 * changed.shape[0] + 1, np.int64)
+    n = 0
+    for i in range(changed.shape[0]):
+        q0 = changed[i]
+        r0 = q0 // W
+        c0 = q0 - r0 * W
+        for r in range(max(0, r0 - 1), min(H, r0 + 2)):
+            for c in range(max(0, c0 - 1), min(W, c0 + 2)):
+                q = r * W + c
+                if mark[q] == gen:
+                    continue
+                mark[q] = gen
+                if gcell[q] or (skeleton[q] and passable[q]):
+                    out[n] = q
+                    n += 1
+    return np.sort(out[:n])
+
+
+@njit(cache=True)
+def _drop(aff, gcell, gnode, gedge, gser, ncell, nadj, nalive, nfree, ea, eb, ka, kb, eser, ealive, efree, st, redo):
+    """Drop the nodes at affected cells and every edge through or at them; the nodes that keep
+    going but lost an edge go to ``redo``. Returns how many."""
+    nr = 0
+    for i in range(aff.shape[0]):
+        q = aff[i]
+        u = gnode[q] - 1
+        if u >= 0:
+            for k in range(8):
+                e = nadj[u, k]
+                if e >= 0:
+                    nr = _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr)
+            nalive[u] = False
+            nfree[st[1]] = u
+            st[1] += 1
+            gnode[q] = 0
+        else:
+            e = _edge_at(gedge, gser, eser, q)
+            if e >= 0:
+                nr = _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr)
+    return nr
+
+
+@njit(cache=True)
+def _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr):
+    if not ealive[e]:
+        return nr
+    ealive[e] = False
+    efree[st[3]] = e
+    st[3] += 1
+    nadj[ea[e], ka[e]] = -1
+    nadj[eb[e], kb[e]] = -1
+    redo[nr] = ea[e]
+    redo[nr + 1] = eb[e]
+    return nr + 2
+
+
+@njit(cache=True)
+def _new_node(q, gnode, ncell, nadj, nalive, nfree, st):
+    if st[1] > 0:
+        st[1] -= 1
+        u = nfree[st[1]]
+    else:
+        u = st[0]
+        st[0] += 1
+    ncell[u] = q
+    nadj[u, :] = -1
+    nalive[u] = True
+    gnode[q] = u + 1
+    return u
+
+
+@njit(cache=True)
+def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast, eser,
+           ealive, efree, st):
+    """The edge leaving node u by move k (which must be allowed and free), traced to its other
+    node; returns its id, or -1 when the chain ends at a cell that is no node (a broken graph)."""
+    if st[3] > 0:
+        st[3] -= 1
+        e = efree[st[3]]
+    else:
+        e = st[2]
+        st[2] += 1
+    st[4] += 1
+    ser = st[4]
+    prev = ncell[u]
+    cur = _move(gcell, passable, H, W, prev, k)
+    length = _STEP[k]
+    kdir = k
+    first = -1
+    last = -1
+    while True:
+        v = gnode[cur] - 1
+        if v >= 0:
+            break
+        if first < 0:
+            first = cur
+        last = cur
+        gedge[cur] = e + 1
+        gser[cur] = ser
+        gpos[cur] = length
+        nxt = -1
+        for j in range(8):
+            q = _move(gcell, passable, H, W, cur, j)
+            if q >= 0 and q != prev:
+                nxt = q
+                kdir = j
+                break
+        if nxt < 0:
+            return -1
+        length += _STEP[kdir]
+        prev = cur
+        cur = nxt
+    ea[e] = u
+    eb[e] = v
+    ka[e] = k
+    kb[e] = _OPP[kdir]
+    elen[e] = length
+    efirst[e] = first
+    elast[e] = last
+    eser[e] = ser
+    ealive[e] = True
+    nadj[u, k] = e
+    nadj[v, _OPP[kdir]] = e
+    return e
+
+
+@njit(cache=True)
+def _rebuild(aff, redo, n_redo, gcell, skeleton, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, nalive, nfree, ea, eb,
+             ka, kb, elen, efirst, elast, eser, ealive, efree, st):
+    """Judge the affected cells again (membership, node or not) and trace the chains again from
+    the nodes in ``redo`` and the new ones. Returns 0, or -1 when a chain ended nowhere."""
+    for i in range(aff.shape[0]):
+        q = aff[i]
+        gcell[q] = skeleton[q] and passable[q]
+    m = n_redo
+    for i in range(aff.shape[0]):
+        q = aff[i]
+        if gcell[q] and _degree(gcell, passable, H, W, q) != 2:
+            redo[m] = _new_node(q, gnode, ncell, nadj, nalive, nfree, st)
+            m += 1
+    for i in range(m):
+        u = redo[i]
+        if not nalive[u]:
+            continue
+        p = ncell[u]
+        for k in range(8):
+            if nadj[u, k] < 0 and _move(gcell, passable, H, W, p, k) >= 0:
+                if _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast,
+                          eser, ealive, efree, st) < 0:
+                    return -1
+    for i in range(aff.shape[0]):  # a cycle left without a node
+        q = aff[i]
+        if gcell[q] and gnode[q] == 0 and _edge_at(gedge, gser, eser, q) < 0:
+            u = _new_node(q, gnode, ncell, nadj, nalive, nfree, st)
+            for k in range(8):
+                if nadj[u, k] < 0 and _move(gcell, passable, H, W, q, k) >= 0:
+                    if _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, ka, kb, elen, efirst,
+                              elast, eser, ealive, efree, st) < 0:
+                        return -1
+    return 0
+
+
+# ---- searches ---------------------------------------------------------------------------------
+
+@njit(cache=True, inline="always")
+def _before(k1, i1, k2, i2):
+    return k1 < k2 or (k1 == k2 and i1 < i2)
+
+
+@njit(cache=True)
+def _push(hk, hi, n, k, i):
+    j = n
+    while j > 0:
+        p = (j - 1) >> 1
+        if not _before(k, i, hk[p], hi[p]):
+            break
+        hk[j] = hk[p]
+        hi[j] = hi[p]
+        j = p
+    hk[j] = k
+    hi[j] = i
+
+
+@njit(cache=True)
+def _pop(hk, hi, n):
+    n -= 1
+    k = hk[n]
+    i = hi[n]
+    j = 0
+    while True:
+        ch = 2 * j + 1
+        if ch >= n:
+            break
+        if ch + 1 < n and _before(hk[ch + 1], hi[ch + 1], hk[ch], hi[ch]):
+            ch += 1
+        if not _before(hk[ch], hi[ch], k, i):
+            break
+        hk[j] = hk[ch]
+        hi[j] = hi[ch]
+        j = ch
+    hk[j] = k
+    hi[j] = i
+
+
+@njit(cache=True)
+def _local(passable, cost, H, W, r0, c0, radius, reverse):
+    """Dijkstra over the passable cells 4-connected to (r0, c0) within ``radius`` cells (a disk),
+    8-connected moves inside that region (a diagonal needs both orthogonal cells in it), entering
+    cell q costing step * cost[q]. With ``reverse``, costs are those of paths *toward* (r0, c0).
+
+    Returns (R, S, inside, cst, lng, par): the window of side S = 2R + 1 centred on (r0, c0),
+    (S*S,) arrays over it: region membership, cost, length and the previous cell (window index;
+    with ``reverse``, the next cell toward the centre), -1 at the centre."""
+    R = int(math.ceil(radius))
+    S = 2 * R + 1
+    inside = np.zeros(S * S, np.bool_)
+    cst = np.full(S * S, np.inf)
+    lng = np.full(S * S, np.inf)
+    par = np.full(S * S, -1, np.int64)
+    if r0 < 0 or r0 >= H or c0 < 0 or c0 >= W or not passable[r0 * W + c0]:
+        return R, S, inside, cst, lng, par
+    qu = np.empty(S * S, np.int64)
+    qu[0] = R * S + R
+    inside[R * S + R] = True
+    head, tail = 0, 1
+    rad2 = radius * radius
+    while head < tail:
+        li = qu[head]
+        head += 1
+        lr = li // S
+        lc = li - lr * S
+        for k in range(4):
+            mr = lr + _DR[k]
+            mc = lc + _DC[k]
+            if mr < 0 or mr >= S or mc < 0 or mc >= S:
+                continue
+            gr = r0 + mr - R
+            gc = c0 + mc - R
+            if gr < 0 or gr >= H or gc < 0 or gc >= W:
+                continue
+            lj = mr * S + mc
+            if inside[lj] or (mr - R) * (mr - R) + (mc - R) * (mc - R) > rad2 or not passable[gr * W + gc]:
+                continue
+            inside[lj] = True
+            qu[tail] = lj
+            tail += 1
+    hk = np.empty(8 * S * S + 1)
+    hi = np.empty(8 * S * S + 1, np.int64)
+    done = np.zeros(S * S, np.bool_)
+    n = 0
+    cst[R * S + R] = 0.0
+    lng[R * S + R] = 0.0
+    _push(hk, hi, n, 0.0, R * S + R)
+    n += 1
+    while n > 0:
+        d = hk[0]
+        li = hi[0]
+        _pop(hk, hi, n)
+        n -= 1
+        if done[li]:
+            continue
+        done[li] = True
+        lr = li // S
+        lc = li - lr * S
+        for k in range(8):
+            mr = lr + _DR[k]
+            mc = lc + _DC[k]
+            if mr < 0 or mr >= S or mc < 0 or mc >= S:
+                continue
+            lj = mr * S + mc
+            if not inside[lj] or done[lj]:
+                continue
+            if k >= 4 and not (inside[lr * S + mc] and inside[mr * S + lc]):
+                continue
+            into = lj if not reverse else li  # the cell entered: lj going out; li on the way to the centre
+            q = (r0 + (into // S) - R) * W + (c0 + (into % S) - R)
+            nd = d + _STEP[k] * cost[q]
+            if nd < cst[lj]:
+                cst[lj] = nd
+                lng[lj] = lng[li] + _STEP[k]
+                par[lj] = li
+                _push(hk, hi, n, nd, lj)
+                n += 1
+    return R, S, inside, cst, lng, par
+
+
+@njit(cache=True)
+def _nodes(seeds, scost, slen, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, elen, eser, dc, dl, dpar, dedge, dseed, dend,
+           dgen, gen, hk, hi):
+    """Dijkstra over the nodes from the seeds (graph cells with a cost and length), settling them
+    in the order of (cost, cell index). A node's record: cost, length, the node before it (-1: it
+    was reached from a seed), the edge used (-1: the seed is the node), the seed and, for a seed on
+    an edge, the end it entered the node by (0: the edge's first node, 1: its second). Returns 0, or
+    -1 when the heap is full (the caller grows it and searches again)."""
+    n = 0
+    cap = hk.shape[0]
+    for s in range(seeds.shape[0]):
+        q = seeds[s]
+        u = gnode[q] - 1
+        if u >= 0:
+            if _relax(u, scost[s], slen[s], -1, -1, s, 0, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
+                if n == cap:
+                    return -1
+                _push(hk, hi, n, scost[s], ncell[u])
+                n += 1
+            continue
+        e = _edge_at(gedge, gser, eser, q)
+        if e < 0:
+            continue
+        p = gpos[q]
+        for end in range(2):
+            v = ea[e] if end == 0 else eb[e]
+            w = p if end == 0 else elen[e] - p
+            if _relax(v, scost[s] + w, slen[s] + w, -1, e, s, end, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
+                if n == cap:
+                    return -1
+                _push(hk, hi, n, scost[s] + w, ncell[v])
+                n += 1
+    while n > 0:
+        d = hk[0]
+        u = gnode[hi[0]] - 1
+        _pop(hk, hi, n)
+        n -= 1
+        if d > dc[u]:  # a stale entry
+            continue
+        for k in range(8):
+            e = nadj[u, k]
+            if e < 0:
+                continue
+            v = eb[e] if ea[e] == u else ea[e]
+            if v == u:
+                continue
+            if _relax(v, d + elen[e], dl[u] + elen[e], u, e, -1, 0, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
+                if n == cap:
+                    return -1
+                _push(hk, hi, n, d + elen[e], ncell[v])
+                n += 1
+    return 0
+
+
+@njit(cache=True)
+def _relax(v, c, ln, u, e, s, end, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
+    if dgen[v] == gen and not c < dc[v]:
+        return False
+    dgen[v] = gen
+    dend[v] = end
+    dc[v] = c
+    dl[v] = ln
+    dpar[v] = u
+    dedge[v] = e
+    dseed[v] = s
+    return True
+
+
+@njit(cache=True)
+def _at(q, seeds, scost, slen, gnode, gedge, gser, gpos, ea, eb, elen, eser, dc, dl, dgen, gen):
+    """A graph cell's cost and length from the robot, and how: (cost, length, way, seed) with way
+    0 the node itself, 1 through the edge's first node, 2 its second, 3 from a seed on its edge."""
+    u = gnode[q] - 1
+    if u >= 0:
+        if dgen[u] == gen:
+            return dc[u], dl[u], 0, -1
+        return INF, INF, 0, -1
+    e = _edge_at(gedge, gser, eser, q)
+    if e < 0:
+        return INF, INF, 0, -1
+    p = gpos[q]
+    bc, bl, way, seed = INF, INF, 0, -1
+    a, b = ea[e], eb[e]
+    if dgen[a] == gen and dc[a] + p < bc:
+        bc, bl, way = dc[a] + p, dl[a] + p, 1
+    if dgen[b] == gen and dc[b] + elen[e] - p < bc:
+        bc, bl, way = dc[b] + elen[e] - p, dl[b] + elen[e] - p, 2
+    for s in range(seeds.shape[0]):
+        if _edge_at(gedge, gser, eser, seeds[s]) == e:
+            w = abs(gpos[seeds[s]] - p)
+            if scost[s] + w < bc:
+                bc, bl, way, seed = scost[s] + w, slen[s] + w, 3, s
+    return bc, bl, way, seed
+
+
+@njit(cache=True)
+def _targets(tq, r0, c0, R, S, rin, rcst, rlen, passable, cost, H, W, radius, seeds, scost, slen, gcell, gnode, gedge, gser,
+             gpos, ea, eb, elen, eser, dc, dl, dgen, gen):
+    """Each target's cost and length from the robot, and how: kind 0 directly in the robot's join
+    region, 1 along the graph to cell y (then, off the graph, through the target's join region),
+    2 through the robot's region to cell y of the target's."""
+    n = tq.shape[0]
+    tc = np.full(n, np.inf)
+    tl = np.full(n, np.inf)
+    kind = np.zeros(n, np.int64)
+    ty = np.full(n, -1, np.int64)
+    for i in range(n):
+        t = tq[i]
+        li = _win(t, r0, c0, R, S, W)
+        if li >= 0 and rin[li] and rcst[li] < tc[i]:
+            tc[i], tl[i], kind[i], ty[i] = rcst[li], rlen[li], 0, t
+        if gcell[t]:
+            c, ln, _, _ = _at(t, seeds, scost, slen, gnode, gedge, gser, gpos, ea, eb, elen, eser, dc, dl, dgen, gen)
+            if c < tc[i]:
+                tc[i], tl[i], kind[i], ty[i] = c, ln, 1, t
+            continue
+        TR, TS, tin, tcst, tlen, _ = _local(passable, cost, H, W, t // W, t % W, radius, True)
+        for lj in range(TS * TS):
+            if not tin[lj] or not tcst[lj] < np.inf:
+                continue
+            y = (t // W + lj // TS - TR) * W + (t % W + lj % TS - TR)
+            li = _win(y, r0, c0, R, S, W)
+            if li >= 0 and rin[li] and rcst[li] + tcst[lj] < tc[i]:
+                tc[i], tl[i], kind[i], ty[i] = rcst[li] + tcst[lj], rlen[li] + tlen[lj], 2, y
+            if gcell[y]:
+                c, ln, _, _ = _at(y, seeds, scost, slen, gnode, gedge, gser, gpos, ea, eb, elen, eser, dc, dl, dgen, gen)
+                if c + tcst[lj] < tc[i]:
+                    tc[i], tl[i], kind[i], ty[i] = c + tcst[lj], ln + tlen[lj], 1, y
+    return tc, tl, kind, ty
+
+
+@njit(cache=True, inline="always")
+def _win(q, r0, c0, R, S, W):
+    """Index of flat cell q in the window of side S centred on (r0, c0), or -1 outside it."""
+    lr = q // W - r0 + R
+    lc = q % W - c0 + R
+    if lr < 0 or lr >= S or lc < 0 or lc >= S:
+        return -1
+    return lr * S + lc
+
+
+@njit(cache=True)
+def _walk(q, e, up, H, W, gedge, gser, gpos, eser):
+    """The next interior cell of edge e after q, toward its second node (``up``) or its first;
+    -1 when q is the last one that way."""
+    r = q // W
+    c = q - r * W
+    p = gpos[q]
+    best = -1
+    bp = 0.0
+    for k in range(8):
+        nr = r + _DR[k]
+        nc = c + _DC[k]
+        if nr < 0 or nr >= H or nc < 0 or nc >= W:
+            continue
+        x = nr * W + nc
+        if _edge_at(gedge, gser, eser, x) != e:
+            continue
+        px = gpos[x]
+        if (up and px > p and (best < 0 or px < bp)) or (not up and px < p and (best < 0 or px > bp)):
+            best = x
+            bp = px
+    return best
+
+
+@njit(cache=True)
+def _back(y, seeds, scost, slen, H, W, gnode, gedge, gser, gpos, ncell, ea, eb, elen, efirst, elast, eser, dc, dl, dpar, dedge,
+          dseed, dend, dgen, gen):
+    """The graph part of the path to graph cell y, from y back to the seed it starts at: (cells,
+    seed index)."""
+    buf = np.empty(256, np.int64)
+    n = 0
+    _, _, way, seed = _at(y, seeds, scost, slen, gnode, gedge, gser, gpos, ea, eb, elen, eser, dc, dl, dgen, gen)
+    buf, n = _emit(buf, n, y)
+    if way == 0:
+        u = gnode[y] - 1
+    else:
+        e = _edge_at(gedge, gser, eser, y)
+        if way == 3:
+            qs = seeds[seed]
+            up = gpos[qs] > gpos[y]
+            q = y
+            while q != qs:
+                q = _walk(q, e, up, H, W, gedge, gser, gpos, eser)
+                buf, n = _emit(buf, n, q)
+            return buf[:n], seed
+        up = way == 2
+        q = _walk(y, e, up, H, W, gedge, gser, gpos, eser)
+        while q >= 0:
+            buf, n = _emit(buf, n, q)
+            q = _walk(q, e, up, H, W, gedge, gser, gpos, eser)
+        u = eb[e] if up else ea[e]
+        buf, n = _emit(buf, n, ncell[u])
+    while dpar[u] >= 0:
+        e = dedge[u]
+        p = dpar[u]
+        at_b = eb[e] == u
+        q = elast[e] if at_b else efirst[e]
+        while q >= 0:
+            buf, n = _emit(buf, n, q)
+            q = _walk(q, e, not at_b, H, W, gedge, gser, gpos, eser)
+        buf, n = _emit(buf, n, ncell[p])
+        u = p
+    seed = dseed[u]
+    e = dedge[u]
+    if e >= 0:
+        qs = seeds[seed]
+        at_b = dend[u] == 1
+        q = elast[e] if at_b else efirst[e]
+        buf, n = _emit(buf, n, q)
+        while q != qs:
+            q = _walk(q, e, not at_b, H, W, gedge, gser, gpos, eser)
+            buf, n = _emit(buf, n, q)
+    return buf[:n], seed
+
+
+@njit(cache=True, inline="always")
+def _emit(buf, n, q):
+    if n == buf.shape[0]:
+        b = np.empty(2 * n, np.int64)
+        b[:n] = buf
+        buf = b
+    buf[n] = q
+    return buf, n + 1
+
+
+@njit(cache=True)
+def _unwind(li, par, r0, c0, R, S, W):
+    """Flat cells of a join region's path from window cell li along ``par`` to the centre."""
+    n = 0
+    j = li
+    while j >= 0:
+        n += 1
+        j = par[j]
+    out = np.empty(n, np.int64)
+    j = li
+    k = 0
+    while j >= 0:
+        out[k] = (r0 + j // S - R) * W + (c0 + j % S - R)
+        k += 1
+        j = par[j]
+    return out
+
+
+class SkeletonGraph:
+    """The contracted skeleton graph of one grid shape (see the module's text): :meth:`repair`
+    after the skeleton or passable cells change, :meth:`search` from the robot."""
+
+    def __init__(self, shape):
+        H, W = shape
+        self.shape = (H, W)
+        N = H * W
+        self.gcell = lazy_zeros(N, bool)  # graph cells, as of the last repair
+        self.gnode = lazy_zeros(N, np.int32)  # node id + 1 at nodes, 0 elsewhere
+        self.gedge = lazy_zeros(N, np.int32)  # at interior cells: edge id + 1 (valid while gser matches)
+        self.gser = lazy_zeros(N, np.int64)
+        self.gpos = lazy_zeros(N, np.float64)  # at interior cells: length from the edge's first node
+        self._mark = lazy_zeros(N, np.int64)
+        self._mgen = 0
+        self.st = np.zeros(8, np.int64)  # node high-water mark, free nodes, edge high-water mark, free edges, serial
+        self._nodes_cap(0)
+        self._edges_cap(0)
+        self.gen = 0
+
+    # ---- storage ---------------------------------------------------------------------------
+    def _nodes_cap(self, need: int) -> None:
+        old = getattr(self, "ncell", None)
+        cap = 256 if old is None else old.shape[0]
+        if old is not None and cap >= need:
+            return
+        while cap < need:
+            cap *= 2
+        fields = {"ncell": (np.int64, 0), "nadj": (np.int32, -1), "nalive": (bool, False), "nfree": (np.int64, 0),
+                  "dc": (np.float64, np.inf), "dl": (np.float64, np.inf), "dpar": (np.int64, -1), "dedge": (np.int64, -1),
+                  "dseed": (np.int64, -1), "dend": (np.int64, 0), "dgen": (np.int64, 0)}
+        for name, (dt, fill) in fields.items():
+            shape = (cap, 8) if name == "nadj" else (cap,)
+            a = np.full(shape, fill, dt)
+            if old is not None:
+                a[: old.shape[0]] = getattr(self, name)
+            setattr(self, name, a)
+
+    def _edges_cap(self, need: int) -> None:
+        old = getattr(self, "ea", None)
+        cap = 512 if old is None else old.shape[0]
+        if old is not None and cap >= need:
+            return
+        while cap < need:
+            cap *= 2
+        fields = {"ea": np.int64, "eb": np.int64, "ka": np.int64, "kb": np.int64, "elen": np.float64, "efirst": np.int64,
+                  "elast": np.int64, "eser": np.int64, "ealive": bool, "efree": np.int64}
+        for name, dt in fields.items():
+            a = np.zeros(cap, dt)
+            if old is not None:
+                a[: old.shape[0]] = getattr(self, name)
+            setattr(self, name, a)
+        self._heap = (np.empty(4 * cap + 64), np.empty(4 * cap + 64, np.int64))
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.st[0] - self.st[1])
+
+    @property
+    def n_edges(self) -> int:
+        return int(self.st[2] - self.st[3])
+
+    # ---- repair ------------------------------------------------------------------------------
+    def repair(self, skeleton: np.ndarray, passable: np.ndarray, changed: np.ndarray) -> int:
+        """Bring the graph up to date after the cells ``changed`` (flat indices) changed in
+        ``skeleton`` or ``passable`` ((H, W) bool, as they are now). Returns the number of
+        affected cells."""
+        if len(changed) == 0:
+            return 0
+        H, W = self.shape
+        sk, pa = skeleton.reshape(-1), passable.reshape(-1)
+        self._mgen += 1
+        aff = _affected(self.gcell, sk, pa, H, W, np.asarray(changed, np.int64), self._mark, self._mgen)
+        if aff.shape[0] == 0:
+            return 0
+        redo = np.empty(18 * aff.shape[0] + 16, np.int64)
+        n_redo = _drop(aff, self.gcell, self.gnode, self.gedge, self.gser, self.ncell, self.nadj, self.nalive, self.nfree,
+                       self.ea, self.eb, self.ka, self.kb, self.eser, self.ealive, self.efree, self.st, redo)
+        self._nodes_cap(int(self.st[0]) + 2 * aff.shape[0])
+        self._edges_cap(int(self.st[2]) + 8 * (n_redo + 2 * aff.shape[0]))
+        ok = _rebuild(aff, redo, n_redo, self.gcell, sk, pa, H, W, self.gnode, self.gedge, self.gser, self.gpos, self.ncell,
+                      self.nadj, self.nalive, self.nfree, self.ea, self.eb, self.ka, self.kb, self.elen, self.efirst, self.elast,
+                      self.eser, self.ealive, self.efree, self.st)
+        if ok < 0:  # pragma: no cover - an invariant broken: say so rather than search a wrong graph
+            raise RuntimeError("skeleton graph: a chain ended at a cell that is not a node")
+        return int(aff.shape[0])
+
+    # ---- searches ----------------------------------------------------------------------------
+    def search(self, r: int, c: int, robot_passable: np.ndarray, passable: np.ndarray, cost: np.ndarray, t_rows, t_cols,
+               n_stop: int, radius: float) -> "GraphSearch":
+        """Costs and lengths (cells) from the robot cell (r, c) to the targets (see the module's
+        text): the robot joined over ``robot_passable``, off-graph targets over ``passable``,
+        both under ``cost`` (which must be 1 on the skeleton). Only the first ``n_stop`` targets
+        (0: all) in the order of (cost, cell index) count as reached."""
+        H, W = self.shape
+        rp, pa, co = robot_passable.reshape(-1), passable.reshape(-1), cost.reshape(-1)
+        R, S, rin, rcst, rlen, rpar = _local(rp, co, H, W, int(r), int(c), radius, False)
+        win = np.flatnonzero(rin & np.isfinite(rcst))
+        cells = (int(r) + win // S - R) * W + (int(c) + win % S - R)
+        on = self.gcell[cells]
+        seeds, scost, slen = cells[on], rcst[win[on]], rlen[win[on]]
+        while True:
+            self.gen += 1
+            hk, hi = self._heap
+            if _nodes(seeds, scost, slen, self.gnode, self.gedge, self.gser, self.gpos, self.ncell, self.nadj, self.ea, self.eb,
+                      self.elen, self.eser, self.dc, self.dl, self.dpar, self.dedge, self.dseed, self.dend, self.dgen, self.gen,
+                      hk, hi) == 0:
+                break
+            self._heap = (np.empty(2 * hk.shape[0]), np.empty(2 * hi.shape[0], np.int64))
+        tq = np.asarray(t_rows, np.int64) * W + np.asarray(t_cols, np.int64)
+        tc, tl, kind, ty = _targets(tq, int(r), int(c), R, S, rin, rcst, rlen, pa, co, H, W, radius, seeds, scost, slen,
+                                    self.gcell, self.gnode, self.gedge, self.gser, self.gpos, self.ea, self.eb, self.elen,
+                                    self.eser, self.dc, self.dl, self.dgen, self.gen)
+        # reached: the first n_stop distinct target cells in the order of (cost, cell index)
+        fin = np.flatnonzero(np.isfinite(tc))
+        order = fin[np.lexsort((tq[fin], tc[fin]))]
+        cells_in_order, first = np.unique(tq[order], return_index=True)
+        ranked = cells_in_order[np.argsort(first, kind="stable")]
+        need = len(ranked) if n_stop <= 0 else min(int(n_stop), len(ranked))
+        reached = np.isin(tq, ranked[:need])
+        return GraphSearch(self, (int(r), int(c)), tq, np.where(reached, tc, np.inf), np.where(reached, tl, np.inf), kind, ty,
+                           (R, S, rpar), (seeds, scost, slen), (pa, co, radius), need)
+
+
+class GraphSearch:
+    """One search's answer (:meth:`SkeletonGraph.search`): :meth:`lengths`, :meth:`costs`,
+    :meth:`settled` and :meth:`path` for its targets, as :class:`~semsearch_cli.kernels.grid.GridSearch`
+    answers them; valid until the graph's next search or repair."""
+
+    def __init__(self, graph, source, tq, tc, tl, kind, ty, robot, seeds, join, reached):
+        self.graph, self.source, self.gen = graph, source, graph.gen
+        order = np.argsort(tq, kind="stable")
+        self._tq, self._tc, self._tl, self._kind, self._ty = tq[order], tc[order], tl[order], kind[order], ty[order]
+        self._robot, self._seeds, self._join = robot, seeds, join
+        self.reached = reached  # distinct targets reached
+
+    def _find(self, rows, cols):
+        q = np.asarray(rows, np.int64) * self.graph.shape[1] + np.asarray(cols, np.int64)
+        i = np.clip(np.searchsorted(self._tq, q), 0, max(len(self._tq) - 1, 0))
+        hit = (self._tq[i] == q) if len(self._tq) else np.zeros(q.shape, bool)
+        return i, hit
+
+    def lengths(self, rows, cols) -> np.ndarray:
+        """Path length (cells) to each given cell, inf where it is not a reached target."""
+        i, hit = self._find(rows, cols)
+        return np.where(hit, self._tl[i] if len(self._tl) else np.inf, np.inf)
+
+    def costs(self, rows, cols) -> np.ndarray:
+        i, hit = self._find(rows, cols)
+        return np.where(hit, self._tc[i] if len(self._tc) else np.inf, np.inf)
+
+    def settled(self, rows, cols) -> np.ndarray:
+        return np.isfinite(self.costs(rows, cols))
+
+    def path(self, r, c):
+        """Cells (rows, cols) from the robot to the reached target (r, c), or None."""
+        i, hit = self._find(np.int64(r), np.int64(c))
+        i = int(i)
+        if not bool(hit) or not np.isfinite(self._tc[i]):
+            return None
+        g = self.graph
+        if g.gen != self.gen:
+            raise RuntimeError("a skeleton-graph search's path asked for after another search")
+        H, W = g.shape
+        r0, c0 = self.source
+        R, S, rpar = self._robot
+        seeds, scost, slen = self._seeds
+        t, y, kind = int(self._tq[i]), int(self._ty[i]), int(self._kind[i])
+        if kind == 1:
+            back, s = _back(y, seeds, scost, slen, H, W, g.gnode, g.gedge, g.gser, g.gpos, g.ncell, g.ea, g.eb, g.elen, g.efirst,
+                            g.elast, g.eser, g.dc, g.dl, g.dpar, g.dedge, g.dseed, g.dend, g.dgen, g.gen)
+            head = _unwind(_win(int(seeds[s]), r0, c0, R, S, W), rpar, r0, c0, R, S, W)[::-1]
+            cells = np.concatenate([head[:-1], back[::-1]])
+        else:
+            cells = _unwind(_win(y, r0, c0, R, S, W), rpar, r0, c0, R, S, W)[::-1]
+        if y != t:  # through the target's join region, from y on toward it
+            pa, co, radius = self._join
+            TR, TS, _, _, _, tpar = _local(pa, co, H, W, t // W, t % W, radius, True)
+            tail = _unwind(_win(y, t // W, t % W, TR, TS, W), tpar, t // W, t % W, TR, TS, W)
+            cells = np.concatenate([cells[:-1], tail])
+        return cells // W, cells % W
