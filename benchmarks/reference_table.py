@@ -15,6 +15,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import yaml
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from thesis import GREEDY, MAPS, NSOS, SHORTEST  # noqa: E402
@@ -25,7 +27,6 @@ from semsearch_cli.planners import expand_variants  # noqa: E402
 from semsearch_cli.report.build import write_meta  # noqa: E402
 from semsearch_cli.report.tables import summarise  # noqa: E402
 from semsearch_cli.world.importers.mobilesim import import_mobilesim  # noqa: E402
-from semsearch_cli.world.ground_truth import build_world  # noqa: E402
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 
@@ -60,10 +61,11 @@ def main() -> int:
     for stem, (name, start, delta) in MAPS.items():
         goals = list(GREEDY[name])
         p, _ = import_mobilesim(REF / f"{stem}.map", REF / f"{stem}.doors", tmp / stem, 0.1, start, goals, delta, f"{name.lower()}-reference")
-        L = Loaded.load(p)
-        start = L.sc.start.model_copy(update={"heading": a.heading if a.heading == "random" else float(a.heading)})
-        L.sc = L.sc.model_copy(update={"planners": specs, "start": start})
-        L.world = build_world(L.sc, p.parent, str(p))
+        if a.heading != "random":  # the scenario's start heading, written into the imported file
+            d = yaml.safe_load(p.read_text())
+            d["start"]["heading"] = float(a.heading)
+            p.write_text(yaml.safe_dump(d, sort_keys=False))
+        L = Loaded.load(p).with_planners(specs)
         todo = expand(L, a.seeds)
         t0 = time.perf_counter()
         write_meta(a.out / name.lower(), L)

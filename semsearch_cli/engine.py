@@ -15,10 +15,10 @@ replays it (:func:`refusal`). docs/engines.md says what each engine changed.
 
 from __future__ import annotations
 
-ENGINE = 1
+ENGINE = 2
 
 # the releases that run each engine, as pip reads them
-RELEASES = {1: "0.2.*"}
+RELEASES = {1: "0.2.*", 2: "0.3.*"}
 
 
 def engine_of(value) -> int:

@@ -82,7 +82,7 @@ def test_a_seeded_door_reset_reads_as_pinned():
         "facing 90 deg.\n"
         "Choices: drive to a frontier target (a point on the edge of the explored area), nearest first, with the "
         "direction in which unexplored space goes on beyond it; or look at a wall:\n"
-        "[0] 1.2 m away, bearing -9 deg, unexplored space towards -22 deg\n"
+        "[0] 1.2 m away, bearing -9 deg, unexplored space towards -21 deg\n"
         "[64] look at the nearest wall face no camera has read yet\n"
         "Answer with one number: 0 or 64.")
     assert np.flatnonzero(info["action_mask"]).tolist() == [0, 64]

@@ -12,19 +12,18 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from skimage.morphology import skeletonize
 
 from .. import deprecation
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
-from ..kernels.grid import (GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, set_joins,
-                            widest_of_groups)
+from ..kernels.grid import GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, widest_of_groups
 from ..kernels.memory import lazy_zeros
 from ..kernels.raycast import fold_free, himm_update, mark_viewed
+from ..kernels.skelgraph import SkeletonGraph, rank_targets
+from ..kernels.skeleton import Skeleton
 
 CLEARANCE_CAP_M = 1.0
 CONNECT_M = 1.5
-SKELETON_MARGIN_M = 4.0
 BRANCH_DEPTH = 10
 MIN_BRANCH_CELLS = 3
 
@@ -160,12 +159,13 @@ class DoorBelief:
         self.visited = lazy_zeros((H, W), bool)
         self.seg_class = lazy_zeros((H, W), np.int16)  # meaningful where visited
         self.clearance = lazy_zeros((H, W), np.float32)
-        self.skeleton = lazy_zeros((H, W), bool)
+        self._thinning = Skeleton((H, W))  # Zhang and Suen's thinning of the whole map, kept up to date
+        self.skeleton = self._thinning.skeleton
         self.passable = lazy_zeros((H, W), bool)
-        self.skel_band = lazy_zeros((H, W), bool)
-        self._search_mask = lazy_zeros((H, W), bool)  # skel_band, plus a search's joins while it runs
         self.cost = lazy_zeros((H, W), np.float32)  # read only where passable, which refresh_derived writes with it
-        self.search_state = GridSearch((H, W))
+        self.graph = SkeletonGraph((H, W))  # the skeleton where the robot fits, contracted to its junctions and ends
+        self.search_state = GridSearch((H, W))  # for searches the graph cannot answer (every cell where the robot fits)
+        self._result = None  # the last search's answer: the graph's, or search_state
         self.version = 0  # bumped whenever passable/cost change
         self.lost = 0  # cells that were free and are no longer (a wall seen where the map had free space)
         self._search_key = None  # (r, c, version) of the search search_state holds
@@ -188,7 +188,6 @@ class DoorBelief:
         self._view_stamp = None  # (H, W) int64: the last pose that counted for each cell
         self._n_views = 0
         self._touched = np.empty(1024, np.int64)  # cells whose free state the last scan may have changed (flat)
-        self._joins = np.empty(0, np.int64)  # cells a search added to the skeleton band (flat indices)
 
     # ---- per-step updates -------------------------------------------------------------
     def add_view(self, v: float, u: float, heading: float) -> None:
@@ -285,12 +284,14 @@ class DoorBelief:
 
     # ---- derived maps, refreshed at re-plan time ---------------------------------------
     def refresh_derived(self) -> None:
-        """Recompute clearance and skeleton inside the dirty box (plus margins).
+        """Bring clearance, skeleton, passable, cost and the skeleton graph up to date with the
+        cells whose free state changed since the last refresh (the dirty box).
 
-        Clearance is exact (it is capped at ``CLEARANCE_CAP_M``). Thinning is not strictly local,
-        so the windowed skeleton equals the global one wherever free regions are narrower than
-        about ``SKELETON_MARGIN_M`` (corridors); in wide open areas it may differ near the window
-        seam, which only moves candidate cells within those areas.
+        Clearance is exact (it is capped at ``CLEARANCE_CAP_M``), so it changes only within that
+        cap of the dirty box. The skeleton is Zhang and Suen's thinning of the whole map, kept up
+        to date where it changes (:class:`~semsearch_cli.kernels.skeleton.Skeleton`: the same as
+        thinning the map from scratch), and the graph is repaired at the cells whose skeleton or
+        passable state changed (:class:`~semsearch_cli.kernels.skelgraph.SkeletonGraph`).
         """
         d = self.dirty
         if d[1] < d[0]:
@@ -298,7 +299,6 @@ class DoorBelief:
         H, W = self.free.shape
         res = self.frame.res
         cap = int(np.ceil(CLEARANCE_CAP_M / res))
-        m = int(np.ceil(SKELETON_MARGIN_M / res))
         # clearance: write dirty+cap, compute on dirty+2cap
         w0, w1, w2, w3 = max(0, d[0] - cap), min(H, d[1] + cap + 1), max(0, d[2] - cap), min(W, d[3] + cap + 1)
         c0, c1, c2, c3 = max(0, d[0] - 2 * cap), min(H, d[1] + 2 * cap + 1), max(0, d[2] - 2 * cap), min(W, d[3] + 2 * cap + 1)
@@ -306,26 +306,24 @@ class DoorBelief:
         sub[1:-1, 1:-1] = self.free[c0:c1, c2:c3]
         dist = cv2.distanceTransform(sub, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
         np.minimum(dist * np.float32(res), np.float32(CLEARANCE_CAP_M), out=dist)
-        self.clearance[w0:w1, w2:w3] = dist[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
-        # skeleton: write dirty+m/2, compute on dirty+m
-        h = m // 2
-        w0, w1, w2, w3 = max(0, d[0] - h), min(H, d[1] + h + 1), max(0, d[2] - h), min(W, d[3] + h + 1)
-        c0, c1, c2, c3 = max(0, d[0] - m), min(H, d[1] + m + 1), max(0, d[2] - m), min(W, d[3] + m + 1)
-        sk = skeletonize(self.free[c0:c1, c2:c3])
         win = (slice(w0, w1), slice(w2, w3))
-        self.skeleton[win] = sk[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
-        # passable and cost over the skeleton's write window (it contains the clearance's)
-        clear = self.clearance[win]
-        self.passable[win] = clear >= self.min_clear
+        clear = self.clearance[win] = dist[w0 - c0 : w1 - c0, w2 - c2 : w3 - c2]
+        fits = clear >= self.min_clear
+        moved = np.flatnonzero(fits != self.passable[win])
+        self.passable[win] = fits
+        moved = (w0 + moved // (w3 - w2)) * W + w2 + moved % (w3 - w2)
+        changed = self._thinning.update(self.free, d)  # the cells that joined or left the skeleton
+        # cost over the clearance's window, and where the skeleton changed outside it
         cost = np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * clear
         cost[self.skeleton[win]] = 1.0
         self.cost[win] = cost
-        # the skeleton band: the skeleton grown by one cell (so that its diagonal steps are
-        # allowed moves), where the robot fits
-        g0, g1, g2, g3 = max(0, w0 - 1), min(H, w1 + 1), max(0, w2 - 1), min(W, w3 + 1)
-        band = cv2.dilate(self.skeleton[g0:g1, g2:g3].astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-        self.skel_band[win] = band[w0 - g0 : w1 - g0, w2 - g2 : w3 - g2] & self.passable[win]
-        self._search_mask[win] = self.skel_band[win]
+        if changed.size:
+            flat_cost = self.cost.reshape(-1)
+            flat_cost[changed] = np.where(self.skeleton.reshape(-1)[changed], np.float32(1.0),
+                                          np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * self.clearance.reshape(-1)[changed])
+            rr, cc = changed // W, changed % W
+            _grow(self.cdirty, (int(rr.min()), int(rr.max()), int(cc.min()), int(cc.max())))
+        self.graph.repair(self.skeleton, self.passable, np.concatenate([changed, moved]))
         _grow(self.cdirty, (w0, w1 - 1, w2, w3 - 1))
         self.version += 1
         d[:] = (H, -1, W, -1)
@@ -472,52 +470,50 @@ class DoorBelief:
         return Candidates(rows[keep], cols[keep], wrap_angle(np.array(theta, float)), np.array(sr, np.int64), np.array(sc, np.int64))
 
     # ---- distances and segments ----------------------------------------------------------
-    def search(self, r: int, c: int, t_rows, t_cols, n_stop: int) -> GridSearch:
-        """Dijkstra from the robot cell (r, c) to target cells along the skeleton; the returned
-        state answers ``lengths`` (cells) and ``path`` for the settled cells. Stops after
-        ``n_stop`` targets (0: all).
+    def search(self, r: int, c: int, t_rows, t_cols, n_stop: int):
+        """Shortest paths from the robot cell (r, c) to target cells along the skeleton; the
+        answer gives ``lengths`` (cells) and ``path`` for the targets reached. Stops after
+        ``n_stop`` targets (0: all), in the order of (cost, cell index).
 
-        The search runs on the skeleton band (the skeleton grown by one cell, where the robot
-        fits), joined to the robot and to each target by the cells within ``CONNECT_M`` of them;
-        on it the cheapest path runs on the skeleton itself (the thesis counts only Voronoi
-        cells for D). Targets it cannot reach that way (a gap in the windowed skeleton) are
-        searched for again over every cell where the robot fits, under ``cost``.
+        The search runs on the skeleton graph (:class:`~semsearch_cli.kernels.skelgraph.SkeletonGraph`:
+        the skeleton where the robot fits), joined to the robot and to each target off it by the
+        cells within ``CONNECT_M`` of them, under ``cost``; so the path runs on the skeleton
+        itself (the thesis counts only Voronoi cells for D). When fewer targets than asked for
+        are reached that way (a gap in the skeleton where the robot does not fit), every target
+        is searched for again over every cell where the robot fits, under ``cost``.
         """
         self._again = None
         return self._search(r, c, np.asarray(t_rows, np.int64), np.asarray(t_cols, np.int64), n_stop)
 
-    def _search(self, r: int, c: int, t_rows, t_cols, n_stop: int, again: bool | None = None, stop=None) -> GridSearch:
+    def _search(self, r: int, c: int, t_rows, t_cols, n_stop: int, again: bool | None = None, stop=None):
         """:meth:`search`; ``again`` (a replay: whether the search went on over every cell, as the
-        record says) skips the search that decided it, and ``stop`` ends the search at that cell
-        (its path is the whole search's: a settled cell's parent is final)."""
-        need = n_stop if n_stop > 0 else len(t_rows)
+        record says) runs that search or not without deciding it again, and ``stop`` ends the
+        search over every cell at that cell (its path is the whole search's: a settled cell's
+        parent is final)."""
+        distinct = int(np.unique(t_rows * self.free.shape[1] + t_cols).size)
+        need = min(n_stop, distinct) if n_stop > 0 else distinct
         passable = self.passable
         if not passable[r, c]:  # robot squeezed near a wall: let it leave
             passable = passable.copy()
             pr, pc = local_reach(self.free, r, c, max(2.0, self.min_clear / self.frame.res + 1), False)
             passable[pr, pc] = True
-        gs = self.search_state
-        if not again:
-            rad = CONNECT_M / self.frame.res
-            # the band joined to each target and to the robot, set in place and undone after (a copy of
-            # the band per search cost as much as the search itself on a large map)
-            side = 2 * int(np.ceil(rad)) + 1
-            if self._joins.shape[0] < (len(t_rows) + 1) * side * side:
-                self._joins = np.empty((len(t_rows) + 1) * side * side, np.int64)
-            mask = self._search_mask
-            n = set_joins(self.passable, mask, t_rows, t_cols, rad, self._joins)
-            n += set_joins(passable, mask, np.array([r], np.int64), np.array([c], np.int64), rad, self._joins[n:])
-            try:
-                settled = gs.run(mask, self.cost, r, c, t_rows, t_cols, n_stop, stop=stop)
-            finally:
-                mask.ravel()[self._joins[:n]] = False
-        if again or (again is None and settled < need):
-            gs.run(passable, self.cost, r, c, t_rows, t_cols, n_stop, stop=stop)
-            again = True
+        W = self.free.shape[1]
+        graph = self.graph.search(r, c, passable, self.passable, self.cost, t_rows, t_cols, 0, CONNECT_M / self.frame.res)
+        on_graph = graph.settled(t_rows, t_cols)
+        reached = graph.reached
+        grid = None
+        if again or (again is None and reached < need):
+            # the targets the graph does not reach, over every cell where the robot fits
+            rest = ~on_graph
+            self.search_state.run(passable, self.cost, r, c, t_rows[rest], t_cols[rest], max(need - reached, 1) if n_stop > 0 else 0,
+                                  stop=stop)
+            grid, again = self.search_state, True
+        result = SearchAnswer(graph, grid, t_rows, t_cols, need, W)
+        self._result = result
         self._search_key = (r, c, self.version)
         self._search_of = (t_rows, t_cols, n_stop, bool(again))
-        self._stopped_at = stop
-        return gs
+        self._stopped_at = stop if again else None
+        return result
 
     def held_search(self, r: int, c: int):
         """The search :meth:`path` would reuse from (r, c) on the current maps, as (target rows,
@@ -548,10 +544,9 @@ class DoorBelief:
         elif self._search_key == key and self._stopped_at is not None and self._stopped_at != (tr, tc):
             rows, cols, n_stop, again = self._search_of  # stopped at another target: run it in whole, as it ran
             self._search(r, c, rows, cols, n_stop, again=again)
-        gs = self.search_state
-        if self._search_key != key or not gs.settled(tr, tc):
+        if self._search_key != key or not self._result.settled(tr, tc):
             self.search(r, c, [tr], [tc], 1)
-        return gs.path(tr, tc)
+        return self._result.path(tr, tc)
 
     def door_lists(self) -> dict:
         """Door list of each visited segment (thesis 4.2.3), rebuilt from every read.
@@ -664,6 +659,54 @@ class DoorBelief:
                 nxt += n - 1
         self._seg_labels = out
         return out
+
+
+class SearchAnswer:
+    """What :meth:`DoorBelief.search` answers: ``lengths``, ``costs``, ``settled`` and ``path`` for
+    the targets it reached. A target's numbers and path are the skeleton graph's when the graph
+    reaches it, else those of the search over every cell where the robot fits (run only when the
+    graph reached fewer targets than asked for); so they never depend on what other targets were
+    searched with it. Of those reached, the first ``need`` in the order of (cost, cell index)
+    count."""
+
+    def __init__(self, graph, grid, t_rows, t_cols, need: int, W: int):
+        self.graph, self.grid, self._W = graph, grid, W
+        q = t_rows * W + t_cols
+        cost = graph.costs(t_rows, t_cols)
+        if grid is not None:
+            cost = np.where(np.isfinite(cost), cost, grid.costs(t_rows, t_cols))
+        self._kept = rank_targets(q, cost, need)
+
+    def _in(self, rows, cols) -> np.ndarray:
+        q = np.asarray(rows, np.int64) * self._W + np.asarray(cols, np.int64)
+        if self._kept.size == 0:
+            return np.zeros(q.shape, bool)
+        i = np.clip(np.searchsorted(self._kept, q), 0, self._kept.size - 1)
+        return self._kept[i] == q
+
+    def _pick(self, name, rows, cols) -> np.ndarray:
+        v = getattr(self.graph, name)(rows, cols)
+        if self.grid is not None:
+            v = np.where(np.isfinite(v), v, getattr(self.grid, name)(rows, cols))
+        return np.where(self._in(rows, cols), v, np.inf)
+
+    def lengths(self, rows, cols) -> np.ndarray:
+        """Path length (cells) to each given cell, inf where it is not a target reached."""
+        return self._pick("lengths", rows, cols)
+
+    def costs(self, rows, cols) -> np.ndarray:
+        return self._pick("costs", rows, cols)
+
+    def settled(self, rows, cols) -> np.ndarray:
+        return self._in(rows, cols)
+
+    def path(self, r, c):
+        """Cells (rows, cols) from the robot to the target reached (r, c), or None."""
+        if not bool(self._in(r, c)):
+            return None
+        if bool(self.graph.settled(r, c)):
+            return self.graph.path(r, c)
+        return self.grid.path(r, c)
 
 
 def _grow(box, other) -> None:

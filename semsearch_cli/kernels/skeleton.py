@@ -181,24 +181,21 @@ def _thin_window(free, tdel, H, W, seeds, n_seeds, br0, br1, bc0, bc1, margin, t
         table = tables[(s - 1) % 2]
         deleted = 0
         t = s - 1
+        r0, r1, c0, c1 = h + 2, -1, w + 2, -1  # the new front: where the histories differ after s
         for r in range(a0, a1 + 1):
             for c in range(b0, b1 + 1):
                 v = cur[r, c]
-                if v <= t:
-                    continue
-                decided += 1
-                code = ((cur[r - 1, c] > t) | ((cur[r - 1, c + 1] > t) << 1) | ((cur[r, c + 1] > t) << 2)
-                        | ((cur[r + 1, c + 1] > t) << 3) | ((cur[r + 1, c] > t) << 4) | ((cur[r + 1, c - 1] > t) << 5)
-                        | ((cur[r, c - 1] > t) << 6) | ((cur[r - 1, c - 1] > t) << 7))
-                if table[code]:
-                    cur[r, c] = s
-                    deleted += 1
-                elif v == s:
-                    cur[r, c] = KEPT
-        r0, r1, c0, c1 = h + 2, -1, w + 2, -1
-        for r in range(a0, a1 + 1):
-            for c in range(b0, b1 + 1):
-                if (cur[r, c] > s) != (old[r, c] > s):
+                if v > t:
+                    decided += 1
+                    code = ((cur[r - 1, c] > t) | ((cur[r - 1, c + 1] > t) << 1) | ((cur[r, c + 1] > t) << 2)
+                            | ((cur[r + 1, c + 1] > t) << 3) | ((cur[r + 1, c] > t) << 4) | ((cur[r + 1, c - 1] > t) << 5)
+                            | ((cur[r, c - 1] > t) << 6) | ((cur[r - 1, c - 1] > t) << 7))
+                    if table[code]:
+                        v = cur[r, c] = s
+                        deleted += 1
+                    elif v == s:
+                        v = cur[r, c] = KEPT
+                if (v > s) != (old[r, c] > s):  # a cell's value is final once judged (judged in place)
                     r0, r1, c0, c1 = min(r0, r), max(r1, r), min(c0, c), max(c1, c)
         pr0, pr1, pc0, pc1 = a0, a1, b0, b1
         quiet = quiet + 1 if deleted == 0 else 0

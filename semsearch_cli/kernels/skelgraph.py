@@ -47,7 +47,16 @@ _DR = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
 _DC = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
 _OPP = np.array([1, 0, 3, 2, 7, 6, 5, 4], np.int64)
 _STEP = np.array([1.0, 1.0, 1.0, 1.0, SQRT2, SQRT2, SQRT2, SQRT2])
+# lengths along the graph are kept as whole numbers of moves, orthogonal + (diagonal << 32), so that
+# they are the same bit for bit whichever end they were counted from (:func:`_len` gives cells)
+_PK = np.array([1, 1, 1, 1, 1 << 32, 1 << 32, 1 << 32, 1 << 32], np.int64)
 INF = np.inf
+
+
+@njit(cache=True, inline="always")
+def _len(v):
+    """Cells in a packed count of moves (orthogonal + (diagonal << 32)), v >= 0."""
+    return np.float64(v & 0xFFFFFFFF) + np.float64(v >> 32) * SQRT2
 
 
 @njit(cache=True, inline="always")
@@ -151,6 +160,8 @@ def _new_node(q, gnode, ncell, nadj, nalive, nfree, st):
         u = nfree[st[1]]
     else:
         u = st[0]
+        if u >= ncell.shape[0]:
+            return -1
         st[0] += 1
     ncell[u] = q
     nadj[u, :] = -1
@@ -160,7 +171,7 @@ def _new_node(q, gnode, ncell, nadj, nalive, nfree, st):
 
 
 @njit(cache=True)
-def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast, eser,
+def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast, eser,
            ealive, efree, st):
     """The edge leaving node u by move k (which must be allowed and free), traced to its other
     node; returns its id, or -1 when the chain ends at a cell that is no node (a broken graph)."""
@@ -169,12 +180,14 @@ def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, e
         e = efree[st[3]]
     else:
         e = st[2]
+        if e >= ea.shape[0]:
+            return -2
         st[2] += 1
     st[4] += 1
     ser = st[4]
     prev = ncell[u]
     cur = _move(gcell, passable, H, W, prev, k)
-    length = _STEP[k]
+    length = _PK[k]
     kdir = k
     first = -1
     last = -1
@@ -188,6 +201,7 @@ def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, e
         gedge[cur] = e + 1
         gser[cur] = ser
         gpos[cur] = length
+        back = _OPP[kdir]  # the move back toward the edge's first node
         nxt = -1
         for j in range(8):
             q = _move(gcell, passable, H, W, cur, j)
@@ -197,7 +211,8 @@ def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, e
                 break
         if nxt < 0:
             return -1
-        length += _STEP[kdir]
+        glink[cur] = np.uint8(back | (kdir << 4))
+        length += _PK[kdir]
         prev = cur
         cur = nxt
     ea[e] = u
@@ -211,23 +226,59 @@ def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, e
     ealive[e] = True
     nadj[u, k] = e
     nadj[v, _OPP[kdir]] = e
+    # one orientation whatever the node it was traced from: the first node is the one of lesser
+    # cell index; on a loop, the way whose first cell has the lesser index
+    if ncell[v] < ncell[u] or (u == v and last < first):
+        ea[e], eb[e], ka[e], kb[e], efirst[e], elast[e] = v, u, kb[e], k, last, first
+        q = first
+        while q >= 0:
+            gpos[q] = length - gpos[q]
+            lk = np.int64(glink[q])
+            glink[q] = np.uint8((lk >> 4) | ((lk & 15) << 4))
+            q = _walk(q, e, False, W, glink, gnode)  # toward the old first node, now the second
     return e
 
 
 @njit(cache=True)
-def _rebuild(aff, redo, n_redo, gcell, skeleton, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, nalive, nfree, ea, eb,
-             ka, kb, elen, efirst, elast, eser, ealive, efree, st):
-    """Judge the affected cells again (membership, node or not) and trace the chains again from
-    the nodes in ``redo`` and the new ones. Returns 0, or -1 when a chain ended nowhere."""
+def _rebuild(aff, redo_in, n_redo, gcell, skeleton, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, nalive, nfree,
+             ea, eb, ka, kb, elen, efirst, elast, eser, ealive, efree, st):
+    """Judge the affected cells again (membership, node or not), turn the nodes that lost an edge
+    and now have degree 2 into chain cells, and trace the chains again from the nodes that lost an
+    edge and the new ones; a cycle of degree-2 cells left without a node gets its cell of least
+    index as one. So the graph is the same whatever the order of the repairs that made it.
+    Returns 0, -1 when a chain ended nowhere, -2 when the storage ran out."""
+    redo = np.empty(max(16, 2 * n_redo + aff.shape[0]), np.int64)
+    redo[:n_redo] = redo_in[:n_redo]
+    m = n_redo
+    check = np.empty(16, np.int64)
+    n_check = 0
     for i in range(aff.shape[0]):
         q = aff[i]
         gcell[q] = skeleton[q] and passable[q]
-    m = n_redo
     for i in range(aff.shape[0]):
         q = aff[i]
         if gcell[q] and _degree(gcell, passable, H, W, q) != 2:
-            redo[m] = _new_node(q, gnode, ncell, nadj, nalive, nfree, st)
-            m += 1
+            u = _new_node(q, gnode, ncell, nadj, nalive, nfree, st)
+            if u < 0:
+                return -2
+            redo, m = _emit(redo, m, u)
+    i = 0
+    while i < m:  # nodes left with degree 2 become chain cells (their edges go, their ends are traced again)
+        u = redo[i]
+        i += 1
+        if not nalive[u] or _degree(gcell, passable, H, W, ncell[u]) != 2:
+            continue
+        for k in range(8):
+            e = nadj[u, k]
+            if e >= 0 and ealive[e]:
+                redo, m = _emit(redo, m, ea[e])
+                redo, m = _emit(redo, m, eb[e])
+                _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, m - 2)
+        nalive[u] = False
+        nfree[st[1]] = u
+        st[1] += 1
+        gnode[ncell[u]] = 0
+        check, n_check = _emit(check, n_check, ncell[u])
     for i in range(m):
         u = redo[i]
         if not nalive[u]:
@@ -235,19 +286,50 @@ def _rebuild(aff, redo, n_redo, gcell, skeleton, passable, H, W, gnode, gedge, g
         p = ncell[u]
         for k in range(8):
             if nadj[u, k] < 0 and _move(gcell, passable, H, W, p, k) >= 0:
-                if _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast,
-                          eser, ealive, efree, st) < 0:
-                    return -1
-    for i in range(aff.shape[0]):  # a cycle left without a node
-        q = aff[i]
-        if gcell[q] and gnode[q] == 0 and _edge_at(gedge, gser, eser, q) < 0:
-            u = _new_node(q, gnode, ncell, nadj, nalive, nfree, st)
-            for k in range(8):
-                if nadj[u, k] < 0 and _move(gcell, passable, H, W, q, k) >= 0:
-                    if _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, ka, kb, elen, efirst,
-                              elast, eser, ealive, efree, st) < 0:
-                        return -1
+                e = _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst,
+                           elast, eser, ealive, efree, st)
+                if e < 0:
+                    return e
+    for j in range(aff.shape[0] + n_check):  # a cycle left without a node: its least cell becomes one
+        q = aff[j] if j < aff.shape[0] else check[j - aff.shape[0]]
+        if not gcell[q] or gnode[q] != 0 or _edge_at(gedge, gser, eser, q) >= 0:
+            continue
+        least = _least_of_cycle(q, gcell, passable, H, W, gnode)
+        if least < 0:
+            return -1
+        u = _new_node(least, gnode, ncell, nadj, nalive, nfree, st)
+        if u < 0:
+            return -2
+        for k in range(8):
+            if nadj[u, k] < 0 and _move(gcell, passable, H, W, least, k) >= 0:
+                e = _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst,
+                           elast, eser, ealive, efree, st)
+                if e < 0:
+                    return e
     return 0
+
+
+@njit(cache=True)
+def _least_of_cycle(q, gcell, passable, H, W, gnode):
+    """The cell of least index on the cycle of degree-2 cells through q, or -1 when the cells
+    from q reach a node (not a cycle)."""
+    least = q
+    prev = -1
+    cur = q
+    while True:
+        nxt = -1
+        for j in range(8):
+            x = _move(gcell, passable, H, W, cur, j)
+            if x >= 0 and x != prev:
+                nxt = x
+                break
+        if nxt < 0 or gnode[nxt] != 0:
+            return -1
+        if nxt == q:
+            return least
+        least = min(least, nxt)
+        prev = cur
+        cur = nxt
 
 
 # ---- searches ---------------------------------------------------------------------------------
@@ -397,10 +479,9 @@ def _nodes(seeds, scost, slen, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, el
         e = _edge_at(gedge, gser, eser, q)
         if e < 0:
             continue
-        p = gpos[q]
         for end in range(2):
             v = ea[e] if end == 0 else eb[e]
-            w = p if end == 0 else elen[e] - p
+            w = _len(gpos[q]) if end == 0 else _len(elen[e] - gpos[q])
             if _relax(v, scost[s] + w, slen[s] + w, -1, e, s, end, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
                 if n == cap:
                     return -1
@@ -420,10 +501,11 @@ def _nodes(seeds, scost, slen, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, el
             v = eb[e] if ea[e] == u else ea[e]
             if v == u:
                 continue
-            if _relax(v, d + elen[e], dl[u] + elen[e], u, e, -1, 0, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
+            L = _len(elen[e])
+            if _relax(v, d + L, dl[u] + L, u, e, -1, 0, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
                 if n == cap:
                     return -1
-                _push(hk, hi, n, d + elen[e], ncell[v])
+                _push(hk, hi, n, d + L, ncell[v])
                 n += 1
     return 0
 
@@ -454,16 +536,18 @@ def _at(q, seeds, scost, slen, gnode, gedge, gser, gpos, ea, eb, elen, eser, dc,
     e = _edge_at(gedge, gser, eser, q)
     if e < 0:
         return INF, INF, 0, -1
-    p = gpos[q]
+    p = _len(gpos[q])
+    pb = _len(elen[e] - gpos[q])
     bc, bl, way, seed = INF, INF, 0, -1
     a, b = ea[e], eb[e]
     if dgen[a] == gen and dc[a] + p < bc:
         bc, bl, way = dc[a] + p, dl[a] + p, 1
-    if dgen[b] == gen and dc[b] + elen[e] - p < bc:
-        bc, bl, way = dc[b] + elen[e] - p, dl[b] + elen[e] - p, 2
+    if dgen[b] == gen and dc[b] + pb < bc:
+        bc, bl, way = dc[b] + pb, dl[b] + pb, 2
     for s in range(seeds.shape[0]):
         if _edge_at(gedge, gser, eser, seeds[s]) == e:
-            w = abs(gpos[seeds[s]] - p)
+            dv = gpos[seeds[s]] - gpos[q]  # both counts move the same way along an edge
+            w = _len(dv if dv >= 0 else -dv)
             if scost[s] + w < bc:
                 bc, bl, way, seed = scost[s] + w, slen[s] + w, 3, s
     return bc, bl, way, seed
@@ -515,32 +599,18 @@ def _win(q, r0, c0, R, S, W):
     return lr * S + lc
 
 
-@njit(cache=True)
-def _walk(q, e, up, H, W, gedge, gser, gpos, eser):
-    """The next interior cell of edge e after q, toward its second node (``up``) or its first;
-    -1 when q is the last one that way."""
-    r = q // W
-    c = q - r * W
-    p = gpos[q]
-    best = -1
-    bp = 0.0
-    for k in range(8):
-        nr = r + _DR[k]
-        nc = c + _DC[k]
-        if nr < 0 or nr >= H or nc < 0 or nc >= W:
-            continue
-        x = nr * W + nc
-        if _edge_at(gedge, gser, eser, x) != e:
-            continue
-        px = gpos[x]
-        if (up and px > p and (best < 0 or px < bp)) or (not up and px < p and (best < 0 or px > bp)):
-            best = x
-            bp = px
-    return best
+@njit(cache=True, inline="always")
+def _walk(q, e, up, W, glink, gnode):
+    """The cell after interior cell q along its edge, toward the edge's second node (``up``) or
+    its first; -1 when that is the node."""
+    v = np.int64(glink[q])
+    k = (v >> 4) if up else (v & 15)
+    x = q + _DR[k] * W + _DC[k]
+    return -1 if gnode[x] > 0 else x
 
 
 @njit(cache=True)
-def _back(y, seeds, scost, slen, H, W, gnode, gedge, gser, gpos, ncell, ea, eb, elen, efirst, elast, eser, dc, dl, dpar, dedge,
+def _back(y, seeds, scost, slen, H, W, gnode, gedge, gser, gpos, glink, ncell, ea, eb, elen, efirst, elast, eser, dc, dl, dpar, dedge,
           dseed, dend, dgen, gen):
     """The graph part of the path to graph cell y, from y back to the seed it starts at: (cells,
     seed index)."""
@@ -557,14 +627,14 @@ def _back(y, seeds, scost, slen, H, W, gnode, gedge, gser, gpos, ncell, ea, eb, 
             up = gpos[qs] > gpos[y]
             q = y
             while q != qs:
-                q = _walk(q, e, up, H, W, gedge, gser, gpos, eser)
+                q = _walk(q, e, up, W, glink, gnode)
                 buf, n = _emit(buf, n, q)
             return buf[:n], seed
         up = way == 2
-        q = _walk(y, e, up, H, W, gedge, gser, gpos, eser)
+        q = _walk(y, e, up, W, glink, gnode)
         while q >= 0:
             buf, n = _emit(buf, n, q)
-            q = _walk(q, e, up, H, W, gedge, gser, gpos, eser)
+            q = _walk(q, e, up, W, glink, gnode)
         u = eb[e] if up else ea[e]
         buf, n = _emit(buf, n, ncell[u])
     while dpar[u] >= 0:
@@ -574,7 +644,7 @@ def _back(y, seeds, scost, slen, H, W, gnode, gedge, gser, gpos, ncell, ea, eb, 
         q = elast[e] if at_b else efirst[e]
         while q >= 0:
             buf, n = _emit(buf, n, q)
-            q = _walk(q, e, not at_b, H, W, gedge, gser, gpos, eser)
+            q = _walk(q, e, not at_b, W, glink, gnode)
         buf, n = _emit(buf, n, ncell[p])
         u = p
     seed = dseed[u]
@@ -585,7 +655,7 @@ def _back(y, seeds, scost, slen, H, W, gnode, gedge, gser, gpos, ncell, ea, eb, 
         q = elast[e] if at_b else efirst[e]
         buf, n = _emit(buf, n, q)
         while q != qs:
-            q = _walk(q, e, not at_b, H, W, gedge, gser, gpos, eser)
+            q = _walk(q, e, not at_b, W, glink, gnode)
             buf, n = _emit(buf, n, q)
     return buf[:n], seed
 
@@ -618,6 +688,57 @@ def _unwind(li, par, r0, c0, R, S, W):
     return out
 
 
+@njit(cache=True)
+def rank_targets(q, cost, need):
+    """The first ``need`` distinct cells of ``q`` (flat indices) with a finite ``cost``, in the
+    order of (cost, cell index) (a cell listed twice counts once, at its least cost), sorted by
+    cell index."""
+    fin = np.flatnonzero(np.isfinite(cost))
+    if fin.shape[0] == 0 or need <= 0:
+        return np.empty(0, np.int64)
+    keys = cost[fin]
+    cells = q[fin]
+    order = np.argsort(cells, kind="mergesort")
+    order = order[np.argsort(keys[order], kind="mergesort")]  # by cost, then cell (a stable sort of a sort by cell)
+    out = np.empty(min(need, order.shape[0]), np.int64)
+    n = 0
+    for i in range(order.shape[0]):
+        x = cells[order[i]]
+        seen = False
+        for j in range(n):
+            if out[j] == x:
+                seen = True
+                break
+        if not seen:
+            out[n] = x
+            n += 1
+            if n == out.shape[0]:
+                break
+    return np.sort(out[:n])
+
+
+@njit(cache=True)
+def _seeds_of(rin, rcst, rlen, r, c, R, S, W, gcell):
+    """The graph cells of the robot's join region, with their cost and length, in window order."""
+    n = 0
+    for li in range(S * S):
+        if rin[li] and rcst[li] < np.inf and gcell[(r + li // S - R) * W + (c + li % S - R)]:
+            n += 1
+    seeds = np.empty(n, np.int64)
+    scost = np.empty(n)
+    slen = np.empty(n)
+    k = 0
+    for li in range(S * S):
+        if rin[li] and rcst[li] < np.inf:
+            q = (r + li // S - R) * W + (c + li % S - R)
+            if gcell[q]:
+                seeds[k] = q
+                scost[k] = rcst[li]
+                slen[k] = rlen[li]
+                k += 1
+    return seeds, scost, slen
+
+
 class SkeletonGraph:
     """The contracted skeleton graph of one grid shape (see the module's text): :meth:`repair`
     after the skeleton or passable cells change, :meth:`search` from the robot."""
@@ -630,7 +751,8 @@ class SkeletonGraph:
         self.gnode = lazy_zeros(N, np.int32)  # node id + 1 at nodes, 0 elsewhere
         self.gedge = lazy_zeros(N, np.int32)  # at interior cells: edge id + 1 (valid while gser matches)
         self.gser = lazy_zeros(N, np.int64)
-        self.gpos = lazy_zeros(N, np.float64)  # at interior cells: length from the edge's first node
+        self.gpos = lazy_zeros(N, np.int64)  # at interior cells: moves from the edge's first node (packed: _len)
+        self.glink = lazy_zeros(N, np.uint8)  # at interior cells: the moves to the previous (low 4 bits) and next cell
         self._mark = lazy_zeros(N, np.int64)
         self._mgen = 0
         self.st = np.zeros(8, np.int64)  # node high-water mark, free nodes, edge high-water mark, free edges, serial
@@ -663,7 +785,7 @@ class SkeletonGraph:
             return
         while cap < need:
             cap *= 2
-        fields = {"ea": np.int64, "eb": np.int64, "ka": np.int64, "kb": np.int64, "elen": np.float64, "efirst": np.int64,
+        fields = {"ea": np.int64, "eb": np.int64, "ka": np.int64, "kb": np.int64, "elen": np.int64, "efirst": np.int64,
                   "elast": np.int64, "eser": np.int64, "ealive": bool, "efree": np.int64}
         for name, dt in fields.items():
             a = np.zeros(cap, dt)
@@ -698,9 +820,12 @@ class SkeletonGraph:
                        self.ea, self.eb, self.ka, self.kb, self.eser, self.ealive, self.efree, self.st, redo)
         self._nodes_cap(int(self.st[0]) + 2 * aff.shape[0])
         self._edges_cap(int(self.st[2]) + 8 * (n_redo + 2 * aff.shape[0]))
-        ok = _rebuild(aff, redo, n_redo, self.gcell, sk, pa, H, W, self.gnode, self.gedge, self.gser, self.gpos, self.ncell,
+        ok = _rebuild(aff, redo, n_redo, self.gcell, sk, pa, H, W, self.gnode, self.gedge, self.gser, self.gpos, self.glink,
+                      self.ncell,
                       self.nadj, self.nalive, self.nfree, self.ea, self.eb, self.ka, self.kb, self.elen, self.efirst, self.elast,
                       self.eser, self.ealive, self.efree, self.st)
+        if ok == -2:  # pragma: no cover - the bounds above hold: say so rather than write past the storage
+            raise RuntimeError("skeleton graph: node or edge storage ran out during a repair")
         if ok < 0:  # pragma: no cover - an invariant broken: say so rather than search a wrong graph
             raise RuntimeError("skeleton graph: a chain ended at a cell that is not a node")
         return int(aff.shape[0])
@@ -715,10 +840,7 @@ class SkeletonGraph:
         H, W = self.shape
         rp, pa, co = robot_passable.reshape(-1), passable.reshape(-1), cost.reshape(-1)
         R, S, rin, rcst, rlen, rpar = _local(rp, co, H, W, int(r), int(c), radius, False)
-        win = np.flatnonzero(rin & np.isfinite(rcst))
-        cells = (int(r) + win // S - R) * W + (int(c) + win % S - R)
-        on = self.gcell[cells]
-        seeds, scost, slen = cells[on], rcst[win[on]], rlen[win[on]]
+        seeds, scost, slen = _seeds_of(rin, rcst, rlen, int(r), int(c), R, S, W, self.gcell)
         while True:
             self.gen += 1
             hk, hi = self._heap
@@ -731,15 +853,12 @@ class SkeletonGraph:
         tc, tl, kind, ty = _targets(tq, int(r), int(c), R, S, rin, rcst, rlen, pa, co, H, W, radius, seeds, scost, slen,
                                     self.gcell, self.gnode, self.gedge, self.gser, self.gpos, self.ea, self.eb, self.elen,
                                     self.eser, self.dc, self.dl, self.dgen, self.gen)
-        # reached: the first n_stop distinct target cells in the order of (cost, cell index)
-        fin = np.flatnonzero(np.isfinite(tc))
-        order = fin[np.lexsort((tq[fin], tc[fin]))]
-        cells_in_order, first = np.unique(tq[order], return_index=True)
-        ranked = cells_in_order[np.argsort(first, kind="stable")]
-        need = len(ranked) if n_stop <= 0 else min(int(n_stop), len(ranked))
-        reached = np.isin(tq, ranked[:need])
-        return GraphSearch(self, (int(r), int(c)), tq, np.where(reached, tc, np.inf), np.where(reached, tl, np.inf), kind, ty,
-                           (R, S, rpar), (seeds, scost, slen), (pa, co, radius), need)
+        if n_stop > 0:  # reached: the first n_stop distinct target cells in the order of (cost, cell index)
+            kept = rank_targets(tq, tc, int(n_stop))
+            off = ~np.isin(tq, kept)
+            tc, tl = np.where(off, np.inf, tc), np.where(off, np.inf, tl)
+        need = int(np.unique(tq[np.isfinite(tc)]).size)
+        return GraphSearch(self, (int(r), int(c)), tq, tc, tl, kind, ty, (R, S, rpar), (seeds, scost, slen), (pa, co, radius), need)
 
 
 class GraphSearch:
@@ -787,7 +906,7 @@ class GraphSearch:
         seeds, scost, slen = self._seeds
         t, y, kind = int(self._tq[i]), int(self._ty[i]), int(self._kind[i])
         if kind == 1:
-            back, s = _back(y, seeds, scost, slen, H, W, g.gnode, g.gedge, g.gser, g.gpos, g.ncell, g.ea, g.eb, g.elen, g.efirst,
+            back, s = _back(y, seeds, scost, slen, H, W, g.gnode, g.gedge, g.gser, g.gpos, g.glink, g.ncell, g.ea, g.eb, g.elen, g.efirst,
                             g.elast, g.eser, g.dc, g.dl, g.dpar, g.dedge, g.dseed, g.dend, g.dgen, g.gen)
             head = _unwind(_win(int(seeds[s]), r0, c0, R, S, W), rpar, r0, c0, R, S, W)[::-1]
             cells = np.concatenate([head[:-1], back[::-1]])
