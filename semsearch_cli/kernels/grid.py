@@ -170,19 +170,19 @@ def segment_roots(seg_parent, visited, cells):
 
 
 @njit(cache=True, inline="always")
-def _before(k1, i1, k2, i2):
+def heap_before(k1, i1, k2, i2):
     """Heap order: by cost, then by cell index (so that every heap pops cells in one order)."""
     return k1 < k2 or (k1 == k2 and i1 < i2)
 
 
 @njit(cache=True, inline="always")
-def _heap_push(hk, hi, n, k, i):
+def heap_push(hk, hi, n, k, i):
     """Put (k, i) into the 4-ary heap of the first ``n`` entries of (hk, hi) (a 4-ary heap is half
     as deep as a binary one, and its four children share a cache line)."""
     j = n
     while j > 0:
         p = (j - 1) >> 2
-        if not _before(k, i, hk[p], hi[p]):
+        if not heap_before(k, i, hk[p], hi[p]):
             break
         hk[j] = hk[p]
         hi[j] = hi[p]
@@ -192,7 +192,7 @@ def _heap_push(hk, hi, n, k, i):
 
 
 @njit(cache=True, inline="always")
-def _heap_drop_top(hk, hi, n):
+def heap_drop_top(hk, hi, n):
     """Remove the top of the heap of ``n`` entries (it then holds n - 1)."""
     n -= 1
     k = hk[n]
@@ -204,9 +204,9 @@ def _heap_drop_top(hk, hi, n):
             break
         best = ch
         for q in range(ch + 1, min(ch + 4, n)):
-            if _before(hk[q], hi[q], hk[best], hi[best]):
+            if heap_before(hk[q], hi[q], hk[best], hi[best]):
                 best = q
-        if not _before(hk[best], hi[best], k, i):
+        if not heap_before(hk[best], hi[best], k, i):
             break
         hk[j] = hk[best]
         hi[j] = hi[best]
@@ -263,7 +263,7 @@ def _dijkstra(passable, cost, H, W, src, tmark, n_stop, max_cost, state, parent,
             state[q, 1] = 0.0
             parent[q] = -1
             stamp[q] = reached
-            _heap_push(hk, hi, n, 0.0, q)
+            heap_push(hk, hi, n, 0.0, q)
             n += 1
     cur = 0  # with dial: the bucket the heap holds (costs in [cur, cur + 1))
     waiting = 0  # with dial: entries in the buckets after it
@@ -278,14 +278,14 @@ def _dijkstra(passable, cost, H, W, src, tmark, n_stop, max_cost, state, parent,
             if m > hcap:
                 return -1
             for j in range(m):
-                _heap_push(hk, hi, n, bk[b, j], bi[b, j])
+                heap_push(hk, hi, n, bk[b, j], bi[b, j])
                 n += 1
             waiting -= m
             bn[b] = 0
             continue
         d = hk[0]
         idx = hi[0]
-        _heap_drop_top(hk, hi, n)
+        heap_drop_top(hk, hi, n)
         n -= 1
         if stamp[idx] == done:
             continue
@@ -333,7 +333,7 @@ def _dijkstra(passable, cost, H, W, src, tmark, n_stop, max_cost, state, parent,
                 else:
                     if n == hcap:
                         return -1
-                    _heap_push(hk, hi, n, nd, q)
+                    heap_push(hk, hi, n, nd, q)
                     n += 1
                 stamp[q] = reached
                 state[q, 0] = nd

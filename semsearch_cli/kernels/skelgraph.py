@@ -39,6 +39,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .grid import heap_drop_top, heap_push, local_reach
 from .memory import lazy_zeros
 
 SQRT2 = math.sqrt(2.0)
@@ -153,16 +154,25 @@ def _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr):
     return nr + 2
 
 
+@njit(cache=True, inline="always")
+def _take(free, st, hwm, n_free, cap):
+    """An id: the last freed one (``st[n_free]`` of them in ``free``), else the next never used
+    (``st[hwm]``); -1 when ``cap`` are in use."""
+    if st[n_free] > 0:
+        st[n_free] -= 1
+        return free[st[n_free]]
+    u = st[hwm]
+    if u >= cap:
+        return -1
+    st[hwm] += 1
+    return u
+
+
 @njit(cache=True)
 def _new_node(q, gnode, ncell, nadj, nalive, nfree, st):
-    if st[1] > 0:
-        st[1] -= 1
-        u = nfree[st[1]]
-    else:
-        u = st[0]
-        if u >= ncell.shape[0]:
-            return -1
-        st[0] += 1
+    u = _take(nfree, st, 0, 1, ncell.shape[0])
+    if u < 0:
+        return -1
     ncell[u] = q
     nadj[u, :] = -1
     nalive[u] = True
@@ -175,14 +185,9 @@ def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, 
            ealive, efree, st):
     """The edge leaving node u by move k (which must be allowed and free), traced to its other
     node; returns its id, or -1 when the chain ends at a cell that is no node (a broken graph)."""
-    if st[3] > 0:
-        st[3] -= 1
-        e = efree[st[3]]
-    else:
-        e = st[2]
-        if e >= ea.shape[0]:
-            return -2
-        st[2] += 1
+    e = _take(efree, st, 2, 3, ea.shape[0])
+    if e < 0:
+        return -2
     st[4] += 1
     ser = st[4]
     prev = ncell[u]
@@ -281,15 +286,11 @@ def _rebuild(aff, redo_in, n_redo, gcell, skeleton, passable, H, W, gnode, gedge
         check, n_check = _emit(check, n_check, ncell[u])
     for i in range(m):
         u = redo[i]
-        if not nalive[u]:
-            continue
-        p = ncell[u]
-        for k in range(8):
-            if nadj[u, k] < 0 and _move(gcell, passable, H, W, p, k) >= 0:
-                e = _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst,
+        if nalive[u]:
+            e = _trace_all(u, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst,
                            elast, eser, ealive, efree, st)
-                if e < 0:
-                    return e
+            if e < 0:
+                return e
     for j in range(aff.shape[0] + n_check):  # a cycle left without a node: its least cell becomes one
         q = aff[j] if j < aff.shape[0] else check[j - aff.shape[0]]
         if not gcell[q] or gnode[q] != 0 or _edge_at(gedge, gser, eser, q) >= 0:
@@ -300,12 +301,24 @@ def _rebuild(aff, redo_in, n_redo, gcell, skeleton, passable, H, W, gnode, gedge
         u = _new_node(least, gnode, ncell, nadj, nalive, nfree, st)
         if u < 0:
             return -2
-        for k in range(8):
-            if nadj[u, k] < 0 and _move(gcell, passable, H, W, least, k) >= 0:
-                e = _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst,
-                           elast, eser, ealive, efree, st)
-                if e < 0:
-                    return e
+        e = _trace_all(u, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast,
+                       eser, ealive, efree, st)
+        if e < 0:
+            return e
+    return 0
+
+
+@njit(cache=True)
+def _trace_all(u, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst, elast, eser,
+               ealive, efree, st):
+    """Trace the edges leaving node u by every allowed move that has none yet; 0, or
+    :func:`_trace`'s error."""
+    for k in range(8):
+        if nadj[u, k] < 0 and _move(gcell, passable, H, W, ncell[u], k) >= 0:
+            e = _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, nadj, ea, eb, ka, kb, elen, efirst,
+                       elast, eser, ealive, efree, st)
+            if e < 0:
+                return e
     return 0
 
 
@@ -334,46 +347,6 @@ def _least_of_cycle(q, gcell, passable, H, W, gnode):
 
 # ---- searches ---------------------------------------------------------------------------------
 
-@njit(cache=True, inline="always")
-def _before(k1, i1, k2, i2):
-    return k1 < k2 or (k1 == k2 and i1 < i2)
-
-
-@njit(cache=True)
-def _push(hk, hi, n, k, i):
-    j = n
-    while j > 0:
-        p = (j - 1) >> 1
-        if not _before(k, i, hk[p], hi[p]):
-            break
-        hk[j] = hk[p]
-        hi[j] = hi[p]
-        j = p
-    hk[j] = k
-    hi[j] = i
-
-
-@njit(cache=True)
-def _pop(hk, hi, n):
-    n -= 1
-    k = hk[n]
-    i = hi[n]
-    j = 0
-    while True:
-        ch = 2 * j + 1
-        if ch >= n:
-            break
-        if ch + 1 < n and _before(hk[ch + 1], hi[ch + 1], hk[ch], hi[ch]):
-            ch += 1
-        if not _before(hk[ch], hi[ch], k, i):
-            break
-        hk[j] = hk[ch]
-        hi[j] = hi[ch]
-        j = ch
-    hk[j] = k
-    hi[j] = i
-
-
 @njit(cache=True)
 def _local(passable, cost, H, W, r0, c0, radius, reverse):
     """Dijkstra over the passable cells 4-connected to (r0, c0) within ``radius`` cells (a disk),
@@ -391,43 +364,21 @@ def _local(passable, cost, H, W, r0, c0, radius, reverse):
     par = np.full(S * S, -1, np.int64)
     if r0 < 0 or r0 >= H or c0 < 0 or c0 >= W or not passable[r0 * W + c0]:
         return R, S, inside, cst, lng, par
-    qu = np.empty(S * S, np.int64)
-    qu[0] = R * S + R
-    inside[R * S + R] = True
-    head, tail = 0, 1
-    rad2 = radius * radius
-    while head < tail:
-        li = qu[head]
-        head += 1
-        lr = li // S
-        lc = li - lr * S
-        for k in range(4):
-            mr = lr + _DR[k]
-            mc = lc + _DC[k]
-            if mr < 0 or mr >= S or mc < 0 or mc >= S:
-                continue
-            gr = r0 + mr - R
-            gc = c0 + mc - R
-            if gr < 0 or gr >= H or gc < 0 or gc >= W:
-                continue
-            lj = mr * S + mc
-            if inside[lj] or (mr - R) * (mr - R) + (mc - R) * (mc - R) > rad2 or not passable[gr * W + gc]:
-                continue
-            inside[lj] = True
-            qu[tail] = lj
-            tail += 1
+    rr, cc = local_reach(passable.reshape(H, W), r0, c0, radius, False)
+    for i in range(rr.shape[0]):
+        inside[(rr[i] - r0 + R) * S + cc[i] - c0 + R] = True
     hk = np.empty(8 * S * S + 1)
     hi = np.empty(8 * S * S + 1, np.int64)
     done = np.zeros(S * S, np.bool_)
     n = 0
     cst[R * S + R] = 0.0
     lng[R * S + R] = 0.0
-    _push(hk, hi, n, 0.0, R * S + R)
+    heap_push(hk, hi, n, 0.0, R * S + R)
     n += 1
     while n > 0:
         d = hk[0]
         li = hi[0]
-        _pop(hk, hi, n)
+        heap_drop_top(hk, hi, n)
         n -= 1
         if done[li]:
             continue
@@ -451,7 +402,7 @@ def _local(passable, cost, H, W, r0, c0, radius, reverse):
                 cst[lj] = nd
                 lng[lj] = lng[li] + _STEP[k]
                 par[lj] = li
-                _push(hk, hi, n, nd, lj)
+                heap_push(hk, hi, n, nd, lj)
                 n += 1
     return R, S, inside, cst, lng, par
 
@@ -473,7 +424,7 @@ def _nodes(seeds, scost, slen, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, el
             if _relax(u, scost[s], slen[s], -1, -1, s, 0, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
                 if n == cap:
                     return -1
-                _push(hk, hi, n, scost[s], ncell[u])
+                heap_push(hk, hi, n, scost[s], ncell[u])
                 n += 1
             continue
         e = _edge_at(gedge, gser, eser, q)
@@ -485,12 +436,12 @@ def _nodes(seeds, scost, slen, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, el
             if _relax(v, scost[s] + w, slen[s] + w, -1, e, s, end, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
                 if n == cap:
                     return -1
-                _push(hk, hi, n, scost[s] + w, ncell[v])
+                heap_push(hk, hi, n, scost[s] + w, ncell[v])
                 n += 1
     while n > 0:
         d = hk[0]
         u = gnode[hi[0]] - 1
-        _pop(hk, hi, n)
+        heap_drop_top(hk, hi, n)
         n -= 1
         if d > dc[u]:  # a stale entry
             continue
@@ -505,7 +456,7 @@ def _nodes(seeds, scost, slen, gnode, gedge, gser, gpos, ncell, nadj, ea, eb, el
             if _relax(v, d + L, dl[u] + L, u, e, -1, 0, dc, dl, dpar, dedge, dseed, dend, dgen, gen):
                 if n == cap:
                     return -1
-                _push(hk, hi, n, d + L, ncell[v])
+                heap_push(hk, hi, n, d + L, ncell[v])
                 n += 1
     return 0
 
@@ -761,38 +712,36 @@ class SkeletonGraph:
         self.gen = 0
 
     # ---- storage ---------------------------------------------------------------------------
-    def _nodes_cap(self, need: int) -> None:
-        old = getattr(self, "ncell", None)
-        cap = 256 if old is None else old.shape[0]
+    _NODE_FIELDS = {"ncell": (np.int64, 0), "nadj": (np.int32, -1), "nalive": (bool, False), "nfree": (np.int64, 0),
+                    "dc": (np.float64, np.inf), "dl": (np.float64, np.inf), "dpar": (np.int64, -1), "dedge": (np.int64, -1),
+                    "dseed": (np.int64, -1), "dend": (np.int64, 0), "dgen": (np.int64, 0)}
+    _EDGE_FIELDS = {name: (dt, 0) for name, dt in (("ea", np.int64), ("eb", np.int64), ("ka", np.int64), ("kb", np.int64),
+                                                   ("elen", np.int64), ("efirst", np.int64), ("elast", np.int64),
+                                                   ("eser", np.int64), ("ealive", bool), ("efree", np.int64))}
+
+    def _room(self, fields: dict, need: int, first: int) -> bool:
+        """Grow the arrays ``fields`` (name: (dtype, fill); ``nadj`` has 8 slots a row) to hold at
+        least ``need`` rows, doubling; returns whether they grew."""
+        old = getattr(self, next(iter(fields)), None)
+        cap = first if old is None else old.shape[0]
         if old is not None and cap >= need:
-            return
+            return False
         while cap < need:
             cap *= 2
-        fields = {"ncell": (np.int64, 0), "nadj": (np.int32, -1), "nalive": (bool, False), "nfree": (np.int64, 0),
-                  "dc": (np.float64, np.inf), "dl": (np.float64, np.inf), "dpar": (np.int64, -1), "dedge": (np.int64, -1),
-                  "dseed": (np.int64, -1), "dend": (np.int64, 0), "dgen": (np.int64, 0)}
         for name, (dt, fill) in fields.items():
-            shape = (cap, 8) if name == "nadj" else (cap,)
-            a = np.full(shape, fill, dt)
+            a = np.full((cap, 8) if name == "nadj" else (cap,), fill, dt)
             if old is not None:
                 a[: old.shape[0]] = getattr(self, name)
             setattr(self, name, a)
+        return True
+
+    def _nodes_cap(self, need: int) -> None:
+        self._room(self._NODE_FIELDS, need, 256)
 
     def _edges_cap(self, need: int) -> None:
-        old = getattr(self, "ea", None)
-        cap = 512 if old is None else old.shape[0]
-        if old is not None and cap >= need:
-            return
-        while cap < need:
-            cap *= 2
-        fields = {"ea": np.int64, "eb": np.int64, "ka": np.int64, "kb": np.int64, "elen": np.int64, "efirst": np.int64,
-                  "elast": np.int64, "eser": np.int64, "ealive": bool, "efree": np.int64}
-        for name, dt in fields.items():
-            a = np.zeros(cap, dt)
-            if old is not None:
-                a[: old.shape[0]] = getattr(self, name)
-            setattr(self, name, a)
-        self._heap = (np.empty(4 * cap + 64), np.empty(4 * cap + 64, np.int64))
+        if self._room(self._EDGE_FIELDS, need, 512):
+            cap = self.ea.shape[0]
+            self._heap = (np.empty(4 * cap + 64), np.empty(4 * cap + 64, np.int64))
 
     @property
     def n_nodes(self) -> int:
