@@ -15,7 +15,7 @@ graph cells (before or after) within one cell of them: the affected cells. Every
 affected cell, or ending at one that was a node, is dropped (an interior cell's record is valid
 only while its edge's serial number matches, so dropping costs nothing per cell), the affected
 cells are judged again, and chains are traced again from every node that lost an edge and every
-new node. A cycle left without a node gets its first affected cell as one. The cost is the
+new node. A cycle left without a node gets its cell of least index as one. The cost is the
 changed chains' length, not the map's.
 
 **Searches.** The robot is joined to the graph by a Dijkstra over the passable cells 4-connected
@@ -128,7 +128,7 @@ def _drop(aff, gcell, gnode, gedge, gser, ncell, nadj, nalive, nfree, ea, eb, ka
             for k in range(8):
                 e = nadj[u, k]
                 if e >= 0:
-                    nr = _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr)
+                    nr = _drop_edge(e, nadj, ea, eb, ka, kb, eser, ealive, efree, st, redo, nr)
             nalive[u] = False
             nfree[st[1]] = u
             st[1] += 1
@@ -136,15 +136,16 @@ def _drop(aff, gcell, gnode, gedge, gser, ncell, nadj, nalive, nfree, ea, eb, ka
         else:
             e = _edge_at(gedge, gser, eser, q)
             if e >= 0:
-                nr = _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr)
+                nr = _drop_edge(e, nadj, ea, eb, ka, kb, eser, ealive, efree, st, redo, nr)
     return nr
 
 
 @njit(cache=True)
-def _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, nr):
+def _drop_edge(e, nadj, ea, eb, ka, kb, eser, ealive, efree, st, redo, nr):
     if not ealive[e]:
         return nr
     ealive[e] = False
+    eser[e] = 0  # its cells' records no longer match any edge (serials start at 1)
     efree[st[3]] = e
     st[3] += 1
     nadj[ea[e], ka[e]] = -1
@@ -240,7 +241,7 @@ def _trace(u, k, gcell, passable, H, W, gnode, gedge, gser, gpos, glink, ncell, 
             gpos[q] = length - gpos[q]
             lk = np.int64(glink[q])
             glink[q] = np.uint8((lk >> 4) | ((lk & 15) << 4))
-            q = _walk(q, e, False, W, glink, gnode)  # toward the old first node, now the second
+            q = _walk(q, e, False, W, glink, gnode)  # on along the chain (its cells' links were swapped)
     return e
 
 
@@ -278,7 +279,7 @@ def _rebuild(aff, redo_in, n_redo, gcell, skeleton, passable, H, W, gnode, gedge
             if e >= 0 and ealive[e]:
                 redo, m = _emit(redo, m, ea[e])
                 redo, m = _emit(redo, m, eb[e])
-                _drop_edge(e, nadj, ea, eb, ka, kb, ealive, efree, st, redo, m - 2)
+                _drop_edge(e, nadj, ea, eb, ka, kb, eser, ealive, efree, st, redo, m - 2)
         nalive[u] = False
         nfree[st[1]] = u
         st[1] += 1
@@ -758,6 +759,7 @@ class SkeletonGraph:
         affected cells."""
         if len(changed) == 0:
             return 0
+        self.gen += 1  # a search made before this repair answers no more paths
         H, W = self.shape
         sk, pa = skeleton.reshape(-1), passable.reshape(-1)
         self._mgen += 1
