@@ -196,3 +196,31 @@ def test_a_cycle_without_junctions_and_its_repair():
     assert res.lengths([4], [5])[0] == pytest.approx(6 + 4 * math.sqrt(2))  # the long way round
     rows, cols = res.path(4, 5)
     assert len(rows) == 11
+
+
+def test_a_dropped_edge_leaves_no_record_that_passes_for_a_live_one():
+    """Review's case: a ring with a spur; the spur goes (the ring's node is reused), then a
+    passable cell off the skeleton changes beside the ring. A dropped edge's cells once still read
+    as that edge, so the ring was left without a node and its path walked for ever."""
+    H, W = 12, 12
+    skeleton = np.zeros((H, W), bool)
+    skeleton[2, 2:7] = skeleton[6, 2:7] = skeleton[2:7, 2] = skeleton[2:7, 6] = True
+    skeleton[7:10, 4] = True
+    passable = skeleton.copy()
+    passable[1, 4] = True
+    g = SkeletonGraph((H, W))
+    g.repair(skeleton, passable, np.arange(H * W))
+    skeleton[7:10, 4] = False
+    passable[7:10, 4] = False
+    g.repair(skeleton, passable, np.array([7 * W + 4, 8 * W + 4, 9 * W + 4]))
+    passable[1, 4] = False
+    g.repair(skeleton, passable, np.array([1 * W + 4]))
+    fresh = SkeletonGraph((H, W))
+    fresh.repair(skeleton, passable, np.arange(H * W))
+    assert (g.n_nodes, g.n_edges) == (fresh.n_nodes, fresh.n_edges) and g.n_nodes > 0
+    cost = np.where(skeleton, 1.0, 3.0)
+    a = g.search(2, 4, passable, passable, cost, [5], [2], 0, 0.5)
+    b = fresh.search(2, 4, passable, passable, cost, [5], [2], 0, 0.5)
+    assert np.array_equal(a.lengths([5], [2]), b.lengths([5], [2]))
+    pa, pb = a.path(5, 2), b.path(5, 2)
+    assert np.array_equal(pa[0], pb[0]) and np.array_equal(pa[1], pb[1])

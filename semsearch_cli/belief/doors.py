@@ -314,13 +314,9 @@ class DoorBelief:
         moved = (w0 + moved // (w3 - w2)) * W + w2 + moved % (w3 - w2)
         changed = self._thinning.update(self.free, d)  # the cells that joined or left the skeleton
         # cost over the clearance's window, and where the skeleton changed outside it
-        cost = np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * clear
-        cost[self.skeleton[win]] = 1.0
-        self.cost[win] = cost
+        self.cost[win] = _cost(clear, self.skeleton[win])
         if changed.size:
-            flat_cost = self.cost.reshape(-1)
-            flat_cost[changed] = np.where(self.skeleton.reshape(-1)[changed], np.float32(1.0),
-                                          np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * self.clearance.reshape(-1)[changed])
+            self.cost.reshape(-1)[changed] = _cost(self.clearance.reshape(-1)[changed], self.skeleton.reshape(-1)[changed])
             rr, cc = changed // W, changed % W
             _grow(self.cdirty, (int(rr.min()), int(rr.max()), int(cc.min()), int(cc.max())))
         self.graph.repair(self.skeleton, self.passable, np.concatenate([changed, moved]))
@@ -707,6 +703,12 @@ class SearchAnswer:
         if bool(self.graph.settled(r, c)):
             return self.graph.path(r, c)
         return self.grid.path(r, c)
+
+
+def _cost(clear: np.ndarray, on_skeleton: np.ndarray) -> np.ndarray:
+    """The cost multiplier of cells of clearance ``clear`` (m): 1 on the skeleton, else 3.5 against a
+    wall down to 1.5 at ``CLEARANCE_CAP_M`` (see ``cost`` above)."""
+    return np.where(on_skeleton, np.float32(1.0), np.float32(3.5) - np.float32(2.0 / CLEARANCE_CAP_M) * clear).astype(np.float32)
 
 
 def _grow(box, other) -> None:

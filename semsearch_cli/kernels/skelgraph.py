@@ -850,7 +850,7 @@ class GraphSearch:
             return None
         g = self.graph
         if g.gen != self.gen:
-            raise RuntimeError("a skeleton-graph search's path asked for after another search")
+            raise RuntimeError("a skeleton-graph search's path asked for after another search or a repair")
         H, W = g.shape
         r0, c0 = self.source
         R, S, rpar = self._robot
