@@ -22,7 +22,7 @@ from .checkout import checkout_commit
 from .engine import ENGINE
 
 PACKAGE = Path(__file__).resolve().parent
-DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "scikit-image", "opencv-python-headless", "matplotlib", "pydantic")
+DEPENDENCIES = ("numpy", "scipy", "numba", "pandas", "opencv-python-headless", "matplotlib", "pydantic")
 
 
 # what a run does not execute: the report, the command line and its API (a typo fixed in a plot
