@@ -61,8 +61,7 @@ API = {
     "import_ros": ["map_file", "doors_file", "out", "options"],
     "import_kth": ["xml_file", "out", "options"],
 }
-DEPRECATED = [(planners, "PlanContext", "DoorContext"), (planners_base, "PlanContext", "DoorContext"),
-              (belief, "Belief", "DoorBelief"), (belief_doors, "Belief", "DoorBelief")]
+REMOVED = [(planners, "PlanContext"), (planners_base, "PlanContext"), (belief, "Belief"), (belief_doors, "Belief")]  # 0.3.0
 
 
 def test_the_planner_api_names_are_pinned():
@@ -85,57 +84,27 @@ def test_the_version_follows_semantic_versioning():
     assert m and (int(m.group(1)), int(m.group(2))) >= (0, 2)
 
 
-@pytest.mark.parametrize("module, old, new", DEPRECATED)
-def test_a_renamed_name_still_works_with_a_warning_naming_its_replacement(module, old, new):
-    with pytest.warns(DeprecationWarning, match=rf"{module.__name__}\.{old} is deprecated since semsearch 0\.2\.0 .*{new}"):
-        obj = getattr(module, old)
-    assert obj is getattr(module, new)
-    with pytest.raises(AttributeError):
-        getattr(module, "NoSuchName")
+@pytest.mark.parametrize("module, old", REMOVED)
+def test_the_names_deprecated_in_0_2_0_are_gone(module, old):
+    """PlanContext and Belief warned through 0.2.0 and were removed in 0.3.0 (CHANGELOG "Removed")."""
+    assert not hasattr(module, old)
 
 
 OLD_PLANNER = '''
 """A door planner written against the API before 0.2.0: Planner with choose(ctx, cands)."""
-from semsearch_cli.planners import Decision, Planner, PlanContext, register_planner
+from semsearch_cli.planners import Decision, Planner, register_planner
 
 
 @register_planner("first_candidate")
 class FirstCandidate(Planner):
-    def choose(self, ctx: PlanContext, cands):
+    def choose(self, ctx, cands):
         if len(cands) == 0:
             return None
         return Decision(int(cands.rows[0]), int(cands.cols[0]))
 '''
 
 
-def test_a_door_planner_written_against_the_old_api_runs_with_a_warning(tmp_path):
-    # in a process of its own: the planner it registers must not join this process's registry
-    (tmp_path / "old_planner.py").write_text(OLD_PLANNER)
-    code = textwrap.dedent(f"""
-        import warnings
-        from pathlib import Path
-        from semsearch_cli.config import PlannerSpec
-        from semsearch_cli.planners import PLANNERS, DoorPlanner, expand_variants
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            expand_variants([PlannerSpec(name="first_candidate", module="old_planner.py")], task="doors", base=Path({str(tmp_path)!r}))
-        cls = PLANNERS["first_candidate"]
-        print(issubclass(cls, DoorPlanner), cls.task, cls.__name__)
-        for w in caught:
-            print(w.category.__name__, w.message)
-    """)
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert res.returncode == 0, res.stderr
-    first, *warned = res.stdout.splitlines()
-    assert first == "True doors FirstCandidate"
-    words = " ".join(warned)
-    # (a package's __getattr__ is asked twice by `from package import NAME`: the same warning twice, shown once)
-    assert all(w.startswith("DeprecationWarning") for w in warned) and len(set(warned)) == 2
-    assert "semsearch_cli.planners.PlanContext is deprecated since semsearch 0.2.0" in words and "use semsearch_cli.planners.DoorContext" in words
-    assert "FirstCandidate) is deprecated since semsearch 0.2.0 and will be removed in 0.3.0: subclass DoorPlanner" in words
-
-
-def test_the_command_line_runs_an_old_planner_and_shows_its_warning(tmp_path, demo_dir):
+def test_the_command_line_refuses_a_planner_written_against_the_api_removed_in_0_3_0(tmp_path, demo_dir):
     (tmp_path / "old_planner.py").write_text(OLD_PLANNER)
     sc = yaml.safe_load((demo_dir / "scenario.yaml").read_text())
     sc["map"]["image"] = str(demo_dir / sc["map"]["image"])
@@ -146,6 +115,9 @@ def test_the_command_line_runs_an_old_planner_and_shows_its_warning(tmp_path, de
     (tmp_path / "old.yaml").write_text(yaml.safe_dump(sc))
     res = subprocess.run([sys.executable, "-c", "from semsearch_cli.cli import main; main()", "run", str(tmp_path / "old.yaml"),
                           "--workers", "1", "--out", str(tmp_path / "out")], capture_output=True, text=True)
-    assert res.returncode == 0, res.stderr
-    assert "DeprecationWarning" in res.stderr and "subclass DoorPlanner" in res.stderr
-    assert "first_candidate" in (tmp_path / "out" / "runs.csv").read_text()
+    assert res.returncode == 2, res.stderr
+    assert "Traceback" not in res.stderr
+    words = " ".join(res.stderr.split())
+    assert "FirstCandidate answers no kind of search" in words and "removed in 0.3.0" in words and "subclass DoorPlanner" in words
+    assert "old_planner.py" in words
+    assert not (tmp_path / "out" / "runs.csv").exists()

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .. import deprecation
 from ..config import BeliefSpec
 from ..geometry import GridFrame, wrap_angle
 from ..kernels.grid import GridSearch, branch_walk, local_reach, mark_visited, nearest_visited, segment_roots, widest_of_groups
@@ -721,9 +720,3 @@ def _empty() -> Candidates:
     z = np.zeros(0, np.int64)
     return Candidates(z, z.copy(), np.zeros(0), z.copy(), z.copy())
 
-
-DEPRECATED = {"Belief": ("semsearch_cli.belief.DoorBelief", DoorBelief)}  # 0.2.0 -> removed in 0.3.0
-
-
-def __getattr__(name: str):
-    return deprecation.alias(__name__, name, DEPRECATED)

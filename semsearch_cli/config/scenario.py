@@ -35,7 +35,7 @@ class Scenario(Strict):
     with that value as its default. A section the kind does not take is refused, naming it.
 
     ``retired``: sections the kind's model took in 0.2.0 without using them; given, each is
-    ignored with a DeprecationWarning (refused from 0.3.0), and counted in the fingerprint as 0.2.0
+    ignored with a DeprecationWarning (refused from 0.4.0), and counted in the fingerprint as 0.2.0
     counted it (a results folder of 0.2.0 resumes)."""
 
     section: ClassVar[str] = ""  # the field whose presence makes a document this kind

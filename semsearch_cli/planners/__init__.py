@@ -7,8 +7,6 @@ and :func:`register_planner` (door search), :class:`ObjectPlanner` and :class:`O
 search).
 """
 
-from .. import deprecation
-from . import base
 from .base import (PLANNERS, Decision, DoorContext, DoorPlanner, NoParams, Planner, Told, Variant, code_of, expand_variants,
                    load_entry_points, load_planner_file, planner_class, register_planner)
 from .doors import advantage, bvp, draft, greedy, learned, nsos, numbering, oracle, walls  # noqa: F401  (registration side effect)
@@ -18,9 +16,3 @@ from .objects import ObjectContext, ObjectPlanner, LsosParams, lsos_goals
 
 __all__ = ["PLANNERS", "Decision", "DoorContext", "DoorPlanner", "Goal", "IndirectContext", "IndirectPlanner", "LsosParams", "NoParams", "ObjectContext", "ObjectPlanner", "Planner",
            "Told", "Variant", "code_of", "expand_variants", "load_entry_points", "load_planner_file", "lsos_goals", "planner_class", "register_planner"]
-
-DEPRECATED = base.DEPRECATED  # PlanContext (0.2.0 -> removed in 0.3.0)
-
-
-def __getattr__(name: str):
-    return deprecation.alias(__name__, name, DEPRECATED)

@@ -37,7 +37,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..belief import DoorBelief, Candidates
-from .. import __version__, deprecation
+from .. import __version__
 from ..credentials import WHERE_THE_KEY_GOES, credential_in, looks_like_key, redact, url_credential
 from ..errors import PlannerError, ScenarioError, did_you_mean
 from ..files import user_file
@@ -288,10 +288,10 @@ def register_planner(name: str):
 
     def deco(cls):
         if isinstance(cls, type) and issubclass(cls, Planner) and not cls.task:
-            if not callable(getattr(cls, "choose", None)):
-                raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search; subclass DoorPlanner (door "
-                                "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
-            cls = _as_door_planner(cls)
+            old = (" (a Planner with choose(ctx, cands) was the door planner's API until 0.1.0, run with a warning in "
+                   "0.2.0, removed in 0.3.0)") if callable(getattr(cls, "choose", None)) else ""
+            raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search{old}; subclass DoorPlanner (door "
+                            "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
         if isinstance(cls, type) and issubclass(cls, Planner):
             check_planner_class(cls)
         return PLANNERS.add(name, cls)
@@ -482,18 +482,6 @@ def _raised_in(exc: BaseException, file: str) -> str:
     if _same_file(last.filename, file) or last.filename.startswith(not_users):
         return ""
     return f" (raised at line {last.lineno} of {last.filename})"
-
-
-def _as_door_planner(cls: type[Planner]) -> type[DoorPlanner]:
-    """A ``Planner`` subclass with ``choose(ctx, cands)``, written against the API before 0.2.0
-    (when ``Planner`` was the door planner's protocol), as a :class:`DoorPlanner`: the same class
-    with DoorPlanner among its bases, under the same name and module, with a DeprecationWarning.
-    Deprecated in 0.2.0; refused from 0.3.0."""
-    deprecation.warn(f"a door planner that subclasses Planner ({cls.__qualname__})",
-                     "subclass DoorPlanner (from semsearch_cli.planners import DoorPlanner); Planner is the base of "
-                     "every kind of planner", stacklevel=4)
-    return type(cls.__name__, (cls, DoorPlanner), {"__module__": cls.__module__, "__qualname__": cls.__qualname__,
-                                                  "__doc__": cls.__doc__})
 
 
 ENTRY_POINT_GROUP = "semsearch.planners"
@@ -963,9 +951,3 @@ def code_of(variant: Variant) -> dict:
     out["hash"] = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     return out
 
-
-DEPRECATED = {"PlanContext": ("semsearch_cli.planners.DoorContext", DoorContext)}  # 0.2.0 -> removed in 0.3.0
-
-
-def __getattr__(name: str):
-    return deprecation.alias(__name__, name, DEPRECATED)
