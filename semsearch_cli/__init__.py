@@ -9,4 +9,4 @@ import os
 # import it; a value the user set is kept.
 os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
-__version__ = "0.3.0.dev0"
+__version__ = "0.3.0"
