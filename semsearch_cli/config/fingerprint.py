@@ -14,6 +14,7 @@ a deprecation) and that a new one moves no fingerprint.
 
 from __future__ import annotations
 
+import functools
 import types
 import typing
 
@@ -103,6 +104,19 @@ def schema_paths(built_in: bool = True) -> set[str]:
 _ABSENT = object()
 
 
+@functools.lru_cache(maxsize=8)
+def _parents(known: frozenset) -> tuple[frozenset, frozenset]:
+    """(the paths with fields under them, the paths that are mappings of models) among ``known``."""
+    nested, mappings = set(), set()
+    for f in known:
+        for i, ch in enumerate(f):
+            if ch in ".[{":
+                nested.add(f[:i])
+                if ch == "{":
+                    mappings.add(f[:i])
+    return frozenset(nested), frozenset(mappings)
+
+
 def drop_new_defaults(doc, set_away, known: frozenset = FINGERPRINTED, path: str = "", mapping: bool = False):
     """``doc`` (a scenario's canonical form, as JSON) without the fields outside ``known`` that
     ``set_away`` (the same scenario dumped without its defaults) does not hold: the fields added
@@ -122,9 +136,10 @@ def drop_new_defaults(doc, set_away, known: frozenset = FINGERPRINTED, path: str
         sub = f"{path}.{k}" if path else k
         if sub not in known and away is _ABSENT:
             continue
-        if sub in known and not any(f.startswith((sub + ".", sub + "[]", sub + "{}")) for f in known):
+        nested, mappings = _parents(known)
+        if sub in known and sub not in nested:
             out[k] = v  # a field of its own (a number, a list or a mapping of plain values): whole
-        elif isinstance(v, dict) and any(f.startswith(sub + "{}") for f in known):
+        elif isinstance(v, dict) and sub in mappings:
             out[k] = drop_new_defaults(v, away, known, sub + "{}", mapping=True)
         else:
             out[k] = drop_new_defaults(v, away, known, sub)
