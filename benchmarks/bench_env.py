@@ -1,7 +1,7 @@
 """Steps per second of the Gymnasium environments, with Minigrid (and IR-SIM, when installed) timed
 beside them in the same run.
 
-    pip install 'semsearch[gym]' minigrid     # irsim-x too, for its column
+    pip install '.[benchmarks]'     # gymnasium, minigrid and irsim-x (pyproject's benchmarks extra)
     python benchmarks/bench_env.py [--steps 20000] [--repeat 5] [--md FILE]
 
 One process, random actions (``action_space.sample()``; macro actions drawn among the valid ones
@@ -15,7 +15,7 @@ same run, since this machine's speed varies from day to day.
 - semsearch macro: the same in the macro mode (a step is a re-plan: about a metre of travel, the
   skeleton and candidates refreshed);
 - Minigrid: ``MiniGrid-FourRooms-v0``;
-- IR-SIM (``pip install irsim-x``): a differential robot with a 181-beam, 10 m lidar on the Hotel
+- IR-SIM (irsim-x, in the benchmarks extra): a differential robot with a 181-beam, 10 m lidar on the Hotel
   map (the PNG at its 0.1 m cells), ``env.step()`` driving a wanderer that keeps moving.
 """
 
@@ -113,7 +113,7 @@ def main() -> int:
         import minigrid  # noqa: F401
         cases["Minigrid FourRooms"] = (lambda: gym.make("MiniGrid-FourRooms-v0"), a.steps, False)
     except ImportError:
-        print("minigrid is not installed (pip install minigrid): its column is left out", file=sys.stderr)
+        print("minigrid is not installed (pip install '.[benchmarks]'): its column is left out", file=sys.stderr)
     rates: dict[str, list[float]] = {k: [] for k in cases}
     envs = {k: make() for k, (make, _, _) in cases.items()}
     with tempfile.TemporaryDirectory() as tmp:

@@ -377,3 +377,12 @@ def test_the_indirect_replay_has_a_key(monkeypatch, tmp_path):
     labels = [t.get_text() for t in figs[0].legends[0].get_texts()]
     assert labels == ["path", "robot", "objects seen", "goal", "A, the target"]
     plt.close(figs[0])
+
+
+def test_the_swept_value_comes_from_the_rows_params_not_the_label():
+    """A row's params hold its planner's parameters; the label is only a name (a --param sweep or a
+    label of one's own need not spell alpha): params {"alpha": 0.8} under the label "nsos" is 0.8."""
+    runs = pd.DataFrame({"planner": ["nsos", "nsos[alpha=1.0]", "nsos[alpha=0.9]", "greedy"],
+                         "params": ['{"alpha": 0.8}', '{"alpha": 1.0}', "{}", "{}"]})
+    assert swept_values(runs) == [0.8, 0.9, 1.0]  # "{}": nsos's default, 0.9
+    assert swept_values(runs.drop(columns="params")) == [0.9, 1.0]  # no params: the labels ("nsos": the default)

@@ -34,7 +34,7 @@ from ..report.indirect import PAPER_SCALES, PAPER_TABLE3, claims_table
 from ..report.stats import mean_ci, rate_ci, ratio_ci
 from ..runner import read_runs
 from .run import BENCH_FILE, is_bench, read_bench
-from .suites import PUBLISHED
+from .suites import is_official
 
 BASELINES = {"doors": "nsos[alpha=0.9]", "objects": "lsos"}  # each kind's planner of the thesis, the board's reference
 # per kind, the gap every planner's share is measured on: door search's from nearest-frontier to
@@ -127,8 +127,8 @@ def load(folders) -> pd.DataFrame:
             r = r[(r["stage"] == "") & (r["floor"].astype(str) == fid) & (r["numbering"].astype(str) == meta["numbering"])]
             if not len(r):
                 continue
-            official = PUBLISHED.get((str(meta["suite"]), str(meta["split"])))
-            r = r.assign(verdict=verdict, official=r["suite_hash"].astype(str) == str(official), folder=str(folder),
+            official = r["suite_hash"].astype(str).map(lambda h: is_official(str(meta["suite"]), str(meta["split"]), h))
+            r = r.assign(verdict=verdict, official=official.astype(bool), folder=str(folder),
                          unit=r["floor"].astype(str) + "/" + r["episode"].astype(str),
                          convention=str((info or {}).get("convention", fid)),
                          predictability=float((info or {}).get("predictability") or np.nan),

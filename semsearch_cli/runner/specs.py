@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config import Scenario, all_fields, load_scenario, parse_scenario
+from ..config.fingerprint import FINGERPRINTED, drop_new_defaults
 from ..engine import ENGINE
 from ..errors import ScenarioError
 from ..files import safe_chars
@@ -110,24 +111,31 @@ class Loaded:
         (planners, goals, seeds, output folder), with every file it names (map image, doors,
         logs, ...) standing for its bytes, not its path (a scenario moved with its files keeps
         its fingerprint), and the simulator engine (:mod:`semsearch_cli.engine`) from engine 2 on.
-        Rows carry it, and a batch resumes only rows that match."""
+        A field added after 0.3.0 enters only when the scenario sets it away from its default
+        (:mod:`semsearch_cli.config.fingerprint`), so a new field orphans no results folder. Rows
+        carry it, and a batch resumes only rows that match."""
         if self._fingerprint is None:
-            # one canonical form whatever the kind's model: every kind's sections (null where this
-            # kind has none), and ``kind`` only as written (null when the sections said it)
-            # (semsearch's own kinds' fields: a kind another package adds moves no other kind's fingerprint)
-            d = dict.fromkeys(all_fields(built_in=True)) | self.sc._retired | self.sc.model_dump(mode="json")
-            if "kind" not in self.sc.model_fields_set:
-                d["kind"] = None
-            for key in ("planners", "goals"):  # the name stays: rows of a renamed copy are not resumed under the old name
-                d.pop(key, None)
-            for key in ("seeds", "out", "run_time_limit"):
-                d["experiment"].pop(key, None)
-            d = files_by_content(d, self.path.parent)
-            if ENGINE > 1:  # engine 1's fingerprints are as they always were; a later engine's differ from them
-                d["engine"] = ENGINE
-            h = hashlib.sha256(json.dumps(d, sort_keys=True).encode())
+            h = hashlib.sha256(json.dumps(self.canonical(), sort_keys=True).encode())
             self._fingerprint = h.hexdigest()[:16]
         return self._fingerprint
+
+    def canonical(self, known: frozenset = FINGERPRINTED) -> dict:
+        """What the fingerprint hashes (``known``: the fields that enter even at their defaults)."""
+        # one canonical form whatever the kind's model: every kind's sections (null where this
+        # kind has none), and ``kind`` only as written (null when the sections said it)
+        # (semsearch's own kinds' fields: a kind another package adds moves no other kind's fingerprint)
+        d = dict.fromkeys(all_fields(built_in=True)) | self.sc._retired | self.sc.model_dump(mode="json")
+        d = drop_new_defaults(d, self.sc.model_dump(mode="json", exclude_defaults=True), known)
+        if "kind" not in self.sc.model_fields_set:
+            d["kind"] = None
+        for key in ("planners", "goals"):  # the name stays: rows of a renamed copy are not resumed under the old name
+            d.pop(key, None)
+        for key in ("seeds", "out", "run_time_limit"):
+            d["experiment"].pop(key, None)
+        d = files_by_content(d, self.path.parent)
+        if ENGINE > 1:  # engine 1's fingerprints are as they always were; a later engine's differ from them
+            d["engine"] = ENGINE
+        return d
 
     def with_planners(self, specs) -> "Loaded":
         """The same scenario with other planner entries (checked for this kind of search)."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 
 import inspect
+import json
 from pathlib import Path
 
 import numpy as np
@@ -33,13 +34,19 @@ _HORIZONTAL = {"orientation": "horizontal"} if "orientation" in inspect.signatur
 def swept_rows(runs: pd.DataFrame) -> tuple[type | None, pd.DataFrame]:
     """(the planner class that sweeps a parameter, its rows with the parameter's value in column
     ``swept``): the first swept planner in report order (:attr:`Planner.swept`; nsos and alpha),
-    the value read from each row's label (:func:`~semsearch_cli.planners.base.swept_value`)."""
+    the value each row's ``params`` holds (the parameter's default when they do not set it); from
+    the row's label (:func:`~semsearch_cli.planners.base.swept_value`) only for a table without
+    ``params``."""
     labels = runs["planner"].astype(str)
     for lab in planner_order(labels):
         cls = planner_named(lab)
         if cls is not None and cls.swept is not None:
             rows = runs[labels.map(lambda x: planner_named(x) is cls)].copy()
-            rows["swept"] = rows["planner"].astype(str).map(swept_value)
+            if "params" in rows:
+                default = float(cls.Params.model_fields[cls.swept].default)
+                rows["swept"] = [float(json.loads(str(p) or "{}").get(cls.swept, default)) for p in rows["params"]]
+            else:
+                rows["swept"] = rows["planner"].astype(str).map(swept_value)
             return cls, rows
     return None, runs.iloc[:0].assign(swept=pd.Series(dtype=float))
 
