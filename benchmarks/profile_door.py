@@ -13,16 +13,13 @@ import cProfile
 import io
 import pstats
 import sys
-import tempfile
 from pathlib import Path
 
 from output import emit
+from refmaps import hotel
 
 from semsearch_cli.planners import Variant
-from semsearch_cli.runner import Loaded
-from semsearch_cli.world.importers.mobilesim import import_mobilesim
 
-REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 # (phase, (file under semsearch_cli/, function) whose cumulative time is that phase's; a file
 # ending in / stands for every file under that folder; several pairs add up). A re-plan is the
 # door search's plan(), a generator (belief upkeep, candidates, the path; cProfile counts each
@@ -55,13 +52,9 @@ def main() -> int:
     ap.add_argument("--top", type=int, default=20)
     ap.add_argument("--md", type=Path)
     a = ap.parse_args()
-    if not REF.is_dir():
-        print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
+    L = hotel("semsearch-profile-")
+    if L is None:
         return 0
-    tmp = Path(tempfile.mkdtemp(prefix="semsearch-profile-"))
-    p, _ = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5,
-                            "hotel-reference")
-    L = Loaded.load(p)
     v = Variant(a.planner, (("alpha", a.alpha),) if a.planner == "nsos" else ())
     L.task.run(v, a.goal, 0)  # warm-up: numba's cache, imports
     prof = cProfile.Profile()

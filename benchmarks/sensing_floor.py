@@ -21,12 +21,12 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 from output import emit
+from refmaps import hotel
 
 from semsearch_cli.belief import DoorBelief
 from semsearch_cli.kernels.grid import local_reach
@@ -34,9 +34,7 @@ from semsearch_cli.kernels.raycast import cast_rays
 from semsearch_cli.planners import Variant
 from semsearch_cli.runner import Loaded
 from semsearch_cli.sensors.doors import DoorCamera, Laser
-from semsearch_cli.world.importers.mobilesim import import_mobilesim
 
-REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 PARTS = ("laser", "fold_scan", "cameras", "visit")
 
 
@@ -114,13 +112,9 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--md", type=Path)
     a = ap.parse_args()
-    if not REF.is_dir():
-        print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
+    L = hotel("semsearch-sensing-")
+    if L is None:
         return 0
-    tmp = Path(tempfile.mkdtemp(prefix="semsearch-sensing-"))
-    p, _ = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5,
-                            "hotel-reference")
-    L = Loaded.load(p)
     res = L.task.run(Variant("nsos", (("alpha", 0.9),)), 148, 0)
     frames = poses(res.path.astype(float))
     one_pass(L, frames)  # warm-up (numba cache)

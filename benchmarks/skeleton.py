@@ -13,21 +13,19 @@ from __future__ import annotations
 
 import argparse
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 from output import emit
+from refmaps import hotel
 from skimage.morphology import skeletonize
 
 from semsearch_cli.belief import doors as belief_doors
 from semsearch_cli.kernels.skeleton import Skeleton, deletion_table
 from semsearch_cli.planners import Variant
 from semsearch_cli.runner import Loaded
-from semsearch_cli.world.importers.mobilesim import import_mobilesim
 
-REF = Path(__file__).resolve().parents[2] / "shared" / "reference_maps"
 ENGINE1_MARGIN_M = 4.0  # engine 1 thinned the changed box and this much around it (semsearch 0.2)
 
 
@@ -71,13 +69,9 @@ def main() -> int:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--md", type=Path)
     a = ap.parse_args()
-    if not REF.is_dir():
-        print(f"skipped: the authors' reference maps are not at {REF} (../shared absent)")
+    loaded = hotel("semsearch-skeleton-")
+    if loaded is None:
         return 0
-    tmp = Path(tempfile.mkdtemp(prefix="semsearch-skeleton-"))
-    p, _ = import_mobilesim(REF / "hotel2.map", REF / "hotel2.doors", tmp / "hotel", 0.1, (46.0, 64.0), [76, 135, 148, 185], 2.5,
-                            "hotel-reference")
-    loaded = Loaded.load(p)
     rec = record(loaded, Variant("nsos", (("alpha", 0.9),)), 148)
     H, W = rec[0][1].shape
     m = int(np.ceil(ENGINE1_MARGIN_M / loaded.world.frame.res))
