@@ -8,7 +8,8 @@ import pytest
 import yaml
 
 from semsearch_cli import api, shipped
-from semsearch_cli.config.fingerprint import FINGERPRINTED, drop_new_defaults, schema_paths
+from semsearch_cli.config import KINDS
+from semsearch_cli.config.fingerprint import FINGERPRINTED, _models_in, drop_new_defaults, schema_paths
 from semsearch_cli.runner import Loaded
 
 # every shipped scenario's fingerprint on engine 2 (semsearch 0.3.0), before and after the rule
@@ -21,6 +22,35 @@ SHIPPED = {"demo": "34448576965adb4b", "hospital": "a353e5fd42377212", "hotel": 
 def test_the_shipped_scenarios_keep_their_fingerprints():
     assert sorted(shipped.names()) == sorted(SHIPPED)
     assert {n: Loaded.load(shipped.path(n)).fingerprint for n in SHIPPED} == SHIPPED
+
+
+# the fields added since 0.3.0 (outside FINGERPRINTED), each with its default: at that default a field
+# does not enter the fingerprint, so its default is part of the format (changing one means adding
+# the field to FINGERPRINTED, which moves every fingerprint)
+ADDED_SINCE = {}
+
+
+def test_the_fields_added_since_0_3_0_are_pinned_with_their_defaults():
+    def default(path):
+        """The default of the field at ``path`` in the first kind that has it (None: none has it)."""
+        parts = path.split(".")
+        for cls in KINDS.values():
+            model = cls
+            for i, part in enumerate(parts):
+                name = part.split("[")[0].split("{")[0]
+                if name not in model.model_fields:
+                    break
+                f = model.model_fields[name]
+                if i == len(parts) - 1:
+                    return f.get_default(call_default_factory=True)
+                sub = [m for _, m in _models_in(f.annotation)]
+                if not sub:
+                    break
+                model = sub[0]
+        return None
+
+    added = schema_paths() - FINGERPRINTED
+    assert {p: default(p) for p in added} == ADDED_SINCE
 
 
 def test_every_frozen_field_is_still_a_field():
@@ -67,3 +97,8 @@ def test_keys_of_a_mapping_are_data_and_new_fields_in_its_values_follow_the_rule
     lists = frozenset({"l", "l[].x"})
     assert drop_new_defaults({"l": [{"x": 1, "y": 0}, {"x": 2, "y": 3}]}, {"l": [{}, {"y": 3}]}, lists) == \
         {"l": [{"x": 1}, {"x": 2, "y": 3}]}
+
+
+def test_keys_of_a_mapping_inside_a_list_are_data_too():
+    known = frozenset({"a", "a[]{}", "a[]{}.x"})
+    assert drop_new_defaults({"a": [{"k": {"x": 1, "new": 0}}]}, {}, known) == {"a": [{"k": {"x": 1}}]}

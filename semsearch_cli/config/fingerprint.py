@@ -5,7 +5,11 @@ of a list, ``{}`` a value of a mapping) always enter, as they always did, so eve
 made before this rule is what it was. A field added since enters only when a scenario sets it away
 from its default: adding a field with a default moves no fingerprint and orphans no results
 folder, while a scenario that uses the new field gets a fingerprint of its own. A field of a kind
-another package adds follows the same rule: at its default, it does not enter.
+another package adds follows the same rule: at its default, it does not enter. So the default of a
+field outside the list is part of the format: changing it means adding the field to the list
+(which moves every fingerprint, as a changed default must); ``tests/test_fingerprint.py`` pins the
+fields added since 0.3.0 for that reason. (A new field whose default names a file counts that file
+by name only, at its default.)
 
 :func:`schema_paths` gives the paths of the kinds registered now; ``tests/test_fingerprint.py``
 checks that every path of :data:`FINGERPRINTED` is still among them (a field is removed only after
@@ -117,7 +121,7 @@ def _parents(known: frozenset) -> tuple[frozenset, frozenset]:
     return frozenset(nested), frozenset(mappings)
 
 
-def drop_new_defaults(doc, set_away, known: frozenset = FINGERPRINTED, path: str = "", mapping: bool = False):
+def drop_new_defaults(doc, set_away, known: frozenset = FINGERPRINTED, path: str = ""):
     """``doc`` (a scenario's canonical form, as JSON) without the fields outside ``known`` that
     ``set_away`` (the same scenario dumped without its defaults) does not hold: the fields added
     since :data:`FINGERPRINTED` that the scenario leaves at their defaults. A mapping's keys are
@@ -127,20 +131,16 @@ def drop_new_defaults(doc, set_away, known: frozenset = FINGERPRINTED, path: str
         return [drop_new_defaults(v, a, known, path + "[]") for v, a in zip(doc, away)]
     if not isinstance(doc, dict):
         return doc
+    nested, mappings = _parents(known)
+    if path in mappings:  # a mapping of models: its keys are data, its values models at path{}
+        return {k: drop_new_defaults(v, set_away.get(k, _ABSENT) if isinstance(set_away, dict) else _ABSENT, known, path + "{}")
+                for k, v in doc.items()}
     out = {}
     for k, v in doc.items():
         away = set_away.get(k, _ABSENT) if isinstance(set_away, dict) else _ABSENT
-        if mapping:
-            out[k] = drop_new_defaults(v, away, known, path)
-            continue
         sub = f"{path}.{k}" if path else k
         if sub not in known and away is _ABSENT:
             continue
-        nested, mappings = _parents(known)
-        if sub in known and sub not in nested:
-            out[k] = v  # a field of its own (a number, a list or a mapping of plain values): whole
-        elif isinstance(v, dict) and sub in mappings:
-            out[k] = drop_new_defaults(v, away, known, sub + "{}", mapping=True)
-        else:
-            out[k] = drop_new_defaults(v, away, known, sub)
+        # a field of its own (a number, a list or a mapping of plain values) enters whole
+        out[k] = v if sub in known and sub not in nested else drop_new_defaults(v, away, known, sub)
     return out

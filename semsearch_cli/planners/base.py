@@ -288,8 +288,8 @@ def register_planner(name: str):
 
     def deco(cls):
         if isinstance(cls, type) and issubclass(cls, Planner) and not cls.task:
-            old = (" (a Planner with choose(ctx, cands) was the door planner's API until 0.1.0, run with a warning in "
-                   "0.2.0, removed in 0.3.0)") if callable(getattr(cls, "choose", None)) else ""
+            old = (" (a Planner with choose(ctx, cands) was the door planner's API through 0.1.x, ran with a warning in "
+                   "0.2.x, removed in 0.3.0)") if callable(getattr(cls, "choose", None)) else ""
             raise TypeError(f"planner {name!r}: {cls.__name__} answers no kind of search{old}; subclass DoorPlanner (door "
                             "search), ObjectPlanner or IndirectPlanner (from semsearch_cli.planners)")
         if isinstance(cls, type) and issubclass(cls, Planner):

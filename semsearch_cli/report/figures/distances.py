@@ -44,7 +44,8 @@ def swept_rows(runs: pd.DataFrame) -> tuple[type | None, pd.DataFrame]:
             rows = runs[labels.map(lambda x: planner_named(x) is cls)].copy()
             if "params" in rows:
                 default = float(cls.Params.model_fields[cls.swept].default)
-                rows["swept"] = [float(json.loads(str(p) or "{}").get(cls.swept, default)) for p in rows["params"]]
+                rows["swept"] = [float(json.loads(p if isinstance(p, str) and p else "{}").get(cls.swept, default))
+                                 for p in rows["params"]]
             else:
                 rows["swept"] = rows["planner"].astype(str).map(swept_value)
             return cls, rows
