@@ -8,8 +8,7 @@ import pytest
 import yaml
 
 from semsearch_cli import api, shipped
-from semsearch_cli.config import KINDS
-from semsearch_cli.config.fingerprint import FINGERPRINTED, _models_in, drop_new_defaults, schema_paths
+from semsearch_cli.config.fingerprint import FINGERPRINTED, drop_new_defaults, schema_fields, schema_paths
 from semsearch_cli.runner import Loaded
 
 # every shipped scenario's fingerprint on engine 2 (semsearch 0.3.0), before and after the rule
@@ -31,26 +30,9 @@ ADDED_SINCE = {}
 
 
 def test_the_fields_added_since_0_3_0_are_pinned_with_their_defaults():
-    def default(path):
-        """The default of the field at ``path`` in the first kind that has it (None: none has it)."""
-        parts = path.split(".")
-        for cls in KINDS.values():
-            model = cls
-            for i, part in enumerate(parts):
-                name = part.split("[")[0].split("{")[0]
-                if name not in model.model_fields:
-                    break
-                f = model.model_fields[name]
-                if i == len(parts) - 1:
-                    return f.get_default(call_default_factory=True)
-                sub = [m for _, m in _models_in(f.annotation)]
-                if not sub:
-                    break
-                model = sub[0]
-        return None
-
-    added = schema_paths() - FINGERPRINTED
-    assert {p: default(p) for p in added} == ADDED_SINCE
+    fields = schema_fields()
+    added = set(fields) - FINGERPRINTED
+    assert {p: fields[p].get_default(call_default_factory=True) for p in added} == ADDED_SINCE
 
 
 def test_every_frozen_field_is_still_a_field():

@@ -84,16 +84,17 @@ def _models_in(annotation) -> list[tuple[str, type[BaseModel]]]:
     return []
 
 
-def schema_paths(built_in: bool = True) -> set[str]:
-    """The dotted path of every field of every kind's model, nested models' fields included
-    (``built_in``: semsearch's own kinds only)."""
-    out: set[str] = set()
+def schema_fields(built_in: bool = True) -> dict:
+    """Every field of every kind's model, nested models' fields included, by dotted path: its
+    pydantic ``FieldInfo`` (the first kind's, where kinds share a path; ``built_in``: semsearch's
+    own kinds only)."""
+    out: dict = {}
     seen: set = set()
 
     def walk(model: type[BaseModel], prefix: str) -> None:
         for name, f in model.model_fields.items():
             path = prefix + name
-            out.add(path)
+            out.setdefault(path, f)
             for step, sub in _models_in(f.annotation):
                 if (path + step, sub) not in seen:
                     seen.add((path + step, sub))
@@ -103,6 +104,11 @@ def schema_paths(built_in: bool = True) -> set[str]:
         if not built_in or cls.__module__.startswith("semsearch_cli."):
             walk(cls, "")
     return out
+
+
+def schema_paths(built_in: bool = True) -> set[str]:
+    """The dotted paths of :func:`schema_fields`."""
+    return set(schema_fields(built_in))
 
 
 _ABSENT = object()
