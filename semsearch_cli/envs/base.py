@@ -40,7 +40,7 @@ from ..config import load_scenario
 from .. import shipped as shipped_scenarios
 from ..errors import ScenarioError, did_you_mean
 from ..tasks import Task, build_task
-from ..tasks.decisions import DecisionPoint
+from ..tasks.decisions import Agent, DecisionPoint
 from ..tasks.episodes import Episode, episode_seed
 
 SUCCESS_BONUS = 100.0
@@ -205,7 +205,8 @@ def compass_step(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
     """The primitive actions of a robot on a grid, applied to ``st`` (a RobotState): 0-7 move
     ``step`` m towards ``COMPASS[a]``, the heading turning to it (a move into a cell where the
     robot's disk does not fit, ``cspace`` False, leaves it where it is); 8 and 9 turn 45 degrees
-    left and right. Counts the step and the trail; returns the metres moved."""
+    left and right. Returns the metres moved (the episode counts the step,
+    :meth:`~semsearch_cli.tasks.base.OpenEpisode.take`)."""
     moved = 0.0
     if a < 8:
         ang = a * math.pi / 4
@@ -216,9 +217,6 @@ def compass_step(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
             st.x, st.y, moved = x, y, step
     else:
         st.heading = (st.heading + (math.pi / 4 if a == 8 else -math.pi / 4) + math.pi) % TWO_PI - math.pi
-    st.distance += moved
-    st.steps += 1
-    st.trail.append((st.x, st.y))
     return moved
 
 
@@ -258,8 +256,12 @@ def compass_moves(step: float) -> str:
 
 class SearchEnv(gym.Env):
     """The part of every semsearch environment that is not the kind's: scenario, episodes,
-    reward, pickling. Subclasses set ``kind`` and implement ``_begin`` (start the drawn episode),
-    ``_act`` (one action: metres travelled, outcome or None) and ``_observe``."""
+    reward, pickling, and the episode itself: the batch's run opened with the agent in the
+    planner's seat (:meth:`_begin`), its primitive steps and its answers (:meth:`_act`), written
+    once. Subclasses set ``kind`` and the spaces and implement :meth:`_choice` (the macro action
+    as the kind's choice), :meth:`_motion` (a primitive action), :meth:`_observe` and
+    :meth:`action_masks`; :meth:`agent_attributes`, :meth:`_opened` and :meth:`_settle` when the
+    kind needs them."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
     kind = ""
@@ -317,6 +319,8 @@ class SearchEnv(gym.Env):
         self._reset_options = {"episode": k, "repeat": self.repeat}
         self._actions = []
         self._idle = 0
+        # the run's generator, as the batch seeds it (Task.open draws the same; an environment of
+        # a kind from before 0.4.0 that starts its episode itself reads it here)
         self.rng = np.random.default_rng(episode_seed(self.episode, self.repeat, self.task.sc.experiment.base_seed))
         self._begin()
         # what the robot travelled inside reset() (a sweep before the first choice) is charged to
@@ -373,11 +377,58 @@ class SearchEnv(gym.Env):
                 self.step(a)
         self._np_random, self._np_random_seed = state["np_random"], state["np_random_seed"]
 
+    # ---- the episode: the batch's own run, the agent in the planner's seat -------------------
+    def _begin(self) -> None:
+        """Open the drawn episode as the batch does (:meth:`~semsearch_cli.tasks.base.Task.open`:
+        the same start, generator and search), the agent in the planner's seat
+        (:class:`~semsearch_cli.tasks.decisions.Agent`, with the kind's :meth:`agent_attributes`),
+        and run it to the first decision the agent answers (macro) or only sense at the start
+        (primitive)."""
+        self.run = self.run_task.open(None, self.episode, self.repeat, seat=Agent("agent", **self.agent_attributes()))
+        self.state, self.rng = self.run.state, self.run.rng
+        self._opened()
+        if self.action_mode == "primitive":
+            self.outcome = self.run.start(primitive=True)
+        else:
+            self.outcome = self._settle(self.run.start())
+        self.search = self.run.search  # the kind's search (what an observation reads besides the robot's state)
+
+    def _act(self, action) -> tuple[float, str | None]:
+        """One action: a primitive move (the kind's :meth:`_motion`, then sensing) or the answer
+        to the pending decision (the kind's :meth:`_choice`); (metres travelled, outcome or None)."""
+        d0 = self.state.distance
+        if self.action_mode == "primitive":
+            out = self.run.take(lambda st: self._motion(st, action))
+        else:
+            out = self._settle(self.run.answer(self._choice(action)))
+        return self.state.distance - d0, out
+
+    @property
+    def run_task(self) -> Task:
+        """The task the episodes run in (the environment's own; door search: its budget)."""
+        return self.task
+
     # ---- the kind's ---------------------------------------------------------------------
-    def _begin(self) -> None:  # pragma: no cover
+    def agent_attributes(self) -> dict:
+        """The run attributes of the agent's seat that the kind's search reads (door search:
+        ``replan_on_signs``)."""
+        return {}
+
+    def _opened(self) -> None:
+        """The episode is open (``self.run``), not started: what the kind sets up for it."""
+
+    def _settle(self, point) -> str | None:
+        """The run from ``point`` (a decision point, or the outcome) to the next decision the agent
+        answers: the outcome, or None. A kind may answer some points itself (door search: one with
+        no frontier target has one answer)."""
+        return ended(point)
+
+    def _choice(self, action: int):  # pragma: no cover
+        """The kind's choice that the (checked) macro action names."""
         raise NotImplementedError
 
-    def _act(self, action) -> tuple[float, str | None]:  # pragma: no cover
+    def _motion(self, st, action: int) -> float:  # pragma: no cover
+        """Move ``st`` by the primitive action; the metres moved (the step is counted after)."""
         raise NotImplementedError
 
     def _observe(self):  # pragma: no cover

@@ -62,9 +62,7 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..planners import Decision
-from ..tasks.decisions import DecisionPoint, StandIn
-from ..tasks.doors import DoorSearch
-from ..tasks.loop import Session
+from ..tasks.decisions import DecisionPoint
 from ..world.labels import parse_label
 from .base import (BIG, SearchEnv, box, check_flag, check_number, clip_text, compass_moves, compass_step, text_space, window)
 from ..planners.text import FRAME_TEXT, answer_line, deg
@@ -133,29 +131,24 @@ class DoorSearchEnv(SearchEnv):
     def step_limit(self) -> int:
         return self.task.max_steps(self.budget)
 
-    # ---- episode ----------------------------------------------------------------------
-    def _begin(self) -> None:
-        t, ep = self.task, self.episode
-        self.state = st = t.start_state(ep, self.rng)
-        st.belief = t.new_belief()
-        # the agent in the planner's seat: named in the checks of its choices, with the re-plan cadence
-        self.search = DoorSearch(t, StandIn("agent", {"replan_on_signs": self.replan_on_signs}), ep.goal, self.rng)
-        self.goal_label = parse_label(ep.goal)
-        self.decision = None
-        if self.action_mode == "macro":
-            self.session = Session(self.search, st, self.step_m, self.budget, self.step_limit)
-            self.outcome = self._to_choice(self.session.start())
-        else:
-            found, _ = self.search.sense(st)
-            self.search.update(st)
-            self.outcome = "found" if found else None
+    @property
+    def run_task(self):
+        return self.task if self.max_distance is None else self.task.with_budget(self.max_distance)
 
-    def _to_choice(self, point):
+    # ---- episode ----------------------------------------------------------------------
+    def agent_attributes(self) -> dict:
+        return {"replan_on_signs": self.replan_on_signs}  # the re-plan cadence the agent asks for
+
+    def _opened(self) -> None:
+        self.goal_label = parse_label(self.episode.goal)
+        self.decision = None
+
+    def _settle(self, point):
         """The episode from a decision point to the next one that offers the agent a choice (one
         with no frontier candidate has one answer, the sweep, and is answered so), or to its end;
         returns the outcome, or None."""
         while isinstance(point, DecisionPoint) and len(point.choices) == 0:
-            point = self.session.answer(None)
+            point = self.run.answer(None)
         if not isinstance(point, DecisionPoint):
             self.decision = None
             return point
@@ -169,36 +162,19 @@ class DoorSearchEnv(SearchEnv):
         d = np.hypot(xs - self.state.x, ys - self.state.y)
         self.decision, self.slots = (ctx, cands), np.argsort(d, kind="stable")[:self.K]
 
-    def _act(self, action):
-        st = self.state
-        d0 = st.distance
-        a = action  # an int of the action space (SearchEnv.step checked it)
-        if self.action_mode == "primitive":
-            return self._primitive(a), self._primitive_outcome()
+    def _choice(self, a: int):
+        """Slot ``a``'s candidate; the sweep action (or an empty slot, which the mask forbids):
+        None, look at the nearest wall face not read yet. A candidate with no path is taken out
+        and the agent asked again (travelling nothing), as the planner is in the batch; sweeps
+        on the way travel too."""
         cands = self.decision[1]
-        choice = None  # the sweep: look at the nearest wall face not read yet
         if 0 <= a < len(self.slots):
             j = int(self.slots[a])
-            choice = Decision(int(cands.rows[j]), int(cands.cols[j]))
-        # a candidate with no path is taken out and the agent asked again (travelling nothing), as
-        # the planner is in the batch; sweeps on the way travel too
-        out = self._to_choice(self.session.answer(choice))
-        return st.distance - d0, out
-
-    def _primitive(self, a: int) -> float:
-        st = self.state
-        moved = compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
-        self._found, _ = self.search.sense(st)
-        self.search.update(st)
-        return moved
-
-    def _primitive_outcome(self):
-        st = self.state
-        if self._found:
-            return "found"
-        if st.distance >= self.budget or st.steps >= self.step_limit:
-            return "budget"
+            return Decision(int(cands.rows[j]), int(cands.cols[j]))
         return None
+
+    def _motion(self, st, a: int) -> float:
+        return compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
 
     # ---- what the agent sees ----------------------------------------------------------
     def action_masks(self) -> np.ndarray:

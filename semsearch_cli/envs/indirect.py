@@ -49,10 +49,7 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..planners import Goal
 from ..planners.indirect import Lattice
-from ..tasks.indirect import IndirectSearch
-from ..tasks.decisions import StandIn
-from ..tasks.loop import Session
-from .base import (BIG, TWO_PI, SearchEnv, box, check_choice, check_flag, check_number, clip_text, ended, text_space)
+from .base import (BIG, TWO_PI, SearchEnv, box, check_choice, check_flag, check_number, clip_text, text_space)
 from ..planners.text import indirect_fields, lattice_choices
 
 class IndirectSearchEnv(SearchEnv):
@@ -84,52 +81,36 @@ class IndirectSearchEnv(SearchEnv):
         self.action_space = gym.spaces.Discrete(self.N * 8 if action_mode == "macro" else 4)
         self.observation_space = gym.spaces.Dict(spaces) if observation_mode == "dict" else text_space()
 
-    def _begin(self) -> None:
-        t, ep = self.task, self.episode
-        self.grid = t.grids[ep.room]
-        # the agent in the planner's seat: the map's kind, and re-plans on detections too
-        self.agent = StandIn("agent", {"masks": self.masks, "negative": self.negative, "uses_map": True,
-                                       "replan_on_detection": True})
-        self.search = IndirectSearch(t, self.grid, self.agent, float(ep.goal), self.rng)
-        self.state = st = t.start_state(ep, self.rng)
-        st.belief = self.search.new_belief()
-        self.max_steps = int(round(t.spec.time_limit * t.spec.camera.fps))
+    def agent_attributes(self) -> dict:
+        # the map's kind, and re-plans on detections too
+        return {"masks": self.masks, "negative": self.negative, "uses_map": True, "replan_on_detection": True}
+
+    def _opened(self) -> None:
+        self.grid = self.task.grids[self.episode.room]
         self.lattice_poses = Lattice.over(self.grid.frame, self.grid.stand, self.grid.room.size, self.lattice)
         self.standable, self.points = self.lattice_poses.standable, self.lattice_poses.points
-        if self.action_mode == "macro":
-            self.session = Session(self.search, st, 0.0, math.inf, self.max_steps, move=self.search.move)
-            self.outcome = ended(self.session.start())
-        else:
-            found, _ = self.search.sense(st)
-            self.search.update(st)
-            self.outcome = "found" if found else None
 
-    def _act(self, action):
-        st = self.state
-        d0 = st.distance
-        a = action  # an int of the action space (SearchEnv.step checked it)
-        if self.action_mode == "primitive":
-            spec = self.task.spec
-            dt = 1.0 / spec.camera.fps
-            if a == 0:
-                x, y = st.x + spec.robot.speed * dt * math.cos(st.heading), st.y + spec.robot.speed * dt * math.sin(st.heading)
-                _, _, r, c = self.grid.frame.point_to_cell(x, y)
-                H, W = self.grid.stand.shape
-                if 0 <= r < H and 0 <= c < W and self.grid.stand[r, c]:
-                    st.distance += math.hypot(x - st.x, y - st.y)
-                    st.x, st.y = float(x), float(y)
-            elif a in (1, 2):
-                turn = (1 if a == 1 else -1) * math.radians(spec.robot.turn_rate) * dt
-                st.heading = (st.heading + turn + math.pi) % TWO_PI - math.pi
-            st.steps += 1
-            st.trail.append((st.x, st.y))
-            found, _ = self.search.sense(st)
-            self.search.update(st)
-            return st.distance - d0, "found" if found else "budget" if st.steps >= self.max_steps else None
+    def _choice(self, a: int):
         x, y, heading = self.lattice_poses.pose(a)  # a point the robot cannot stand on: the nearest that it can
-        goal = Goal(x, y, heading, {"action": a})
-        out = ended(self.session.answer(goal))
-        return st.distance - d0, out
+        return Goal(x, y, heading, {"action": a})
+
+    def _motion(self, st, a: int) -> float:
+        """0: drive one frame's distance along the heading (not off the standing cells); 1, 2:
+        turn one frame's angle left, right; 3: wait."""
+        spec = self.task.spec
+        dt = 1.0 / spec.camera.fps
+        if a == 0:
+            x, y = st.x + spec.robot.speed * dt * math.cos(st.heading), st.y + spec.robot.speed * dt * math.sin(st.heading)
+            _, _, r, c = self.grid.frame.point_to_cell(x, y)
+            H, W = self.grid.stand.shape
+            if 0 <= r < H and 0 <= c < W and self.grid.stand[r, c]:
+                moved = math.hypot(x - st.x, y - st.y)
+                st.x, st.y = float(x), float(y)
+                return moved
+        elif a in (1, 2):
+            turn = (1 if a == 1 else -1) * math.radians(spec.robot.turn_rate) * dt
+            st.heading = (st.heading + turn + math.pi) % TWO_PI - math.pi
+        return 0.0
 
     def action_masks(self) -> np.ndarray:
         """(action_space.n,) bool. Macro: every heading of the lattice points the robot can stand

@@ -39,11 +39,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..planners import ObjectContext
-from ..sensors import PlaceCamera
-from ..tasks.loop import Session
-from ..tasks.objects import ObjectSearch
-from .base import (BIG, SearchEnv, box, clip_text, compass_moves, compass_step, ended, text_space)
+from .base import (BIG, SearchEnv, box, clip_text, compass_moves, compass_step, text_space)
 from ..planners.text import object_fields, place_history
 
 
@@ -68,44 +64,30 @@ class ObjectSearchEnv(SearchEnv):
         self.observation_space = gym.spaces.Dict(spaces) if observation_mode == "dict" else text_space()
         self._cspace = t.world.cspace
 
-    def _begin(self) -> None:
-        t, ep = self.task, self.episode
-        req = t.request(ep.goal)
-        self.request = req
-        self.state = st = t.start_state(ep, self.rng)
-        instances = t.request_instances(req)
-        camera = PlaceCamera(t.world, t.spec.camera, t.places, t.facing, instances)
-        log = t.logs[req.case]
-        self.ctx = ObjectContext(t.world.frame, t.known, t.places, list(t.route), t.world.start_xy, req.cls, req.hour, log, self.rng)
-        self.search = ObjectSearch(t, None, req.cls, instances, camera, self.ctx, self.rng)  # the agent answers
-        self.search.planner_name = "agent"
-        self.history = place_history(log, req.cls, req.hour, self.names)
-        if self.action_mode == "macro":
-            self.session = Session(self.search, st, self.step_m, t.sc.experiment.max_distance, t.max_steps())
-            self.outcome = ended(self.session.start())
-        else:
-            self.outcome = "found" if self.search.sense(st)[0] else None
+    def _opened(self) -> None:
+        t = self.task
+        self.request = req = t.request(self.episode.goal)
+        self.history = place_history(t.logs[req.case], req.cls, req.hour, self.names)
 
-    def _act(self, action):
-        st = self.state
-        d0 = st.distance
-        a = action  # an int of the action space (SearchEnv.step checked it)
-        if self.action_mode == "primitive":
-            moved = compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
-            found = self.search.sense(st)[0]
-            e = self.task.sc.experiment
-            budget = st.distance >= e.max_distance or st.steps >= self.task.max_steps()
-            return moved, "found" if found else "budget" if budget else None
-        # the place, driven to on the recorded map, looked around on arrival; a place with no path,
-        # or the one the robot stands at, travels nothing and asks again, as a planner's target does
+    @property
+    def ctx(self):
+        """The search's :class:`~semsearch_cli.planners.ObjectContext` (the places seen so far)."""
+        return self.search.ctx
+
+    def _choice(self, a: int):
+        """Place ``a``, driven to on the recorded map, looked around on arrival; a place with no
+        path, or the one the robot stands at, travels nothing and asks again, as a planner's
+        target does."""
         x, y = self.task.places[self.names[a]]
-        out = ended(self.session.answer((x, y, {"place": self.names[a]})))
-        return st.distance - d0, out
+        return x, y, {"place": self.names[a]}
+
+    def _motion(self, st, a: int) -> float:
+        return compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
 
     def action_masks(self) -> np.ndarray:
         """(action_space.n,) bool. Macro: every place but the one the robot has just looked around
         at (choosing it again would travel nothing and see nothing new); primitive: every action."""
-        point = self.session.point if self.action_mode == "macro" else None
+        point = self.run.point if self.action_mode == "macro" else None
         return point.mask.copy() if point is not None else np.ones(self.action_space.n, bool)
 
     def _places(self) -> np.ndarray:

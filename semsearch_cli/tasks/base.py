@@ -11,6 +11,7 @@ scenario is.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import time
@@ -21,38 +22,18 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..config import Scenario
+from ..deprecation import warn
 from ..kernels.grid import dijkstra
-from ..errors import PlannerError, ScenarioError
+from ..errors import BudgetSpent, PlannerError, ScenarioError
 from ..metrics import run_row
 from ..registry import Registry
 from ..navigation import NAVIGATORS
 from ..planners import Variant, expand_variants
 from ..world.ground_truth import World, build_world
-from .decisions import Seat, ask
+from .decisions import DecisionPoint, Seat, ask
+from .loop import Session, answer_all
+from .state import RobotState
 from .episodes import Episode, check_hash, draw_starts, episode_seed, given_episodes, label_words, region_mask
-
-
-@dataclass
-class RobotState:
-    """The robot between and during episodes.
-
-    x, y : float, m; heading : float, rad; belief : the map and sign reads built so far (door
-    search), or None; clock : float, hour of day, or None; distance : float, m travelled so far;
-    steps : int; trail : list of (x, y) m, every pose so far; headings : list of rad, the heading
-    at every pose (the robot-orientation histogram of nsos); read_signs : sign index -> its label
-    as last read, for every sign read at least once.
-    """
-
-    x: float
-    y: float
-    heading: float
-    belief: Any = None
-    clock: float | None = None
-    distance: float = 0.0
-    steps: int = 0
-    trail: list = field(default_factory=list)
-    headings: list = field(default_factory=list)
-    read_signs: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -223,6 +204,159 @@ def checked_point(planner: str, x, y, frame, heading=None) -> tuple[float, float
     return fx, fy
 
 
+class OpenEpisode:
+    """One run of one episode, opened (:meth:`Task.open`) and stepped decision by decision: the
+    handle every driver holds, whoever answers the decisions.
+
+    :meth:`start` runs the episode to its first decision point (returned: a
+    :class:`~semsearch_cli.tasks.decisions.DecisionPoint`, with the kind's ``observation``, its
+    ``choices`` and the legal-choice ``mask``) or to its end (the outcome, a string);
+    :meth:`answer` takes a choice from outside (an agent, a user) and runs to the next point or
+    the end; :meth:`ask` has the seat answer instead (the planner, a recording, a replay), and
+    :meth:`play` lets it answer every point. :meth:`take` steps the robot by a motion of the
+    agent's own (primitive actions) instead of by decisions. When the episode has ended,
+    ``outcome`` is set and :meth:`result` and :meth:`rows` give what the batch writes.
+
+    ``state`` (the :class:`RobotState`, changed as the run goes), ``rng`` (the run's generator),
+    ``episode``, ``seed``, ``variant`` and ``seat`` are the run's; ``point`` is the decision the
+    run waits at (None when it does not), ``session`` the loop of the search under way
+    (:class:`~semsearch_cli.tasks.loop.Session`: its ``search`` and ``stepper``)."""
+
+    def __init__(self, task: "Task", variant: Variant | None, ep, seed: int, seat: Seat | None,
+                 observer: Observer | None):
+        self.t0 = time.perf_counter()
+        self.task, self.observer = task, observer
+        self.episode = ep = task.as_episode(ep)
+        self.seed = int(seed)
+        self.seat = Seat() if seat is None else seat
+        self.variant = Variant(getattr(self.seat, "name", "agent"), ()) if variant is None else variant
+        self.rng = np.random.default_rng(episode_seed(ep, seed, task.sc.experiment.base_seed))
+        self.state = task.start_state(ep, self.rng)
+        self.start_heading = self.state.heading
+        self.seat.run = {"scenario": task.sc.name, "kind": task.planner_kind, "planner": self.variant.label,
+                         "goal": str(ep.goal), "episode": int(ep.index), "seed": self.seed}
+        self._steps = task.search(self.variant, ep, self.seed, self.state, self.rng, self.seat, observer)
+        self.session: Session | None = None
+        self.point: DecisionPoint | None = None
+        self.outcome: str | None = None
+        self._started = False
+        self._result: RunResult | None = None
+
+    # ---- what the driver reads ------------------------------------------------------------
+    @property
+    def observation(self):
+        """What a planner of the kind reads at the pending decision (None when none is pending)."""
+        return None if self.point is None else self.point.observation
+
+    @property
+    def mask(self) -> np.ndarray | None:
+        """The legal choices of the pending decision (None when none is pending)."""
+        return None if self.point is None else self.point.mask
+
+    @property
+    def search(self):
+        """The kind's search under way (its ``Search``; None before :meth:`start`)."""
+        return None if self.session is None else self.session.search
+
+    # ---- stepping -------------------------------------------------------------------------
+    def start(self, primitive: bool = False):
+        """Run to the first decision point (returned) or the end (the outcome). With
+        ``primitive``: only set the search up and sense at the start pose; the agent then moves
+        the robot itself (:meth:`take`), and no decision is asked. Returns the outcome (found:
+        the target is in view from the start) or None."""
+        if self._started:
+            raise RuntimeError("the episode has started already")
+        self._started = True
+        if not primitive:
+            return self._advance()
+        item = self._steps.send(None)  # a search shows its loop first (tasks.loop.drive)
+        if not isinstance(item, Session):
+            raise RuntimeError(f"a {self.task.kind} search has no step loop to take primitive steps in")
+        self.session = item
+        return self._primitive_end() if item.stepper.look() else None
+
+    def answer(self, choice):
+        """Take ``choice`` at the pending decision point; run to the next one (returned) or the end
+        (the outcome)."""
+        self._pending()
+        self.point = None
+        return self._advance(choice)
+
+    def ask(self):
+        """Have the seat answer the pending decision point (the planner's answer, or a record's);
+        run to the next one or the end, as :meth:`answer`. A planner whose own budget is spent
+        (:class:`~semsearch_cli.errors.BudgetSpent`) ends the search as ``budget``."""
+        point = self._pending()
+        try:
+            choice = self.seat.decide(point)
+        except BudgetSpent as exc:
+            self.point = None
+            return self._advance(spent=exc)
+        self.point = None
+        return self._advance(choice)
+
+    def play(self) -> RunResult:
+        """Let the seat answer every decision to the end (started if it was not); the result."""
+        item = self.start() if not self._started else self.point if self.point is not None else self.outcome
+        while isinstance(item, DecisionPoint):
+            item = self.ask()
+        return self.result()
+
+    def take(self, motion) -> str | None:
+        """One primitive step (after ``start(primitive=True)``): ``motion(st)`` moves the pose and
+        returns the metres moved (:meth:`~semsearch_cli.tasks.loop.Stepper.take`); returns the
+        outcome (found, budget) or None."""
+        if self.session is None or self.point is not None or self._result is not None:
+            raise RuntimeError("take() steps an episode started with start(primitive=True) that has not ended")
+        return self._primitive_end() if self.session.stepper.take(motion) is not None else None
+
+    # ---- the end ----------------------------------------------------------------------------
+    def result(self) -> RunResult:
+        """The run's result, once it has ended."""
+        if self._result is None:
+            raise RuntimeError("the episode has not ended")
+        return self._result
+
+    def rows(self) -> list[dict]:
+        """The rows the batch writes of this run (its own, then a chain's stage rows)."""
+        return self.task.rows(self.variant, self.episode, self.seed, self.result())
+
+    def _pending(self) -> DecisionPoint:
+        if self.point is None:
+            raise RuntimeError("no decision is pending" + (f": the episode has ended ({self.outcome})" if self.outcome else ""))
+        return self.point
+
+    def _advance(self, send=None, spent: BaseException | None = None):
+        while True:
+            try:
+                item = self._steps.throw(spent) if spent is not None else self._steps.send(send)
+            except StopIteration as stop:
+                return self._end(stop.value)
+            send = spent = None
+            if isinstance(item, Session):
+                self.session = item
+                continue
+            self.point = item
+            return item
+
+    def _primitive_end(self) -> str:
+        st = self.state
+        self._steps.close()
+        return self._end(Outcome(self.session.stepper.outcome, st.distance, st.steps, 0))
+
+    def _end(self, out: Outcome) -> str:
+        seat, st, ep = self.seat, self.state, self.episode
+        seat.finish()
+        left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.task.distance_left(ep.goal, st.x, st.y)
+        message = out.message or (seat.notes() if out.outcome == "budget" else "")
+        self._result = RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - self.t0,
+                                 np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=out.stages,
+                                 message=message, time_s=out.time_s, left_m=left, start_heading=self.start_heading,
+                                 record={**out.record, **seat.costs()}, transcripts=seat.transcripts())
+        self.outcome = out.outcome
+        return out.outcome
+
+
 class Task:
     """One kind of search over a scenario, whatever its world. Subclasses set ``kind``,
     ``planner_kind`` (which registered planners answer it), ``columns`` (its own row columns
@@ -337,42 +471,59 @@ class Task:
         heading = math.radians(ep.heading) if ep.heading is not None else float(rng.uniform(-np.pi, np.pi))
         return RobotState(ep.x, ep.y, heading, trail=[(ep.x, ep.y)])
 
-    def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
-                observer: Observer | None = None, decide=ask) -> tuple[Outcome, RobotState]:  # pragma: no cover
-        """One search for ``goal`` by ``planner`` from ``state``, its decisions answered by
-        ``decide`` (:mod:`.decisions`)."""
+    def steps(self, state: RobotState, planner, goal, rng: np.random.Generator, observer: Observer | None = None):  # pragma: no cover
+        """One search for ``goal`` by ``planner`` from ``state``, as a generator: it runs the step
+        loop with ``yield from`` :func:`~semsearch_cli.tasks.loop.drive` (or several, one after
+        another), so that it yields each decision point and is sent the choice, and returns
+        ``(Outcome, state)``. Whoever drives the run answers (:meth:`open`)."""
         raise NotImplementedError
+
+    def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
+                observer: Observer | None = None, decide=ask) -> tuple[Outcome, RobotState]:
+        """One search for ``goal`` by ``planner`` from ``state``, its decisions answered by
+        ``decide`` (by default the planner's; :mod:`.decisions`): :meth:`steps` run to its end."""
+        return answer_all(self.steps(state, planner, goal, rng, observer), decide)
+
+    def open(self, variant: Variant | None, ep, seed: int, *, seat: Seat | None = None,
+             observer: Observer | None = None) -> "OpenEpisode":
+        """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode), opened: the start
+        state drawn and the search set up, nothing run yet; step it with
+        :meth:`OpenEpisode.start` and :meth:`OpenEpisode.answer`, or let the seat answer every
+        decision (:meth:`OpenEpisode.play`). ``seat`` says who sits in the planner's seat
+        (default: the variant's planner, :class:`~semsearch_cli.tasks.decisions.Seat`; an
+        :class:`~semsearch_cli.tasks.decisions.Agent` for choices from outside, with ``variant``
+        None); ``observer`` sees the run's events. The one way every driver runs an episode: the
+        batch, ``semsearch verify``, the Gymnasium environments and the robot bridge."""
+        return OpenEpisode(self, variant, ep, seed, seat, observer)
 
     def run(self, variant: Variant, ep: Episode, seed: int, observer: Observer | None = None,
             seat: Seat | None = None) -> RunResult:
-        """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode): the start state, then
-        the kind's search (:meth:`search`), its events shown to ``observer`` and its decisions
-        answered by ``seat`` (default: the variant's planner; a
+        """Repeat ``seed`` of episode ``ep`` (or of a goal's first episode), every decision answered
+        by ``seat`` (default: the variant's planner; a
         :class:`~semsearch_cli.tasks.decisions.Recording` keeps them, a
-        :class:`~semsearch_cli.tasks.decisions.Replay` answers from a record). Every kind's run."""
-        t0 = time.perf_counter()
-        ep = self.as_episode(ep)
-        rng = np.random.default_rng(episode_seed(ep, seed, self.sc.experiment.base_seed))
-        st = self.start_state(ep, rng)
-        heading = st.heading
-        seat = Seat() if seat is None else seat
-        seat.run = {"scenario": self.sc.name, "kind": self.planner_kind, "planner": variant.label, "goal": str(ep.goal), "episode": int(ep.index),
-                    "seed": int(seed)}
-        out = self.search(variant, ep, seed, st, rng, seat, observer)
-        seat.finish()
-        left = out.left_m if out.left_m is not None else 0.0 if out.outcome == "found" else self.distance_left(ep.goal, st.x, st.y)
-        message = out.message or (seat.notes() if out.outcome == "budget" else "")
-        return RunResult(out.outcome, out.distance_m, out.steps, out.decisions, time.perf_counter() - t0,
-                         np.asarray(st.trail, np.float32), sorted(st.read_signs), stages=out.stages,
-                         message=message, time_s=out.time_s, left_m=left, start_heading=heading,
-                         record={**out.record, **seat.costs()}, transcripts=seat.transcripts())
+        :class:`~semsearch_cli.tasks.decisions.Replay` answers from a record): :meth:`open`, then
+        :meth:`OpenEpisode.play`. Every kind's run."""
+        return self.open(variant, ep, seed, seat=seat, observer=observer).play()
 
     def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng: np.random.Generator, seat: Seat,
-               observer: Observer | None) -> Outcome:
-        """One run's search from ``st`` (changed in place): by default one :meth:`episode` of the
-        variant's planner (as ``seat`` seats it) for the episode's goal."""
-        out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
+               observer: Observer | None):
+        """One run's search from ``st`` (changed in place), as a generator of its decision points
+        that returns the :class:`Outcome`: by default one :meth:`steps` of the variant's planner
+        (as ``seat`` seats it) for the episode's goal."""
+        if type(self).steps is Task.steps:  # a kind of before 0.4.0: its episode() answers its own decisions
+            out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
+            return out
+        out, _ = yield from self.steps(st, seat.planner(variant), ep.goal, rng, observer)
         return out
+
+    def with_budget(self, max_distance: float) -> "Task":
+        """This task with ``experiment.max_distance`` replaced (and the step limit that follows from
+        it), sharing its world and episodes: an environment's shorter training episodes."""
+        task = copy.copy(self)
+        e = self.sc.experiment
+        task.sc = self.sc.model_copy(update={"experiment": e.model_copy(update={"max_distance": float(max_distance)})})
+        task._variants = None
+        return task
 
     def rows(self, variant: Variant, ep: Episode, seed: int, res: RunResult) -> list[dict]:
         """The rows of one finished run: its own, then any per-stage rows."""
@@ -580,7 +731,13 @@ TASKS = Registry("task", Task)  # kind -> its Task subclass
 
 def register_task(cls):
     """Class decorator: the task answers scenarios of kind ``cls.kind`` (a :class:`Task` subclass,
-    one per kind)."""
+    one per kind). A kind that defines ``episode(..., decide)`` answering its own decisions, and
+    no :meth:`Task.steps`, runs with a warning: it cannot be opened decision by decision."""
+    if isinstance(cls, type) and issubclass(cls, Task) and cls.steps is Task.steps and cls.episode is not Task.episode:
+        warn(f"a kind whose episode(..., decide) answers its own decisions (kind {getattr(cls, 'kind', '')!r}, "
+             f"{cls.__module__}.{cls.__qualname__})", "write its steps(state, planner, goal, rng, observer) as a generator "
+             "over tasks.loop.drive (yield from drive(search, ...)) and drop episode(); Task.episode answers it",
+             since="0.4.0", until="0.5.0")
     return TASKS.add(getattr(cls, "kind", ""), cls)
 
 

@@ -190,8 +190,8 @@ class ChainTask(OnMapTask):
     # ---- running ----------------------------------------------------------------------
     def _stage(self, ch, s: Stage, st: RobotState, variant: Variant, rng, reuse: bool, observer: Observer | None,
                seat: Seat):
-        """One stage from ``st``: (outcome, decisions)."""
-        out, st = self.doors.episode(st, seat.planner(variant), s.door, rng, observer, reuse_reads=reuse, decide=seat.decide)
+        """One stage from ``st`` (a generator of its decision points): (outcome, decisions)."""
+        out, st = yield from self.doors.steps(st, seat.planner(variant), s.door, rng, observer, reuse_reads=reuse)
         decisions = out.decisions
         if out.outcome != "found" or s.cls is None:
             return out.outcome, decisions
@@ -199,8 +199,8 @@ class ChainTask(OnMapTask):
         log = self.logs[ch.name]
         near = _nearest_place(log, self.objects.places)
         planner = seat.planner(Variant(ch.object_planner, ()))
-        out, st = self.objects.search_episode(st, planner, s.cls, s.hour, self._instances(ch, s), log[near.isin(room)],
-                                              room, None, rng, observer, decide=seat.decide)
+        out, st = yield from self.objects.search_steps(st, planner, s.cls, s.hour, self._instances(ch, s), log[near.isin(room)],
+                                                       room, None, rng, observer)
         return out.outcome, decisions + out.decisions
 
     def search(self, variant: Variant, ep: Episode, seed: int, st: RobotState, rng, seat: Seat,
@@ -222,7 +222,7 @@ class ChainTask(OnMapTask):
             pose = (st.x, st.y, st.heading)
             d0, s0, t_stage = st.distance, st.steps, time.perf_counter()
             stage_seed = episode_seed(ep, seed, base, k)  # the same draws kept and from scratch
-            outcome, dec = self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True,
+            outcome, dec = yield from self._stage(ch, s, st, variant, np.random.default_rng(stage_seed), True,
                                        StageObserver(observer, k) if observer is not None else None, seat)
             n_legs = 2 if s.cls is not None else 1
             shortest = sum(next(leg) for _ in range(n_legs))
@@ -232,7 +232,7 @@ class ChainTask(OnMapTask):
             # the same stage from scratch: same pose, empty map, same seed
             fresh = RobotState(*pose, trail=[pose[:2]])
             t_s = time.perf_counter()
-            o2, d2 = self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, None, seat)
+            o2, d2 = yield from self._stage(ch, s, fresh, variant, np.random.default_rng(stage_seed), False, None, seat)
             stages.append(_stage_row(k, s, "scratch", o2, fresh.distance, fresh.steps, shortest, d2, time.perf_counter() - t_s))
             if outcome != "found":
                 # left: to this stage's door and on to its object (when its door was not read), or

@@ -229,6 +229,27 @@ class StandIn:
             raise AttributeError(key) from None
 
 
+class Agent(Seat):
+    """The seat of choices made outside the run: a Gymnasium environment's agent, a front end's
+    user, a robot's operator. What sits in the planner's seat is a :class:`StandIn` named
+    ``name`` with ``attributes``, the run attributes the kind's search reads (door search:
+    ``replan_on_signs``; indirect search: ``masks``, ``negative``, ``uses_map``,
+    ``replan_on_detection``); every choice comes through
+    :meth:`~semsearch_cli.tasks.base.OpenEpisode.answer`, so :meth:`decide` refuses."""
+
+    def __init__(self, name: str = "agent", **attributes):
+        super().__init__()
+        self.name, self.attributes = name, attributes
+
+    def planner(self, variant):
+        return self.seat(StandIn(self.name, dict(self.attributes)))
+
+    def decide(self, point: DecisionPoint):
+        raise RuntimeError(f"the {self.name} answers each {point.kind} decision through OpenEpisode.answer(choice); "
+                           "a kind whose episode() answers its own decisions (before semsearch 0.4.0) cannot be "
+                           "stepped so: write its steps()")
+
+
 class Replay(Seat):
     """A recorded run's choices answering its decision points (see the module docstring);
     :meth:`finish` checks that every one was asked for."""

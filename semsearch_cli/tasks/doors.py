@@ -31,7 +31,7 @@ from ..world.ground_truth import check_goals_reachable
 from ..world.buildings.demo import write_demo
 from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_cell, register_task
 from .decisions import Codec, DecisionPoint, ask, rng_word
-from .loop import run_loop
+from .loop import drive
 
 MAX_RETRIES = 5
 
@@ -529,23 +529,21 @@ class DoorTask(OnMapTask):
     def new_belief(self) -> DoorBelief:
         return DoorBelief(self.world.frame, self.sc.belief, self.sc.robot.radius)
 
-    def episode(self, state, planner, goal, rng, observer: Observer | None = None, reuse_reads: bool = False,
-                decide=ask):
-        """Search for sign ``goal`` from ``state`` (a new belief when it has none), each decision
-        answered by ``decide``. With ``reuse_reads`` and the sign already read, go there on the
-        map built so far."""
+    def steps(self, state, planner, goal, rng, observer: Observer | None = None, reuse_reads: bool = False):
+        """Search for sign ``goal`` from ``state`` (a new belief when it has none), as a generator
+        of its decision points (:func:`~semsearch_cli.tasks.loop.drive`). With ``reuse_reads``
+        and the sign already read, go there on the map built so far."""
         if state.belief is None:
             state.belief = self.new_belief()
         d0, s0 = state.distance, state.steps
         target = read_position(state.belief, goal) if reuse_reads else None
         search = GoToRead(self, goal, rng, target) if target is not None else DoorSearch(self, planner, goal, rng, observer)
         search.start_distance = d0
-        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(), decide=decide)
+        outcome = yield from drive(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
         if outcome == "stuck" and isinstance(search, GoToRead):  # the map built so far has no path: search again
             search = DoorSearch(self, planner, goal, rng, observer)
             search.start_distance = d0
-            outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(),
-                               decide=decide)
+            outcome = yield from drive(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def describe(self):

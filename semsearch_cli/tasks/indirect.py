@@ -39,7 +39,7 @@ from ..world.rooms import OBJECT_GAP, WALL_MARGIN, Room, estimate_relations, gen
 from .base import Event, Observer, Outcome, RobotState, RunResult, Task, checked_point, register_task
 from .episodes import Episode, check_hash, draw_starts, given_episodes, label_words
 from .decisions import Codec, DecisionPoint, ask
-from .loop import run_loop
+from .loop import drive
 
 
 def _encode(goal: Goal):
@@ -633,13 +633,13 @@ class IndirectTask(Task):
         """One room's search at the episode's scale; the result adds the simulated time, and the
         distance left is measured in the room."""
         scale = float(ep.goal)
-        out, st = self.episode(st, seat.planner(variant), scale, rng, observer, room=ep.room, decide=seat.decide)
+        out, st = yield from self.steps(st, seat.planner(variant), scale, rng, observer, room=ep.room)
         out.left_m = 0.0 if out.outcome == "found" else self.shortest_of(ep.room, scale, st.x, st.y)
         out.time_s = out.steps / self.spec.camera.fps
         out.message = "the robot could not move" if out.outcome == "stuck" else ""
         return out
 
-    def episode(self, state, planner, goal, rng, observer: Observer | None = None, room: int = 0, decide=ask):
+    def steps(self, state, planner, goal, rng, observer: Observer | None = None, room: int = 0):
         """Search room ``room`` for A at view scale ``goal`` from ``state`` (a new map of A when it
         has none); the time limit counts from the state's steps (camera frames)."""
         spec = self.spec
@@ -648,7 +648,7 @@ class IndirectTask(Task):
             state.belief = search.new_belief()
         d0, s0 = state.distance, state.steps
         max_steps = s0 + int(round(spec.time_limit * spec.camera.fps))
-        outcome = run_loop(search, state, 0.0, math.inf, max_steps, move=search.move, decide=decide)
+        outcome = yield from drive(search, state, 0.0, math.inf, max_steps, move=search.move)
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def describe(self):

@@ -16,7 +16,7 @@ from typing import Protocol
 
 from ..errors import BudgetSpent
 from ..navigation import advance
-from .base import RobotState
+from .state import RobotState
 from .decisions import DecisionPoint, ask
 
 STALL_STEPS = 50  # steps without moving before a run is stuck
@@ -114,6 +114,34 @@ class Stepper:
         self._moving = True
         return self.advance()
 
+    def look(self) -> bool:
+        """Sense at the pose and fold it into the belief, outside the loop (the start of an
+        episode stepped by primitive actions, :meth:`take`): whether the target was seen."""
+        found, _ = self.search.sense(self.st)
+        self.search.update(self.st)
+        if found:
+            self.outcome = "found"
+        return found
+
+    def take(self, motion) -> str | None:
+        """One step of someone else's motion instead of the plan's (a primitive action of an
+        environment): ``motion(st)`` moves the pose and returns the metres moved; the step is
+        counted (distance, steps, trail), then sensed and folded in (:meth:`look`). Returns
+        ``found``, ``budget`` (the distance or step limit reached) or None. No plan and no
+        decision point: the agent moves the robot itself."""
+        if self.outcome is not None:
+            raise RuntimeError(f"the episode has ended ({self.outcome})")
+        st = self.st
+        moved = float(motion(st))
+        st.distance += moved
+        st.steps += 1
+        st.trail.append((st.x, st.y))
+        if self.look():
+            return "found"
+        if st.distance >= self.max_distance or st.steps >= self.max_steps:
+            self.outcome = "budget"
+        return self.outcome
+
     def _move(self) -> str | None:
         st = self.st
         h0 = st.heading
@@ -183,18 +211,48 @@ class Session:
         return out
 
 
+def drive(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None):
+    """The step loop of one search as a generator (a kind's :meth:`~semsearch_cli.tasks.base.Task.steps`
+    runs it with ``yield from``): it yields its :class:`Session` once, first (so that whoever
+    drives the run can see the search and take primitive steps, :meth:`Stepper.take`), then each
+    :class:`~semsearch_cli.tasks.decisions.DecisionPoint`, and is sent the choice; it returns the
+    outcome. A :class:`~semsearch_cli.errors.BudgetSpent` thrown in at a decision point (a
+    planner's own budget spent: a language model's calls or tokens) ends the search as ``budget``."""
+    session = Session(search, st, step, max_distance, max_steps, move)
+    yield session
+    point = session.start()
+    while isinstance(point, DecisionPoint):
+        try:
+            choice = yield point
+        except BudgetSpent:
+            return "budget"
+        point = session.answer(choice)
+    return point
+
+
+def answer_all(steps: Generator, decide=ask):
+    """Run ``steps`` (a generator of a kind's search: :func:`drive`, a task's ``steps``) to its
+    end, each decision point answered by ``decide``, a planner's spent budget
+    (:class:`~semsearch_cli.errors.BudgetSpent`) thrown back in; returns what the generator returns."""
+    send = spent = None
+    while True:
+        try:
+            item = steps.throw(spent) if spent is not None else steps.send(send)
+        except StopIteration as stop:
+            return stop.value
+        send = spent = None
+        if isinstance(item, DecisionPoint):
+            try:
+                send = decide(item)
+            except BudgetSpent as exc:
+                spent = exc
+
+
 def run_loop(search: Search, st: RobotState, step: float, max_distance: float, max_steps: int, move=None,
              decide=ask) -> str:
     """Drive ``st`` (changed in place) until an outcome: found, budget, stuck, or whatever
     :meth:`Search.plan` returns when there is nowhere to go (see :class:`Stepper`), each decision
     point answered by ``decide`` (by default the seated planner). A planner whose own budget is
-    spent (:class:`~semsearch_cli.errors.BudgetSpent`) ends the run as ``budget``."""
-    session = Session(search, st, step, max_distance, max_steps, move)
-    point = session.start()
-    while isinstance(point, DecisionPoint):
-        try:
-            choice = decide(point)
-        except BudgetSpent:  # the planner's own budget (a language model's calls or tokens): the run's budget outcome
-            return "budget"
-        point = session.answer(choice)
-    return point
+    spent (:class:`~semsearch_cli.errors.BudgetSpent`) ends the run as ``budget``. The same as
+    :func:`drive` answered by :func:`answer_all`."""
+    return answer_all(drive(search, st, step, max_distance, max_steps, move), decide)

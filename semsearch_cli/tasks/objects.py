@@ -51,7 +51,7 @@ from ..sensors import PlaceCamera
 from ..world.buildings.office import office_image, office_scenario
 from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_point, register_task
 from .decisions import Codec, DecisionPoint, ask
-from .loop import run_loop
+from .loop import drive, run_loop
 from ..files import read_user_text, temp_path, user_file
 
 LOG_COLUMNS = ["day", "hour", "class", "x", "y", "robot_x", "robot_y", "place"]
@@ -345,14 +345,13 @@ class ObjectTask(OnMapTask):
     def goals(self) -> list:
         return [r.label for r in self.requests]
 
-    def episode(self, state, planner, goal, rng, observer: Observer | None = None, decide=ask):
-        """Answer the request labelled ``goal`` from ``state``."""
+    def steps(self, state, planner, goal, rng, observer: Observer | None = None):
+        """Answer the request labelled ``goal`` from ``state`` (a generator of its decision points)."""
         req = self.request(goal)
-        return self.search_episode(state, planner, req.cls, req.hour, self.request_instances(req), self.logs[req.case],
-                                   self.route, self.world.start_xy, rng, observer, decide)
+        return (yield from self.search_steps(state, planner, req.cls, req.hour, self.request_instances(req),
+                                             self.logs[req.case], self.route, self.world.start_xy, rng, observer))
 
-    def search_episode(self, state, planner, cls, hour, instances, log, route, home, rng, observer: Observer | None = None,
-                       decide=ask):
+    def search_steps(self, state, planner, cls, hour, instances, log, route, home, rng, observer: Observer | None = None):
         """Search for ``cls`` among ``instances`` [(class, place)] with the places of ``route``."""
         d0, s0 = state.distance, state.steps
         camera = PlaceCamera(self.world, self.spec.camera, self.places, self.facing, instances)
@@ -361,8 +360,7 @@ class ObjectTask(OnMapTask):
                               camera, ctx, rng, observer)
         search.planner_name = planner.name
         search.start_distance = d0
-        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(),
-                           decide=decide)
+        outcome = yield from drive(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions), state
 
     def write_inputs(self, out: Path) -> None:
