@@ -26,7 +26,7 @@ from pydantic import Field
 
 from semsearch_cli.config import OnMap, Strict, register_kind
 from semsearch_cli.errors import ScenarioError
-from semsearch_cli.envs.base import SearchEnv, box, ended
+from semsearch_cli.envs.base import SearchEnv, box
 from semsearch_cli.navigation import KnownMap
 from semsearch_cli.planners import Planner, register_planner
 from semsearch_cli.report.document import write_table
@@ -34,8 +34,8 @@ from semsearch_cli.report.figures.paths import plot_scenario
 from semsearch_cli.report.sections import Section, register_section
 from semsearch_cli.runner import run_rows
 from semsearch_cli.tasks import OnMapTask, Outcome, register_task
-from semsearch_cli.tasks.decisions import Codec, DecisionPoint, StandIn, ask
-from semsearch_cli.tasks.loop import Session, run_loop
+from semsearch_cli.tasks.decisions import Codec, DecisionPoint
+from semsearch_cli.tasks.loop import drive
 
 
 # ---- the scenario section ------------------------------------------------------------------------
@@ -160,10 +160,10 @@ class BeaconTask(OnMapTask):
             out |= np.hypot(x - px, y - py) <= self.sc.read_range
         return out & w.reach
 
-    def episode(self, state, planner, goal, rng, observer=None, decide=ask):
+    def steps(self, state, planner, goal, rng, observer=None):
         search = BeaconSearch(self, planner, goal, rng)
         d0, s0 = state.distance, state.steps
-        outcome = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(), decide=decide)
+        outcome = yield from drive(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps())
         return Outcome(outcome, state.distance - d0, state.steps - s0, search.decisions,
                        record={"posts_read": int(search.read.sum())}), state
 
@@ -230,20 +230,11 @@ class BeaconSearchEnv(SearchEnv):
         self.observation_space = gym.spaces.Dict({"posts": box([-1e6, -1e6, 0], [1e6, 1e6, 1], (n, 3)),
                                                   "pose": box([-1e6, -1e6, -math.pi], [1e6, 1e6, math.pi])})
 
-    def _begin(self):
-        t = self.task
-        self.state = st = t.start_state(self.episode, self.rng)
-        self.search = BeaconSearch(t, StandIn("agent"), self.episode.goal, self.rng)
-        self.session = Session(self.search, st, t.sc.robot.step, t.sc.experiment.max_distance, t.max_steps())
-        self.outcome = ended(self.session.start())
-
-    def _act(self, action):
-        d0 = self.state.distance
-        out = ended(self.session.answer(int(action)))
-        return self.state.distance - d0, out
+    def _choice(self, action):
+        return int(action)  # the post to visit
 
     def action_masks(self):
-        p = self.session.point
+        p = self.run.point
         return p.mask.copy() if p is not None else np.ones(self.action_space.n, bool)
 
     def _observe(self):

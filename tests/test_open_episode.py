@@ -1,0 +1,151 @@
+"""One episode handle for every driver (``Task.open`` -> ``OpenEpisode``): stepped decision by
+decision from outside, it is the batch's run, for every kind; an agent's seat answers from
+outside only; primitive steps and the handle's misuse are refused with a sentence; a kind written
+before 0.4.0 (``episode(..., decide)``) still runs, with a warning naming its replacement."""
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from semsearch_cli.planners import Variant
+from semsearch_cli.runner import Loaded
+from semsearch_cli.tasks import TASKS, OpenEpisode, Outcome, Task, register_task
+from semsearch_cli.tasks.decisions import Agent, DecisionPoint, Recording, Replay
+from semsearch_cli.tasks.doors import DoorSearch, DoorTask
+from semsearch_cli.tasks.loop import run_loop
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = [("demo", Variant("nsos", (("alpha", 0.9),)), 0), ("office", Variant("lsos", ()), 1),
+         ("indirect_quick", Variant("ISC-OP-SM", ()), 0)]
+
+
+def task_of(config: str):
+    return Loaded.load(ROOT / "configs" / f"{config}.yaml").task
+
+
+def same(a, b) -> None:
+    assert (a.outcome, a.distance_m, a.steps, a.decisions, a.left_m) == (b.outcome, b.distance_m, b.steps, b.decisions, b.left_m)
+    assert np.array_equal(a.path, b.path)
+
+
+@pytest.mark.parametrize("config,variant,k", CASES, ids=[c[0] for c in CASES])
+def test_stepped_from_outside_it_is_the_batch_run(config, variant, k):
+    task = task_of(config)
+    ep = task.episodes[k]
+    batch = task.run(variant, ep, 3)
+    h = task.open(variant, ep, 3)
+    assert isinstance(h, OpenEpisode) and h.point is None and h.outcome is None
+    point, n = h.start(), 0
+    while isinstance(point, DecisionPoint):
+        assert h.point is point and h.observation is point.observation and h.mask is point.mask
+        point = h.answer(point.ask())  # the planner's answer, carried by hand
+        n += 1
+    assert point == h.outcome == batch.outcome and h.point is None
+    same(h.result(), batch)
+    assert n >= batch.decisions > 0
+    drop = lambda rows: [{k: v for k, v in r.items() if k != "wall_s"} for r in rows]  # noqa: E731
+    assert drop(h.rows()) == drop(task.rows(variant, ep, 3, batch)) and h.rows()[0]["planner"] == variant.label
+
+
+def test_an_agent_answering_a_record_travels_what_the_batch_recorded():
+    """The agent's seat gets its choices from outside: here the recorded choices of a batch run,
+    decoded by each point's codec; the run is the recorded one."""
+    task = task_of("demo")
+    ep, v = task.episodes[1], Variant("greedy", ())
+    rec = Recording()
+    batch = task.run(v, ep, 0, seat=rec)
+    record = rec.record(task.planner_kind)
+    h = task.open(None, ep, 0, seat=Agent("agent", replan_on_signs=record["seats"]["greedy"]["replan_on_signs"]))
+    assert h.variant.label == "agent"
+    items, last = iter(record["decisions"]), None
+    point = h.start()
+    while isinstance(point, DecisionPoint):
+        item = next(items)
+        item = last if item == 0 else item
+        last = item
+        point = h.answer(point.decode(item))
+    assert next(items, "none left") == "none left"
+    same(h.result(), batch)
+    replayed = task.run(v, ep, 0, seat=Replay(record))  # and the replay seat, through the same handle
+    same(replayed, batch)
+
+
+def test_an_agent_seat_answers_only_from_outside():
+    task = task_of("demo")
+    h = task.open(None, task.episodes[0], 0, seat=Agent())
+    with pytest.raises(RuntimeError, match="answers each doors decision through OpenEpisode.answer"):
+        h.play()
+
+
+def test_primitive_steps_go_through_the_same_episode():
+    task = task_of("demo")
+    h = task.open(None, task.episodes[0], 0, seat=Agent(replan_on_signs=True))
+    assert h.start(primitive=True) is None and h.search is not None
+    x0 = h.state.x
+
+    def east(st):
+        st.x += 0.1
+        return 0.1
+
+    assert h.take(east) is None
+    assert h.state.steps == 1 and h.state.x == pytest.approx(x0 + 0.1) and h.state.distance == pytest.approx(0.1)
+    assert len(h.state.trail) == 2
+    n = 1
+    while (out := h.take(lambda st: 0.0)) is None:
+        n += 1
+    assert out == h.outcome == "budget" and h.state.steps == task.max_steps() == n + 1
+    assert h.result().outcome == "budget"
+    with pytest.raises(RuntimeError, match="has not ended"):
+        h.take(east)
+
+
+def test_misuse_is_refused_with_a_sentence():
+    task = task_of("demo")
+    h = task.open(Variant("greedy", ()), task.episodes[0], 0)
+    with pytest.raises(RuntimeError, match="no decision is pending"):
+        h.answer(None)
+    with pytest.raises(RuntimeError, match="has not ended"):
+        h.result()
+    with pytest.raises(RuntimeError, match="start\\(primitive=True\\)"):
+        h.take(lambda st: 0.0)
+    h.start()
+    with pytest.raises(RuntimeError, match="started already"):
+        h.start()
+    res = h.play()
+    with pytest.raises(RuntimeError, match="the episode has ended"):
+        h.answer(None)
+    assert res is h.result()
+
+
+def test_a_kind_of_before_0_4_runs_with_a_warning():
+    """``episode(..., decide)`` answering its own decisions, no ``steps``: registered with a
+    DeprecationWarning naming the replacement and the releases; the batch runs it as before; it
+    cannot be stepped from outside."""
+
+    class OldDoors(DoorTask):
+        kind = "doors_before_0_4"
+        steps = Task.steps  # as a kind written before 0.4.0 has it: not its own
+
+        def episode(self, state, planner, goal, rng, observer=None, decide=None):
+            state.belief = self.new_belief()
+            search = DoorSearch(self, planner, goal, rng, observer)
+            out = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(), decide=decide)
+            return Outcome(out, state.distance, state.steps, search.decisions), state
+
+    with pytest.warns(DeprecationWarning, match=r"episode\(\.\.\., decide\) answers its own decisions.*since semsearch "
+                      r"0\.4\.0 and will be removed in 0\.5\.0: write its steps"):
+        register_task(OldDoors)
+    try:
+        task = task_of("demo")
+        old = OldDoors(task.sc, task.world, task.path)
+        old.shortest, old._episodes = task.shortest, task.episodes
+        v, ep = Variant("greedy", ()), task.episodes[0]
+        same(old.run(v, ep, 0), task.run(v, ep, 0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(RuntimeError, match="cannot be stepped so"):
+                old.open(None, ep, 0, seat=Agent()).start()
+    finally:
+        TASKS.pop("doors_before_0_4", None)
