@@ -7,6 +7,7 @@ import math
 import os
 import re
 import shutil
+import time
 from contextlib import ExitStack, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,6 +18,7 @@ import yaml
 from .config import PlannerSpec, load_scenario, read_yaml, scenario_schema, with_param
 from .config.scenario import load_yaml_text
 from .config.base import sign_label
+from .deprecation import warn
 from .credentials import WHERE_THE_KEY_GOES, credential_in, redact, url_credential
 from .errors import MissingExtra, ScenarioError, did_you_mean
 from .world.ground_truth import DuplicateSigns
@@ -162,6 +164,7 @@ class VerifyOutput:
     folder: Path
     scenario: Path | str  # the scenario replayed on, or a bench's "SUITE SPLIT (hash ...)"
     verdict: Verdict
+    what: str = ""  # what ``scenario`` is, as the command line says it: scenario, suite, settings ("": by its type)
 
 
 def _rows_scenario(folder: Path, scenario: str | Path | None) -> tuple[Path, Loaded]:
@@ -237,15 +240,18 @@ def ros_replay(bag: str | Path, planner: str, out: str | Path, scenario: str | P
 
 def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | None = None, publish_only: bool = False,
              repro: str | Path | None = None, margin: float = 10.0, max_distance: float | None = None,
-             planner_file: str | Path | None = None, silence: float = 30.0, log=None):
+             planner_file: str | Path | None = None, silence: float = 30.0, log=None, out: str | Path | None = None):
     """Explore with a robot through rosbridge (``ws://HOST:PORT``) until the sign ``goal`` is
     read, door planner ``planner`` choosing where to go (:mod:`semsearch_cli.ros2.live`; the
     ``ros`` extra): the robot's /map, pose and /semsearch/detections in; /explore/frontiers,
     /semsearch/goal and Nav2 ``NavigateToPose`` goals out (none with ``publish_only``). The
     belief's, robot's and navigation's settings come from ``scenario`` when given, and its
     ``experiment.max_distance`` unless ``max_distance`` is; ``margin`` metres of grid surround the
-    robot's first map; a run that does not find the goal leaves a repro bag at ``repro``. ``log``
-    takes a line of progress. Returns the :class:`~semsearch_cli.ros2.LiveRun`."""
+    robot's first map. The planner is seated as in a batch, and the run's folder ``out`` (default
+    ``live-DATE-TIME``) gets its bag, decisions record, transcript and ``run.json``
+    (:mod:`semsearch_cli.ros2.folder`), which ``semsearch verify`` checks. ``repro`` (deprecated
+    since 0.4.0): with no ``out``, only a failed run's bag, there, as before 0.4.0. ``log`` takes a
+    line of progress. Returns the :class:`~semsearch_cli.ros2.LiveRun`."""
     if not ros2.available("rosbags", "roslibpy"):  # rosbags: the repro bag
         raise MissingExtra("semsearch ros live", "ros")
     _margin(margin)
@@ -259,9 +265,34 @@ def ros_live(rosbridge: str, planner: str, goal: str, scenario: str | Path | Non
         raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: a robot explores with door planners only")
     if max_distance is None and loaded is not None:
         max_distance = loaded.sc.experiment.max_distance
-    live = ros2.Live(rosbridge, _door_variant(planner, planner_file), goal, loaded.sc if loaded is not None else None,
-                     publish_only, repro, margin, max_distance, silence, log)
-    return live.run()
+    if repro is not None:
+        warn("ros live --repro (a failed run's bag alone)", "give --out DIR: a folder with every run's bag, its decisions "
+             "record (semsearch verify DIR checks it) and its planner's transcript", since="0.4.0", until="0.5.0")
+    elif out is None:
+        out = f"live-{time.strftime('%Y%m%d-%H%M%S')}"
+    variant = _door_variant(planner, planner_file)
+    live = ros2.Live(rosbridge, variant, goal, loaded.sc if loaded is not None else None,
+                     publish_only, repro, margin, max_distance, silence, log, out=out)
+    res = live.run()
+    if out is not None:
+        ros2.write_live_folder(Path(out), res, planner=variant.label, goal=goal,
+                               scenario=loaded.path.resolve() if loaded is not None else None,
+                               fingerprint=loaded.fingerprint if loaded is not None else None, margin=margin,
+                               max_distance=None if max_distance is None or math.isinf(max_distance) else max_distance,
+                               publish_only=publish_only)
+    return res
+
+
+def _verify_live(folder: Path, scenario: str | Path | None) -> VerifyOutput:
+    """A live run's folder (``ros live --out``), replayed from its record: its scenario the one
+    ``run.json`` names (or ``scenario``), none for a run on the defaults."""
+    if not ros2.available("rosbags"):
+        raise MissingExtra("semsearch verify (a live run's bag)", "ros")
+    run = ros2.read_run(folder / "run.json")
+    named = scenario if scenario is not None else run.get("scenario")
+    loaded = Loaded.load(scenario_file(named), planners=False) if named is not None else None
+    return VerifyOutput(folder, loaded.path if loaded is not None else "the robot's defaults", ros2.verify_live(folder, loaded),
+                        "settings of")
 
 
 def ros_sim(scenario: str | Path, goal: str, seed: int = 0, port: int = 9090, period: float = 0.2,
@@ -336,6 +367,8 @@ def verify(folder: str | Path, scenario: str | Path | None = None, progress=None
     cpus = os.cpu_count() or 1
     if workers is not None and workers > cpus:
         raise ScenarioError("<command line>", "--workers", f"{workers} replaying processes on {cpus} CPUs: at most {cpus}")
+    if ros2.is_live_folder(folder):  # a robot's run (ros live --out): its bag replayed from its record
+        return _verify_live(folder, scenario)
     check_folder_engine(folder)  # another engine's runs replay with the release that made them
     if bench.is_bench(folder):
         if scenario is not None:

@@ -415,7 +415,7 @@ def verify(
                      "they claim no result)")
     more = "".join(f"; {n}" for n in notes)
     out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance, steps and "
-              f"decisions recorded{more} ({'suite' if isinstance(res.scenario, str) else 'scenario'} {res.scenario})",
+              f"decisions recorded{more} ({res.what or ('suite' if isinstance(res.scenario, str) else 'scenario')} {res.scenario})",
               highlight=False, soft_wrap=True)
     if v.failed:
         out.print(f"{len(v.failed)} problem(s): the folder does not verify", highlight=False, soft_wrap=True)
@@ -493,8 +493,11 @@ def ros_live(
                                             "come from, and the distance budget (default: their defaults, no budget)."),
     publish_only: bool = typer.Option(False, "--publish-only", help="Drive nothing: publish each goal on /semsearch/goal "
                                       "(PoseStamped) instead of sending Nav2 NavigateToPose goals."),
-    repro: Optional[str] = typer.Option(None, "--repro", callback=_path, help="Where a run that does not find the goal "
-                                        "leaves its repro bag (default: live-repro-DATE-TIME)."),
+    out_dir: Optional[str] = typer.Option(None, "--out", callback=_path, help="The run's folder: the bag of the messages it "
+                                          "took, its decisions record (semsearch verify checks it), its planner's transcript "
+                                          "and run.json (default: live-DATE-TIME)."),
+    repro: Optional[str] = typer.Option(None, "--repro", callback=_path, help="Deprecated since 0.4.0 (use --out): without "
+                                        "--out, only a run that does not find the goal leaves its bag, here."),
     margin: float = typer.Option(10.0, "--margin", help="Metres of grid around the robot's first map, for the map to grow into."),
     max_distance: Optional[float] = typer.Option(None, "--max-distance", help="Stop after this many metres (default: the "
                                                  "scenario's experiment.max_distance, else none)."),
@@ -510,15 +513,21 @@ def ros_live(
 
     try:
         res = api.ros_live(rosbridge, planner, goal, scenario, publish_only, repro, margin, max_distance, planner_file,
-                           silence, log=lambda text: err.print(text))
+                           silence, log=lambda text: err.print(text), out=out_dir)
     except ScenarioError as exc:
         _fail(exc)
     n = len(res.decisions)
     sent = "targets published on /semsearch/goal" if publish_only else f"{res.goals} goals sent to Nav2 (one a re-plan)"
     out.print(f"{res.outcome}: {res.message}; {res.distance:.1f} m along {res.poses} poses, {n} decision{'s' * (n != 1)}, "
               f"{sent}")
+    if res.costs:
+        out.print("planner's costs: " + ", ".join(f"{k} {v:g}" for k, v in res.costs.items()), highlight=False)
     if res.dropped:
         out.print(f"not taken from the robot: {res.dropped}")
+    if res.bag is not None:
+        folder = res.bag.parent
+        out.print(f"run folder: {folder} (bag, decisions record{', transcript' if res.transcripts else ''}, run.json; "
+                  f"check it: semsearch verify {shlex.quote(str(folder))})", highlight=False, soft_wrap=True)
     if res.repro is not None:
         size = sum(p.stat().st_size for p in res.repro.rglob("*") if p.is_file())
         if res.poses == 0:

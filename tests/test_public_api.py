@@ -44,7 +44,7 @@ API = {
     "export": ["folder", "out", "fmt", "run", "scenario", "kept"],
     "ros_replay": ["bag", "planner", "out", "scenario", "fmt", "planner_file", "goal", "margin"],
     "ros_live": ["rosbridge", "planner", "goal", "scenario", "publish_only", "repro", "margin", "max_distance", "planner_file",
-                 "silence", "log"],
+                 "silence", "log", "out"],
     "ros_sim": ["scenario", "goal", "seed", "port", "period", "follow"],
     "bench_run": ["suite", "planners", "out", "split", "numbering", "options", "limit", "salt_file", "planner_file", "progress"],
     "bench_list": [],

@@ -34,6 +34,7 @@ from semsearch_cli.planners import Variant  # noqa: E402
 from semsearch_cli.planners.doors import nsos  # noqa: E402
 from semsearch_cli.tasks.base import Observer  # noqa: E402
 from semsearch_cli.tasks.doors import DoorDecision  # noqa: E402
+from tests.llm_server import ChatServer, first_target  # noqa: E402
 
 PERIOD = 0.04  # s between the stand-in robot's steps: ros live answers a step within it (see docs/robot.md)
 
@@ -53,8 +54,12 @@ def robot(demo_loaded):
 
 
 def live(bridge, planner, goal, tmp_path, **kw):
+    """ros live on loopback: the run's folder ``out`` when given, else (the deprecated way) a
+    failed run's bag at tmp_path/repro."""
     kw.setdefault("silence", 20.0)
-    return api.ros_live(bridge.url, planner, goal, repro=tmp_path / "repro", **kw)
+    if "out" not in kw:
+        kw["repro"] = tmp_path / "repro"
+    return api.ros_live(bridge.url, planner, goal, **kw)
 
 
 class Decisions(Observer):
@@ -91,9 +96,12 @@ def test_live_finds_the_goal_and_travels_what_run_travels(robot, demo_loaded, tm
     run = demo_loaded.task.run(Variant(planner, ()), goal, 0, observer=seen)
     monkeypatch.setattr(nsos, "pick", real_pick)
     bot = make(goal)
-    res = live(bridge, planner, goal, tmp_path)
+    res = live(bridge, planner, goal, tmp_path, out=tmp_path / "live")
     assert res.outcome == "found" and run.outcome == "found"
-    assert res.repro is None and not (tmp_path / "repro").exists() and not list(tmp_path.glob(".repro*"))
+    assert res.repro is None and res.bag == tmp_path / "live" / "bag" and not list(tmp_path.glob(".*"))
+    # the run's folder replays from its record alone, found again at the same decisions
+    checked = api.verify(tmp_path / "live").verdict
+    assert (checked.runs, checked.verified, checked.failed) == (1, 1, [])
     got = [{"step": r["step"], "target": [round(v, 6) for v in r["target"]]} for r in res.decisions]
     if max(bot.late) == 0 and not any(drawn):
         assert got == seen.rows and bot.found_at == pytest.approx(run.distance_m, abs=1e-9)
@@ -387,3 +395,42 @@ def test_an_axis_heading_comes_back_from_its_quaternion_to_the_bit():
         assert pose_of(m.pose_stamped(0, 1.0, 2.0, yaw)) == (1.0, 2.0, yaw)
     for yaw in (0.3, -2.0, 1.5707963):
         assert pose_of(m.pose_stamped(0, 1.0, 2.0, yaw))[2] == pytest.approx(yaw, abs=1e-15)
+
+
+def test_a_language_model_on_a_robot_is_seated_as_in_a_batch_and_its_run_folder_verifies(robot, tmp_path, monkeypatch):
+    """ros live with the llm planner (the scripted chat server of the tests, on loopback) seats it
+    as a batch does: its transcript and cost columns are kept, the run's folder holds its bag,
+    decisions record and run.json, and `semsearch verify` replays the bag from the record alone
+    (the server gone); a record edited, or cut short, does not verify."""
+    monkeypatch.setenv("SEMSEARCH_CACHE", str(tmp_path / "cache"))
+    bridge, make = robot
+    make("452")
+    folder = tmp_path / "live"
+    with ChatServer(first_target) as srv:
+        res = api.ros_live(bridge.url, f"llm[base_url={srv.base_url},model=scripted]", "452", out=folder, silence=20.0,
+                           max_distance=12.0)
+        calls = len(srv.requests)
+    assert res.outcome == "budget" and len(res.decisions) > 3 and calls >= len(res.decisions)
+    assert res.costs["llm_calls"] == calls and res.costs["tokens_in"] == 100 * calls and res.costs["tokens_out"] == 3 * calls
+    assert sorted(p.name for p in folder.iterdir()) == ["bag", "decisions.json", "run.json", "transcripts.jsonl"]
+    transcript = [json.loads(line) for line in (folder / "transcripts.jsonl").read_text().splitlines()]
+    assert len(transcript) >= len(res.decisions) and all("452" in json.dumps(t) for t in transcript[:1])
+    run = json.loads((folder / "run.json").read_text())
+    assert run["format"] == "semsearch-live" and run["costs"] == res.costs and run["decisions"] == res.decisions
+    record = json.loads((folder / "decisions.json").read_text())
+    assert record["planner"].startswith("llm[") and record["goal"] == "452" and record["engine"] == 2
+    assert res.repro == folder / "bag"
+    r = CliRunner().invoke(app, ["verify", str(folder)])  # the server is gone: the record answers
+    assert r.exit_code == 0, r.output
+    assert "1 of 1 runs replayed from their decisions" in r.output
+    # tampered: a choice moved to another cell, then the record cut short
+    items = record["decisions"]
+    k = next(i for i, item in enumerate(items) if isinstance(item, list))
+    record["decisions"] = items[:k] + [[items[k][0] + 1, items[k][1]]] + items[k + 1:]
+    (folder / "decisions.json").write_text(json.dumps(record))
+    r = CliRunner().invoke(app, ["verify", str(folder)])
+    assert r.exit_code == 1 and "does not replay: live run llm[" in r.output, r.output
+    record["decisions"] = items[:-1]
+    (folder / "decisions.json").write_text(json.dumps(record))
+    r = CliRunner().invoke(app, ["verify", str(folder)])
+    assert r.exit_code == 1 and "does not replay" in r.output, r.output

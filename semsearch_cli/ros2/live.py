@@ -19,9 +19,16 @@ publishes explore_lite's ``/explore/frontiers`` (the candidates as markers, the 
 and resumes (True: a re-plan at once), as explore_lite's. The run ends when the goal's sign is
 read (found; the goal under way is cancelled), when the planner has nowhere left to go (stuck),
 at ``max_distance`` (budget), when the robot has been silent for ``silence`` seconds (lost), or
-on Ctrl-C (interrupted). A run that ends otherwise than found leaves a repro bag: the map, poses
-and detections it received, in the order it took them, which ``semsearch ros replay BAG --goal``
-replays to the same re-plans.
+on Ctrl-C (interrupted).
+
+The planner is seated as in a batch (a :class:`~semsearch_cli.tasks.decisions.Recording`): a
+language model keeps its transcript and its cost columns, and every run keeps its decisions
+record. With ``out`` (``semsearch ros live --out``), a run writes its folder: the bag of the
+messages it took, in the order it took them (``bag/``, for every outcome), which ``semsearch
+ros replay`` replays to the same re-plans and ``semsearch verify`` replays from the record
+alone; ``run.json``, ``decisions.json`` and the planner's ``transcripts.jsonl``
+(:func:`semsearch_cli.api.ros_live` writes them). Without it, a run that ends otherwise than found
+leaves its bag at ``repro`` (before 0.4.0 the only output).
 """
 
 from __future__ import annotations
@@ -41,6 +48,7 @@ from urllib.parse import urlparse
 
 from ..errors import ScenarioError
 from ..optional import lazy_module
+from ..tasks.decisions import Recording
 from .bag import BagWriter, Messages, drop_bag, from_json, to_json
 from .robot import (ABORTED, DETECTIONS, GOAL_STATUS, MAP, NAVIGATE_ACTION, POSE_TYPES, RESUME, SUCCEEDED, GoalWriter,
                     RobotSession, RobotTask, goal_ended, map_frame, refusal)
@@ -75,7 +83,9 @@ class LiveRun:
     """What a live run gave: its outcome (found, stuck, budget, lost, interrupted), the distance
     its poses travelled (m, straight lines between them), the poses, the decisions [{step,
     target_cell, target}], the NavigateToPose goals sent (none with ``publish_only``), a note,
-    and the repro bag (None when found)."""
+    the repro bag (None when found), the bag of every run when the run has a folder (``bag``), and
+    what the seat kept: the planner's ``costs`` (a batch row's cost columns), its ``transcripts``
+    and the decisions ``record``."""
 
     outcome: str
     distance: float
@@ -85,6 +95,10 @@ class LiveRun:
     message: str = ""
     repro: Path | None = None
     dropped: str = ""  # the robot's messages not taken as they came, by reason (RobotSession.dropped_text)
+    bag: Path | None = None  # every run's messages, when the run has a folder (out/bag)
+    costs: dict = field(default_factory=dict)
+    transcripts: list = field(default_factory=list)
+    record: dict | None = None
 
 
 class _Repro:
@@ -137,14 +151,21 @@ class Live:
     :class:`LiveRun`."""
 
     def __init__(self, url: str, variant, goal, sc=None, publish_only: bool = False, repro: Path | None = None,
-                 margin: float = 10.0, max_distance: float | None = None, silence: float = 30.0, log=None):
+                 margin: float = 10.0, max_distance: float | None = None, silence: float = 30.0, log=None,
+                 out: Path | None = None):
         self.host, self.port, self.secure = rosbridge_address(url)
         self.variant, self.goal, self.sc = variant, goal, sc
         self.publish_only, self.margin, self.silence = publish_only, margin, silence
         self.max_distance = max_distance if max_distance is not None else math.inf
-        self.repro_path = Path(repro) if repro is not None else Path(f"live-repro-{time.strftime('%Y%m%d-%H%M%S')}")
-        if self.repro_path.exists():
+        self.folder = Path(out) if out is not None else None  # the run's folder: its bag kept for every outcome
+        if self.folder is not None and self.folder.exists():
+            raise ScenarioError(str(self.folder), "--out", "exists already: give a new folder for the run")
+        if repro is None and self.folder is None:
+            repro = Path(f"live-repro-{time.strftime('%Y%m%d-%H%M%S')}")
+        self.repro_path = Path(repro) if repro is not None else None
+        if self.repro_path is not None and self.repro_path.exists():
             raise ScenarioError(str(self.repro_path), "--repro", "exists already: give a new folder for the repro bag")
+        self.seat = Recording()  # the planner seated as in a batch: its costs, transcript and choices kept
         self.log = log or (lambda text: None)
         self.m = Messages()
         self.q: queue.Queue = queue.Queue()
@@ -201,7 +222,9 @@ class Live:
             sub.subscribe(self._enqueue if t == MAP else (lambda msg, t=t: self.q.put((t, msg))))
             subs.append(sub)
         ros.on("close", lambda *_: self.q.put(("closed", None)))
-        self.repro = _Repro(self.repro_path, self.m)
+        if self.folder is not None:
+            self.folder.mkdir(parents=True)
+        self.repro = _Repro(self.folder / "bag" if self.folder is not None else self.repro_path, self.m)
         res = None
         try:
             res = self._loop()
@@ -217,14 +240,18 @@ class Live:
             time.sleep(0.05)  # the last messages out before the socket closes
             with contextlib.suppress(Exception):
                 ros.close()
-            if res is not None and res.outcome == "found":
+            if res is not None and res.outcome == "found" and self.folder is None:
                 self.repro.drop()
-            else:  # a failed run's, or what a run that raised had taken: kept
+            else:  # a failed run's, or what a run that raised had taken, or any run that has a folder: kept
                 kept = self.repro.keep()
+                if self.folder is not None and self.repro_path is not None and (res is None or res.outcome != "found"):
+                    shutil.copytree(kept, self.repro_path)  # --repro beside --out: a failed run's bag there too
+                    kept = self.repro_path
                 if res is None:
                     self.log(f"stopped: the messages taken so far are in {kept}")
                 else:
-                    res.repro = kept
+                    res.bag = self.folder / "bag" if self.folder is not None else None
+                    res.repro = kept if res.outcome != "found" else None
         return res
 
     def _enqueue(self, msg) -> None:
@@ -342,7 +369,8 @@ class Live:
             except ValueError as exc:  # checked before (a margin too wide for this map): the next map may do
                 return self._drop(topic, str(exc))
             self.out = GoalWriter(self._publish, self.m, frame)
-            s = self.session = RobotSession(RobotTask(frame, self.sc), self.variant.build(), self.goal, self.out, self.pose_topic)
+            s = self.session = RobotSession(RobotTask(frame, self.sc), self.variant, self.goal, self.out, self.pose_topic,
+                                            seat=self.seat)
             s.dropped.update(self.dropped_early)
             self.log(f"map: {frame.width} x {frame.height} cells at {frame.res:g} m (the first map and {self.margin:g} m "
                      "around it)")
@@ -402,8 +430,13 @@ class Live:
             early = "; ".join(f"{n} {topic} ({why})" for (topic, why), n in self.dropped_early.items())
             return LiveRun(outcome, 0.0, 0, [], len(self._goal_ids), message, dropped=early)
         skipped = f"{self.superseded} /map skipped for a newer one waiting" if self.superseded else ""
+        s.finish()
+        kept = s.seated()
+        if outcome == "budget" and kept["notes"]:
+            message = kept["notes"]  # the planner's own budget (a language model's calls) ended the run
         return LiveRun(outcome, s.st.distance, s.st.steps + s.posed, self.out.rows, len(self._goal_ids), message,
-                       dropped="; ".join(filter(None, (s.dropped_text(), skipped))))
+                       dropped="; ".join(filter(None, (s.dropped_text(), skipped))), costs=kept["costs"],
+                       transcripts=kept["transcripts"], record=kept["record"])
 
 
 def _status(res) -> int:

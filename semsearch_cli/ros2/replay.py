@@ -38,10 +38,11 @@ from ..optional import lazy_module
 from ..planners import Variant
 from ..runner.specs import Loaded
 from ..tasks.base import RobotState
-from ..tasks.decisions import set_rng
+from ..tasks.decisions import Seat, set_rng
+from ..tasks.loop import answer_all
 from ..tasks.doors import DoorSearch, DoorTask
 from .bag import BagWriter, Messages, drop_bag, rosbag2
-from .robot import (BASE_FRAMES, MAX_MAP_CELLS, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree, drive,
+from .robot import (BASE_FRAMES, MAX_MAP_CELLS, POSE_TOPICS, GoalWriter, RobotSession, RobotTask, TfTree,
                     map_frame, refusal, within)
 
 
@@ -208,13 +209,17 @@ class Replayed:
 
 
 def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fmt: str = "mcap", goal=None,
-               margin: float = 10.0) -> Replayed:
+               margin: float = 10.0, seat: Seat | None = None, max_distance: float | None = None) -> Replayed:
     """Run door planner ``variant`` over ``bag`` and write its decisions to the new bag folder
     ``out`` (which must not exist). A bag ``semsearch export`` wrote replays on ``loaded``, the
     scenario it was recorded on; a robot's own bag needs ``goal`` (the label to find), is folded
     into a grid of its first map and ``margin`` metres around it (as ``ros live`` folds a robot's
     maps), and takes the belief's, robot's and navigation's settings from ``loaded`` when given,
-    else their defaults."""
+    else their defaults. ``seat`` answers the re-plans' decisions (default: the variant's planner,
+    seated as in a batch; a :class:`~semsearch_cli.tasks.decisions.Replay` answers from a live
+    run's record, no planner built). ``max_distance``: a robot's bag ends at the first pose that
+    has travelled it (where ``ros live --max-distance`` ended the run), before its re-plan."""
+    seat = Seat() if seat is None else seat
     if loaded is not None and not isinstance(loaded.task, DoorTask):
         raise ScenarioError(str(loaded.path), "kind", f"is {loaded.task.kind}: a bag replays door planners only")
     msgs = Messages()
@@ -247,7 +252,7 @@ def replay_bag(loaded: Loaded | None, bag: Path, variant: Variant, out: Path, fm
         writer = None
         try:
             writer = BagWriter(work / out.name, fmt, msgs)
-            found, rows, dropped = run(task, variant, goal, stream, writer, frame, rng_inc)
+            found, rows, dropped = run(task, variant, goal, stream, writer, frame, rng_inc, seat, max_distance)
             writer.close()
         except BaseException as exc:
             drop_bag(writer, work)
@@ -320,8 +325,9 @@ def _setup(stream: BagStream, bag: Path) -> dict:
     return setup
 
 
-def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc: int) -> tuple[bool, list]:
-    planner = variant.build()
+def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc: int, seat: Seat,
+         max_distance=None) -> tuple[bool, list]:
+    planner = seat.planner(variant)
     out = GoalWriter(writer.write, writer.msgs, frame)
     st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
     rng = np.random.default_rng(0)
@@ -339,11 +345,12 @@ def _run(task, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_i
             search.update(st)
         elif ev["event"] == "plan" and ev.get("plan") == "start":
             set_rng(rng, ev["rng"])
-            _plan(search, st)
+            _plan(search, st, seat)
             while (item := stream.next()) is not None:  # what the bag's re-plan sensed and this one did not ask for
                 ev = _fold(search, st, item)
                 if ev is not None and ev["event"] == "plan":
                     break
+    seat.finish()
     return search.found, out.rows, ""
 
 
@@ -360,10 +367,10 @@ def _fold(search: ReplaySearch, st: RobotState, item) -> dict | None:
     return None
 
 
-def _plan(search: ReplaySearch, st: RobotState) -> None:
-    """One re-plan, each decision point answered by the planner under test; its path is not
-    followed (the bag's robot moves as it moved)."""
-    drive(search.plan(st))
+def _plan(search: ReplaySearch, st: RobotState, seat: Seat) -> None:
+    """One re-plan, each decision point answered by the seat (the planner under test); its path is
+    not followed (the bag's robot moves as it moved)."""
+    answer_all(search.plan(st), seat.decide)
 
 
 def _robot_frame(bag: Path, msgs: Messages, margin: float) -> GridFrame:
@@ -386,11 +393,12 @@ def _robot_frame(bag: Path, msgs: Messages, margin: float) -> GridFrame:
         stream.close()
 
 
-def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc=None) -> tuple[bool, list]:
+def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWriter, frame, rng_inc=None,
+               seat: Seat | None = None, max_distance: float | None = None) -> tuple[bool, list]:
     """A robot's bag, through :class:`~semsearch_cli.ros2.robot.RobotSession` (as ``ros live``
-    runs a robot): its robot moves as it moved, the planner is asked where it would go."""
+    runs a robot): its robot moves as it moved, the seat (the planner) is asked where it would go."""
     out = GoalWriter(writer.write, writer.msgs, frame)
-    session = RobotSession(task, variant.build(), goal, out, next((t for t in POSE_TOPICS if t in stream.topics), None))
+    session = RobotSession(task, variant, goal, out, next((t for t in POSE_TOPICS if t in stream.topics), None), seat=seat)
     tf = TfTree()  # no pose topic: /tf, map -> odom -> base_link
     while (item := stream.next()) is not None:
         topic, t, msg = item
@@ -406,7 +414,10 @@ def _run_robot(task: RobotTask, variant, goal, stream: BagStream, writer: BagWri
             what = session.take(topic, msg)
         if what == "found":
             break
+        if max_distance is not None and session.st.distance >= max_distance:
+            break  # where the live run's budget ended it, before the re-plan
         if what == "plan":
-            session.plan()
+            session.plan()  # a plan that ends the run (stuck, a spent budget) ended the live run's bag there too
+    session.finish()
     return session.found, out.rows, session.dropped_text()
 

@@ -44,8 +44,12 @@ from ..config import BeliefSpec, DoorCameraSpec, NavigationSpec, RobotSpec
 from ..config.base import sign_label
 from ..geometry import GridFrame
 from ..world.images import MAX_CELLS
+from ..errors import BudgetSpent
+from ..planners import Variant
 from ..tasks.base import Observer, RobotState
+from ..tasks.decisions import Recording, Seat
 from ..tasks.doors import DoorDecision, DoorSearch
+from ..tasks.loop import answer_all
 
 MAP, DETECTIONS, RESUME = "/map", "/semsearch/detections", "/explore/resume"
 GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray: Nav2's goals and how they ended
@@ -372,11 +376,25 @@ class RobotSearch(DoorSearch):
 class RobotSession:
     """One door search over a robot's messages (see the module's text), taken one at a time by
     :meth:`take`: it says when the goal's sign was read and when to re-plan, and :meth:`plan`
-    re-plans (the planner answers each decision point; decisions go to ``observer``)."""
+    re-plans; decisions go to ``observer``.
 
-    def __init__(self, task: RobotTask, planner, goal, observer=None, pose_topic: str | None = None):
+    Its planner is seated as in a batch (:class:`~semsearch_cli.tasks.decisions.Seat`, or the
+    ``seat`` given): ``planner`` is a :class:`~semsearch_cli.planners.Variant` (built by the
+    seat: a :class:`~semsearch_cli.tasks.decisions.Replay` seats a stand-in that answers from a
+    record) or a built planner; the seat answers each decision point, keeps the planner's costs
+    and transcript (a language model's calls, tokens and prompts: :meth:`seated`), and a
+    :class:`~semsearch_cli.tasks.decisions.Recording` keeps the choices. The run's identity, as a
+    planner that asks for it is given it: the scenario's name (``robot`` without one), goal,
+    episode 0, seed 0."""
+
+    def __init__(self, task: RobotTask, planner, goal, observer=None, pose_topic: str | None = None, seat: Seat | None = None):
         self.task, self.goal = task, sign_label(goal)
         self.st = RobotState(0.0, 0.0, 0.0, belief=task.new_belief())
+        self.seat = seat if seat is not None else Seat()
+        label = planner.label if isinstance(planner, Variant) else getattr(planner, "name", type(planner).__name__)
+        self.seat.run = {"scenario": getattr(task.sc, "name", "robot"), "kind": "doors", "planner": label,
+                         "goal": str(self.goal), "episode": 0, "seed": 0}
+        planner = self.seat.planner(planner) if isinstance(planner, Variant) else self.seat.seat(planner)
         self.search = RobotSearch(task, planner, self.goal, np.random.default_rng(0), observer)
         self.pose_topic = pose_topic  # None: the first of POSE_TOPICS that speaks
         self.pending: list = []  # labels read since the last pose
@@ -486,17 +504,24 @@ class RobotSession:
                 and self.search.replan_due(self.done, self.since, self.event))
 
     def plan(self):
-        """One re-plan, each decision point answered by the planner: waypoints ``(xs, ys)`` (m),
-        or an outcome (``stuck``: nowhere left to go)."""
+        """One re-plan, each decision point answered by the seat (the planner): waypoints
+        ``(xs, ys)`` (m), or an outcome (``stuck``: nowhere left to go; ``budget``: the planner's
+        own budget, a language model's calls, is spent)."""
         self.since, self.event, self.done = 0.0, False, False
-        return drive(self.search.plan(self.st))
+        try:
+            return answer_all(self.search.plan(self.st), self.seat.decide)
+        except BudgetSpent:
+            return "budget"
 
+    def seated(self) -> dict:
+        """What the seat kept of the run's planner: ``costs`` (column -> number, as a batch row's
+        cost columns), ``transcripts`` (a language model's prompts and replies) and ``notes`` (why
+        its own budget ended the run); and ``record``, the decisions record, when the seat is a
+        :class:`~semsearch_cli.tasks.decisions.Recording` (None otherwise)."""
+        s = self.seat
+        record = s.record("doors") | s.run if isinstance(s, Recording) else None
+        return {"costs": s.costs(), "transcripts": s.transcripts(), "notes": s.notes(), "record": record}
 
-def drive(gen):
-    """Run a re-plan's generator, each decision point answered by its planner; its plan."""
-    try:
-        point = next(gen)
-        while True:
-            point = gen.send(point.ask())
-    except StopIteration as stop:
-        return stop.value
+    def finish(self) -> None:
+        """The run is over: the seat's checks at the end (a replayed transcript or record used up)."""
+        self.seat.finish()
