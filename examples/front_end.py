@@ -12,6 +12,7 @@ import numpy as np
 
 from semsearch_cli.planners import Decision
 from semsearch_cli.runner import Loaded
+from semsearch_cli.shipped import scenario_file
 from semsearch_cli.tasks.decisions import Agent, DecisionPoint
 
 
@@ -24,7 +25,7 @@ def nearest(ctx, cands) -> Decision | None:
 
 
 def main(scenario: str = "demo", goal: str = "304", pick=nearest, show=print) -> dict:
-    task = Loaded.load(scenario).task
+    task = Loaded.load(scenario_file(scenario)).task  # a file, or a shipped scenario's name
     episode = task.as_episode(goal)
     run = task.open(None, episode, seed=0, seat=Agent("user", replan_on_signs=True))
     point = run.start()
