@@ -149,3 +149,20 @@ def test_a_kind_of_before_0_4_runs_with_a_warning():
                 old.open(None, ep, 0, seat=Agent()).start()
     finally:
         TASKS.pop("doors_before_0_4", None)
+
+
+def test_a_chain_is_opened_and_stepped_through_all_its_stages(tmp_path):
+    """A chain's run meets the decisions of its stages, kept and from scratch, in the order they
+    run; stepped from outside it is the batch's run, its stage rows too."""
+    chain = Loaded.load(TASKS["chain"].example(tmp_path / "chain", "greedy")).task
+    v, ep = Variant("greedy", ()), chain.episodes[0]
+    batch = chain.run(v, ep, 1)
+    h = chain.open(v, ep, 1)
+    point, n = h.start(), 0
+    while isinstance(point, DecisionPoint):
+        point = h.answer(point.ask())
+        n += 1
+    same(h.result(), batch)
+    assert len(h.result().stages) == len(batch.stages) > 2 and n > batch.decisions
+    drop = lambda rows: [{k: v for k, v in r.items() if k != "wall_s"} for r in rows]  # noqa: E731
+    assert drop(h.rows()) == drop(chain.rows(v, ep, 1, batch))
