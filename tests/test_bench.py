@@ -647,3 +647,22 @@ def test_a_salt_file_that_is_a_fifo_a_folder_or_huge_is_refused_without_reading_
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)
+
+
+def test_the_suite_hash_is_kept_once_and_a_verdict_goes_stale_with_bench_json(bench_two, tmp_path):
+    """verify.json keeps no copy of the suite hash: it digests bench.json (where the folder keeps its
+    hash) with the rows, so an edit of either makes the verdict stale; a verify.json written before
+    0.4.0 (the hash copied in, the rows digested alone) still reads."""
+    b = _copy(bench_two, tmp_path)
+    assert api.verify(b, workers=1).verdict.verified == 2
+    v = json.loads((b / "verify.json").read_text())
+    assert "hash" not in v and v["rows"] == bench.board.rows_digest(b)
+    meta = json.loads((b / "bench.json").read_text())
+    assert bench.board.verdict_of(b, meta["hash"]) == "verified"
+    (b / "bench.json").write_text(json.dumps(meta, indent=2))  # the same hash, another bench.json
+    assert bench.board.verdict_of(b, meta["hash"]) == "changed since verified"
+    old = {"hash": meta["hash"], **{k: v[k] for k in ("runs", "verified", "failed", "unfinished")},
+           "rows": bench.board.rows_digest(b, with_meta=False)}
+    (b / "verify.json").write_text(json.dumps(old))
+    assert bench.board.verdict_of(b, meta["hash"]) == "verified"
+    assert bench.board.verdict_of(b, "0" * 64) == "changed since verified"

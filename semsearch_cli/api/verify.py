@@ -115,5 +115,5 @@ def _verify_bench(folder: Path, salt_file=None, progress=None, workers: int | No
         v.failed += [(f"{'the bench folder' if fid == '(top)' else f'floor {fid}'}: {name}", why) for name, why in fv.failed]
     if not v.runs:
         raise ScenarioError(str(folder), "", "holds no floor with rows to verify")
-    bench.board.write_verdict(folder, split.hash, v.runs, v.verified, len(v.failed), v.unfinished)
+    bench.board.write_verdict(folder, v.runs, v.verified, len(v.failed), v.unfinished)
     return VerifyOutput(folder, f"{split.suite.name} {split.name}, hash {split.hash[:16]}", v)

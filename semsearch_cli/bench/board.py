@@ -43,22 +43,28 @@ GAPS = {"doors": ("greedy", "oracle_goal")}
 VERIFY_FILE = "verify.json"
 
 
-def rows_digest(folder: Path) -> str:
-    """A digest of a bench folder's rows (every floor's runs.csv, in floor order): what a verdict
-    was reached on."""
+def rows_digest(folder: Path, with_meta: bool = True) -> str:
+    """A digest of a bench folder's bench.json (its suite, split and suite hash: the one place a
+    folder keeps its hash) and rows (every floor's runs.csv, in floor order): what a verdict was
+    reached on. ``with_meta`` False: the rows alone, as verify.json before 0.4.0 digested them."""
     h = hashlib.sha256()
+    meta = Path(folder) / "bench.json"
+    if with_meta and meta.is_file():
+        h.update(b"bench.json")
+        h.update(meta.read_bytes())
     for f in sorted(Path(folder).glob("*/runs.csv")):
         h.update(f.parent.name.encode())
         h.update(f.read_bytes())
     return h.hexdigest()
 
 
-def write_verdict(folder: Path, split_hash: str, runs: int, verified: int, failed: int, unfinished: int = 0) -> None:
-    """Record a verification of a bench folder beside its rows (``verify.json``); ``unfinished``:
-    its error and timeout runs, which keep no record and claim no result."""
-    atomic_text(Path(folder) / VERIFY_FILE, json.dumps({"hash": split_hash, "runs": runs, "verified": verified,
-                                                        "failed": failed, "unfinished": unfinished,
-                                                        "rows": rows_digest(folder)}, indent=1) + "\n")
+def write_verdict(folder: Path, runs: int, verified: int, failed: int, unfinished: int = 0) -> None:
+    """Record a verification of a bench folder beside its rows (``verify.json``): its counts, and
+    the digest of bench.json and the rows it was reached on (the suite hash is bench.json's, kept
+    there once); ``unfinished``: its error and timeout runs, which keep no record and claim no result."""
+    atomic_text(Path(folder) / VERIFY_FILE, json.dumps({"runs": runs, "verified": verified, "failed": failed,
+                                                        "unfinished": unfinished, "rows": rows_digest(folder)},
+                                                       indent=1) + "\n")
 
 
 MAX_VERIFY_BYTES = 1_000_000  # a verify.json semsearch writes is a few hundred bytes
@@ -82,7 +88,11 @@ def verdict_of(folder: Path, split_hash: str) -> str:
     counts = ("runs", "verified", "failed")
     if not isinstance(v, dict) or not all(isinstance(v.get(k), int) and not isinstance(v.get(k), bool) for k in counts):
         raise ScenarioError(str(f), "", f"{bad} (not an object of its counts: runs, verified, failed)")
-    if v.get("hash") != split_hash or v.get("rows") != rows_digest(folder):
+    if "hash" in v:  # written before 0.4.0: the suite hash copied in, the rows digested alone
+        stale = v["hash"] != split_hash or v.get("rows") != rows_digest(folder, with_meta=False)
+    else:
+        stale = v.get("rows") != rows_digest(folder)
+    if stale:
         return "changed since verified"
     unfinished = v.get("unfinished", 0) if isinstance(v.get("unfinished", 0), int) else 0
     return "verified" if v["failed"] == 0 and v["verified"] + unfinished == v["runs"] else f"{v['failed']} failed"
