@@ -434,3 +434,30 @@ def test_a_language_model_on_a_robot_is_seated_as_in_a_batch_and_its_run_folder_
     (folder / "decisions.json").write_text(json.dumps(record))
     r = CliRunner().invoke(app, ["verify", str(folder)])
     assert r.exit_code == 1 and "does not replay" in r.output, r.output
+
+
+@pytest.mark.parametrize("name,make,says", [
+    ("run.json not JSON", lambda d: (d / "run.json").write_text("{"), ["run.json", "not a live run's run.json"]),
+    ("run.json a list", lambda d: (d / "run.json").write_text("[1]"), ["run.json", "not a JSON object"]),
+    ("run.json of another format", lambda d: (d / "run.json").write_text('{"format": "x"}'), ["run.json", "format"]),
+    ("run.json without its goal", lambda d: (d / "run.json").write_text(json.dumps(
+        {"format": "semsearch-live", "version": 1, "decisions": [], "planner": "greedy", "outcome": "found", "margin": 10})),
+     ["run.json", "goal"]),
+    ("the bag gone", lambda d: (d / "run.json").write_text(json.dumps(
+        {"format": "semsearch-live", "version": 1, "decisions": [], "planner": "greedy", "goal": "304", "outcome": "found",
+         "margin": 10})), ["bag", "is gone"]),
+])
+def test_a_live_folder_that_is_not_one_is_refused_in_one_paragraph(tmp_path, name, make, says):
+    d = tmp_path / "live"
+    d.mkdir()
+    make(d)
+    r = CliRunner().invoke(app, ["verify", str(d)])
+    assert r.exception is None or isinstance(r.exception, SystemExit), r.output  # no traceback
+    assert r.exit_code == 2 and all(w in " ".join(r.output.split()) for w in says), r.output
+
+
+def test_ros_live_refuses_an_out_folder_that_exists(tmp_path):
+    (tmp_path / "live").mkdir()
+    r = CliRunner().invoke(app, ["ros", "live", "--rosbridge", "ws://127.0.0.1:9", "--planner", "greedy", "--goal", "304",
+                                 "--out", str(tmp_path / "live")])
+    assert r.exit_code == 2 and "--out" in r.output and "exists already" in r.output, r.output

@@ -60,14 +60,10 @@ def write_live_folder(folder: Path, res, *, planner: str, goal: str, scenario: P
 
 
 def is_live_folder(folder: Path) -> bool:
-    """Whether ``folder`` is a live run's (it has a ``run.json`` of this format)."""
-    path = Path(folder) / "run.json"
-    if not path.is_file():
-        return False
-    try:
-        return read_run(path).get("format") == FORMAT
-    except ScenarioError:
-        return False
+    """Whether ``folder`` is a live run's: it has a ``run.json`` and no ``runs.csv`` (a results
+    folder's). A run.json that is not one is then named by :func:`verify_live`."""
+    folder = Path(folder)
+    return (folder / "run.json").is_file() and not (folder / "runs.csv").exists()
 
 
 def read_run(path: Path) -> dict:
@@ -89,6 +85,9 @@ def verify_live(folder: Path, loaded=None) -> Verdict:
     settings came from (the one ``run.json`` names, loaded by the caller), or None."""
     folder = Path(folder)
     run = read_run(folder / "run.json")
+    if run.get("format") != FORMAT:
+        raise ScenarioError(str(folder / "run.json"), "format", f"is {str(run.get('format'))[:40]!r}: not a live run's "
+                            f"run.json (\"format\": \"{FORMAT}\", written by semsearch ros live --out)")
     if run.get("version") != VERSION or not isinstance(run.get("decisions"), list):
         raise ScenarioError(str(folder / "run.json"), "version", f"a live run of version {run.get('version')!r}; this "
                             f"semsearch reads version {VERSION}")
