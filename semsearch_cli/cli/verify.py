@@ -44,8 +44,10 @@ def verify(
         notes.append(f"{v.unfinished} error or timeout run(s) not replayed (a run that did not finish keeps no record; "
                      "they claim no result)")
     more = "".join(f"; {n}" for n in notes)
-    out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to the outcome, distance, steps and "
-              f"decisions recorded{more} ({res.what or ('suite' if isinstance(res.scenario, str) else 'scenario')} {res.scenario})",
+    checked = ("the re-plans (step, target) and the outcome recorded, over the run's bag" if res.what == "settings of"
+               else "the outcome, distance, steps and decisions recorded")
+    out.print(f"{folder}: {v.verified} of {v.runs} runs replayed from their decisions to {checked}{more} "
+              f"({res.what or ('suite' if isinstance(res.scenario, str) else 'scenario')} {res.scenario})",
               highlight=False, soft_wrap=True)
     if v.failed:
         out.print(f"{len(v.failed)} problem(s): the folder does not verify", highlight=False, soft_wrap=True)
