@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from semsearch_cli.envs.base import compass_move, compass_step
 from semsearch_cli.planners import Variant
 from semsearch_cli.runner import Loaded
 from semsearch_cli.tasks import TASKS, OpenEpisode, Outcome, Task, register_task
@@ -120,19 +121,19 @@ def test_misuse_is_refused_with_a_sentence():
 
 
 def test_a_kind_of_before_0_4_runs_with_a_warning():
-    """``episode(..., decide)`` answering its own decisions, no ``steps``: registered with a
-    DeprecationWarning naming the replacement and the releases; the batch runs it as before; it
-    cannot be stepped from outside."""
+    """A kind (here one that extends door search, as another package would) whose own
+    ``episode(..., decide)`` answers its decisions: registered with a DeprecationWarning naming the
+    replacement and the releases; the batch calls that episode (its record shows it) and makes the
+    run as before; it cannot be stepped from outside."""
 
     class OldDoors(DoorTask):
         kind = "doors_before_0_4"
-        steps = Task.steps  # as a kind written before 0.4.0 has it: not its own
 
         def episode(self, state, planner, goal, rng, observer=None, decide=None):
             state.belief = self.new_belief()
             search = DoorSearch(self, planner, goal, rng, observer)
             out = run_loop(search, state, self.sc.robot.step, self.sc.experiment.max_distance, self.max_steps(), decide=decide)
-            return Outcome(out, state.distance, state.steps, search.decisions), state
+            return Outcome(out, state.distance, state.steps, search.decisions, record={"mine": 1}), state
 
     with pytest.warns(DeprecationWarning, match=r"episode\(\.\.\., decide\) answers its own decisions.*since semsearch "
                       r"0\.4\.0 and will be removed in 0\.5\.0: write its steps"):
@@ -142,13 +143,47 @@ def test_a_kind_of_before_0_4_runs_with_a_warning():
         old = OldDoors(task.sc, task.world, task.path)
         old.shortest, old._episodes = task.shortest, task.episodes
         v, ep = Variant("greedy", ()), task.episodes[0]
-        same(old.run(v, ep, 0), task.run(v, ep, 0))
+        res = old.run(v, ep, 0)
+        same(res, task.run(v, ep, 0))
+        assert res.record == {"mine": 1}  # its own episode ran
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             with pytest.raises(RuntimeError, match="cannot be stepped so"):
                 old.open(None, ep, 0, seat=Agent()).start()
     finally:
         TASKS.pop("doors_before_0_4", None)
+
+
+def test_a_kind_whose_search_returns_its_outcome_runs_with_a_warning():
+    """A kind's ``search`` of before 0.4.0 runs whole and returns the Outcome (not a generator):
+    registered with a warning, and its runs are made as before."""
+
+    class OldSearch(DoorTask):
+        kind = "doors_search_before_0_4"
+
+        def search(self, variant, ep, seed, st, rng, seat, observer):
+            out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
+            return out
+
+    with pytest.warns(DeprecationWarning, match=r"search\(\) runs whole and returns its Outcome.*0\.5\.0"):
+        register_task(OldSearch)
+    try:
+        task = task_of("demo")
+        old = OldSearch(task.sc, task.world, task.path)
+        old.shortest, old._episodes = task.shortest, task.episodes
+        v, ep = Variant("nsos", (("alpha", 0.9),)), task.episodes[1]
+        same(old.run(v, ep, 2), task.run(v, ep, 2))
+    finally:
+        TASKS.pop("doors_search_before_0_4", None)
+
+
+def test_episode_takes_the_kinds_own_options():
+    """``Task.episode`` (the planner answering) passes a kind's own options on to its ``steps``:
+    door search's ``reuse_reads``."""
+    task = task_of("demo")
+    st = task.start_state(task.episodes[0], np.random.default_rng(0))
+    out, st = task.episode(st, Variant("greedy", ()).build(), 304, np.random.default_rng(1), reuse_reads=True)
+    assert out.outcome == "found" and out.decisions > 0
 
 
 def test_a_chain_is_opened_and_stepped_through_all_its_stages(tmp_path):
@@ -166,3 +201,14 @@ def test_a_chain_is_opened_and_stepped_through_all_its_stages(tmp_path):
     assert len(h.result().stages) == len(batch.stages) > 2 and n > batch.decisions
     drop = lambda rows: [{k: v for k, v in r.items() if k != "wall_s"} for r in rows]  # noqa: E731
     assert drop(h.rows()) == drop(chain.rows(v, ep, 1, batch))
+
+
+def test_compass_step_still_counts_the_step_and_compass_move_leaves_it_to_the_episode():
+    """An environment of before 0.4.0 that steps its robot itself keeps ``compass_step`` (the step
+    counted); the built-in ones move with ``compass_move`` and let ``OpenEpisode.take`` count."""
+    task = task_of("demo")
+    w = task.world
+    a, b = task.start_state(task.episodes[0], np.random.default_rng(0)), task.start_state(task.episodes[0], np.random.default_rng(0))
+    assert compass_step(a, 0, 0.1, w.cspace, w.frame) == compass_move(b, 0, 0.1, w.cspace, w.frame) == 0.1
+    assert (a.x, a.y, a.heading) == (b.x, b.y, b.heading)
+    assert (a.steps, a.distance, len(a.trail)) == (1, 0.1, 2) and (b.steps, b.distance, len(b.trail)) == (0, 0.0, 1)

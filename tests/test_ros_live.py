@@ -434,6 +434,14 @@ def test_a_language_model_on_a_robot_is_seated_as_in_a_batch_and_its_run_folder_
     (folder / "decisions.json").write_text(json.dumps(record))
     r = CliRunner().invoke(app, ["verify", str(folder)])
     assert r.exit_code == 1 and "does not replay" in r.output, r.output
+    record["decisions"], record["goal"] = items, "999"  # the record of another run
+    (folder / "decisions.json").write_text(json.dumps(record))
+    r = CliRunner().invoke(app, ["verify", str(folder)])
+    assert r.exit_code == 1 and "records another run (its goal: 999)" in r.output, r.output
+
+
+RUN = {"format": "semsearch-live", "version": 1, "decisions": [], "planner": "greedy", "goal": "304", "outcome": "found",
+       "margin": 10, "scenario": None, "fingerprint": None, "max_distance": None}
 
 
 @pytest.mark.parametrize("name,make,says", [
@@ -443,9 +451,13 @@ def test_a_language_model_on_a_robot_is_seated_as_in_a_batch_and_its_run_folder_
     ("run.json without its goal", lambda d: (d / "run.json").write_text(json.dumps(
         {"format": "semsearch-live", "version": 1, "decisions": [], "planner": "greedy", "outcome": "found", "margin": 10})),
      ["run.json", "goal"]),
-    ("the bag gone", lambda d: (d / "run.json").write_text(json.dumps(
-        {"format": "semsearch-live", "version": 1, "decisions": [], "planner": "greedy", "goal": "304", "outcome": "found",
-         "margin": 10})), ["bag", "is gone"]),
+    ("the bag gone", lambda d: (d / "run.json").write_text(json.dumps(RUN)), ["bag", "is gone"]),
+    ("its scenario a number", lambda d: (d / "run.json").write_text(json.dumps({**RUN, "scenario": 5})), ["run.json", "scenario"]),
+    ("its decisions an object", lambda d: (d / "run.json").write_text(json.dumps({**RUN, "decisions": {}})),
+     ["run.json", "decisions"]),
+    ("a fingerprint and no scenario", lambda d: (d / "run.json").write_text(json.dumps({**RUN, "fingerprint": "ab"})),
+     ["names no scenario", "--scenario"]),
+    ("the run stopped: its bag alone", lambda d: (d / "bag").mkdir(), ["run.json", "stopped before it ended"]),
 ])
 def test_a_live_folder_that_is_not_one_is_refused_in_one_paragraph(tmp_path, name, make, says):
     d = tmp_path / "live"

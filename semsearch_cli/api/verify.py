@@ -50,8 +50,8 @@ def _verify_live(folder: Path, scenario: str | Path | None) -> VerifyOutput:
     ``run.json`` names (or ``scenario``), none for a run on the defaults."""
     if not ros2.available("rosbags"):
         raise MissingExtra("semsearch verify (a live run's bag)", "ros")
-    run = ros2.read_run(folder / "run.json")
-    named = scenario if scenario is not None else run.get("scenario")
+    run = ros2.check_run(ros2.read_run(folder / "run.json"), folder / "run.json")
+    named = scenario if scenario is not None else run["scenario"]
     loaded = Loaded.load(scenario_file(named), planners=False) if named is not None else None
     return VerifyOutput(folder, loaded.path if loaded is not None else "the robot's defaults", ros2.verify_live(folder, loaded),
                         "settings of")

@@ -201,12 +201,12 @@ COMPASS = ("east", "north-east", "north", "north-west", "west", "south-west", "s
 TWO_PI = 2.0 * math.pi
 
 
-def compass_step(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
+def compass_move(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
     """The primitive actions of a robot on a grid, applied to ``st`` (a RobotState): 0-7 move
     ``step`` m towards ``COMPASS[a]``, the heading turning to it (a move into a cell where the
     robot's disk does not fit, ``cspace`` False, leaves it where it is); 8 and 9 turn 45 degrees
-    left and right. Returns the metres moved (the episode counts the step,
-    :meth:`~semsearch_cli.tasks.base.OpenEpisode.take`)."""
+    left and right. Returns the metres moved; the episode counts the step
+    (:meth:`~semsearch_cli.tasks.base.OpenEpisode.take`)."""
     moved = 0.0
     if a < 8:
         ang = a * math.pi / 4
@@ -217,6 +217,16 @@ def compass_step(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
             st.x, st.y, moved = x, y, step
     else:
         st.heading = (st.heading + (math.pi / 4 if a == 8 else -math.pi / 4) + math.pi) % TWO_PI - math.pi
+    return moved
+
+
+def compass_step(st, a: int, step: float, cspace: np.ndarray, frame) -> float:
+    """:func:`compass_move`, the step counted in ``st`` too (distance, steps, trail): for an
+    environment that steps the robot itself (one written before 0.4.0, with its own ``_act``)."""
+    moved = compass_move(st, a, step, cspace, frame)
+    st.distance += moved
+    st.steps += 1
+    st.trail.append((st.x, st.y))
     return moved
 
 
@@ -248,7 +258,7 @@ def clip_text(text: str) -> str:
 
 # ---- the text observation's wording (what every kind shares is in planners/text.py) ------------
 def compass_moves(step: float) -> str:
-    """The primitive actions of :func:`compass_step`, as the text observation offers them."""
+    """The primitive actions of :func:`compass_move`, as the text observation offers them."""
     return ("Moves (a move into a wall leaves you where you are): "
             + "; ".join(f"[{k}] {step:g} m {d}" for k, d in enumerate(COMPASS))
             + "; [8] turn 45 deg left (counter-clockwise); [9] turn 45 deg right.")

@@ -64,7 +64,7 @@ from ..geometry import wrap_angle
 from ..planners import Decision
 from ..tasks.decisions import DecisionPoint
 from ..world.labels import parse_label
-from .base import (BIG, SearchEnv, box, check_flag, check_number, clip_text, compass_moves, compass_step, text_space, window)
+from .base import (BIG, SearchEnv, box, check_flag, check_number, clip_text, compass_moves, compass_move, text_space, window)
 from ..planners.text import FRAME_TEXT, answer_line, deg
 
 # The largest window radius (cells). 2048 gives a window of 4097 cells a side (410 m at 0.1 m
@@ -174,7 +174,7 @@ class DoorSearchEnv(SearchEnv):
         return None
 
     def _motion(self, st, a: int) -> float:
-        return compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
+        return compass_move(st, a, self.step_m, self._cspace, self.task.world.frame)
 
     # ---- what the agent sees ----------------------------------------------------------
     def action_masks(self) -> np.ndarray:

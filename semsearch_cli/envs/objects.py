@@ -39,7 +39,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..geometry import wrap_angle
-from .base import (BIG, SearchEnv, box, clip_text, compass_moves, compass_step, text_space)
+from .base import (BIG, SearchEnv, box, clip_text, compass_moves, compass_move, text_space)
 from ..planners.text import object_fields, place_history
 
 
@@ -82,7 +82,7 @@ class ObjectSearchEnv(SearchEnv):
         return x, y, {"place": self.names[a]}
 
     def _motion(self, st, a: int) -> float:
-        return compass_step(st, a, self.step_m, self._cspace, self.task.world.frame)
+        return compass_move(st, a, self.step_m, self._cspace, self.task.world.frame)
 
     def action_masks(self) -> np.ndarray:
         """(action_space.n,) bool. Macro: every place but the one the robot has just looked around

@@ -6,7 +6,7 @@ websockets). See docs/robot.md."""
 from ..optional import installed
 from .bag import FORMATS, TOPICS
 from .export import BagRecorder, Exported, export_folder, export_run, exportable, recorded_runs
-from .folder import is_live_folder, read_run, verify_live, write_live_folder
+from .folder import check_run, is_live_folder, read_run, verify_live, write_live_folder
 from .live import Live, LiveRun
 from .loopback import Rosbridge, SimRobot
 from .replay import Replayed, recorded_scenario, replay_bag
@@ -21,4 +21,4 @@ def available(*packages: str) -> bool:
 
 
 __all__ = ["FORMATS", "MAX_MARGIN", "TOPICS", "BagRecorder", "Exported", "Live", "LiveRun", "Replayed", "Rosbridge", "SimRobot", "available", "export_folder", "export_run", "exportable",
-           "is_live_folder", "read_run", "recorded_runs", "recorded_scenario", "replay_bag", "verify_live", "write_live_folder"]
+           "check_run", "is_live_folder", "read_run", "recorded_runs", "recorded_scenario", "replay_bag", "verify_live", "write_live_folder"]

@@ -26,8 +26,9 @@ from ..errors import ScenarioError
 from ..planners import Variant
 from ..runner.store import read_decisions, write_decisions, write_jsonl
 from ..runner.verify import Verdict
-from ..tasks.decisions import Replay, ReplayError
-from .replay import replay_bag
+from ..tasks.decisions import Recording, Replay, ReplayError
+from .bag import Messages
+from .replay import BagStream, replay_bag
 
 FORMAT = "semsearch-live"
 VERSION = 1
@@ -40,7 +41,9 @@ def write_live_folder(folder: Path, res, *, planner: str, goal: str, scenario: P
     ``res`` (a :class:`~semsearch_cli.ros2.LiveRun`) into ``folder``, beside its ``bag/``;
     each file atomically. Returns ``run.json``'s path."""
     folder = Path(folder)
-    record = dict(res.record or {})
+    # a run that ended before its first map made no decision: its record holds none
+    record = dict(res.record) if res.record is not None else {**Recording().record("doors"), "planner": planner,
+                                                               "goal": str(goal), "episode": 0, "seed": 0}
     if fingerprint is not None:
         record["fingerprint"] = fingerprint
     record["engine"] = ENGINE
@@ -60,14 +63,20 @@ def write_live_folder(folder: Path, res, *, planner: str, goal: str, scenario: P
 
 
 def is_live_folder(folder: Path) -> bool:
-    """Whether ``folder`` is a live run's: it has a ``run.json`` and no ``runs.csv`` (a results
-    folder's). A run.json that is not one is then named by :func:`verify_live`."""
+    """Whether ``folder`` is a live run's: a ``run.json`` or a ``bag/`` (a run that stopped before
+    it ended), and no ``runs.csv`` or ``bench.json`` (a results or bench folder's). A run.json
+    that is not one is then named by :func:`check_run`."""
     folder = Path(folder)
-    return (folder / "run.json").is_file() and not (folder / "runs.csv").exists()
+    ours = (folder / "run.json").is_file() or (folder / "bag").is_dir()
+    return ours and not (folder / "runs.csv").exists() and not (folder / "bench.json").exists()
 
 
 def read_run(path: Path) -> dict:
-    """A live run's ``run.json``, or a :class:`ScenarioError` naming it when it is not one."""
+    """A live run's ``run.json`` (not yet checked: :func:`check_run`), or a :class:`ScenarioError`
+    naming it when it is not JSON."""
+    if not path.is_file():
+        raise ScenarioError(str(path), "", "is gone: the live run stopped before it ended (its messages are in bag/, which "
+                            "`semsearch ros replay` replays), so there is no run to verify")
     try:
         if path.stat().st_size > MAX_RUN_BYTES:
             raise ValueError(f"larger than {MAX_RUN_BYTES:,} bytes")
@@ -79,30 +88,62 @@ def read_run(path: Path) -> dict:
     return run
 
 
+RUN_KEYS = {"planner": (str,), "goal": (str,), "outcome": (str,), "margin": (int, float), "decisions": (list,),
+            "scenario": (str, type(None)), "fingerprint": (str, type(None)), "max_distance": (int, float, type(None))}
+
+
+def check_run(run: dict, path: Path) -> dict:
+    """``run`` (a live run's run.json at ``path``) checked: its format and version, and each of
+    :data:`RUN_KEYS` of its type; else a :class:`ScenarioError` naming the file and the field."""
+    if run.get("format") != FORMAT:
+        raise ScenarioError(str(path), "format", f"is {str(run.get('format'))[:40]!r}: not a live run's run.json "
+                            f"(\"format\": \"{FORMAT}\", written by semsearch ros live --out)")
+    if run.get("version") != VERSION:
+        raise ScenarioError(str(path), "version", f"a live run of version {str(run.get('version'))[:20]!r}; this semsearch "
+                            f"reads version {VERSION}")
+    for key, kinds in RUN_KEYS.items():
+        v = run.get(key)
+        if not isinstance(v, kinds) or isinstance(v, bool):
+            raise ScenarioError(str(path), key, f"is {str(v)[:40]!r}: not a run.json semsearch wrote")
+    if run["fingerprint"] is not None and run["scenario"] is None:
+        raise ScenarioError(str(path), "scenario", "names no scenario, and the run was made with one (its fingerprint): "
+                            "give it, semsearch verify FOLDER --scenario FILE")
+    return run
+
+
 def verify_live(folder: Path, loaded=None) -> Verdict:
     """Replay a live run's bag from its decisions record (see the module's text): a
     :class:`~semsearch_cli.runner.verify.Verdict` of its one run. ``loaded``: the scenario its
     settings came from (the one ``run.json`` names, loaded by the caller), or None."""
     folder = Path(folder)
-    run = read_run(folder / "run.json")
-    if run.get("format") != FORMAT:
-        raise ScenarioError(str(folder / "run.json"), "format", f"is {str(run.get('format'))[:40]!r}: not a live run's "
-                            f"run.json (\"format\": \"{FORMAT}\", written by semsearch ros live --out)")
-    if run.get("version") != VERSION or not isinstance(run.get("decisions"), list):
-        raise ScenarioError(str(folder / "run.json"), "version", f"a live run of version {run.get('version')!r}; this "
-                            f"semsearch reads version {VERSION}")
-    for key, kind in (("planner", str), ("goal", str), ("outcome", str), ("margin", (int, float))):
-        if not isinstance(run.get(key), kind) or isinstance(run.get(key), bool):
-            raise ScenarioError(str(folder / "run.json"), key, f"is {run.get(key)!r}: not a run.json semsearch wrote")
-    if loaded is not None and run.get("fingerprint") not in (None, loaded.fingerprint):
+    run = check_run(read_run(folder / "run.json"), folder / "run.json")
+    if loaded is not None and run["fingerprint"] not in (None, loaded.fingerprint):
         raise ScenarioError(str(folder / "run.json"), "fingerprint", f"the run was made with another scenario (fingerprint "
                             f"{run['fingerprint']}; {loaded.path.name}'s is {loaded.fingerprint})")
+    name = f"live run {run['planner']} goal {run['goal']}"
+    verdict = Verdict(runs=1)
     bag = folder / "bag"
     if not bag.is_dir():
         raise ScenarioError(str(bag), "", "is gone: a live run's folder keeps the messages it took in bag/")
     record = read_decisions(folder / "decisions.json")
-    name = f"live run {run['planner']} goal {run['goal']}"
-    verdict = Verdict(runs=1)
+    ids = {"planner": run["planner"], "goal": run["goal"], "fingerprint": run["fingerprint"]}
+    other = [k for k, v in ids.items() if v is not None and str(record.get(k)) != v]
+    if other:
+        verdict.failed.append((name, f"decisions.json records another run (its {', '.join(other)}: "
+                               f"{', '.join(str(record.get(k))[:40] for k in other)})"))
+        return verdict
+    stream = BagStream(bag, Messages())
+    try:
+        mapped = "/map" in stream.topics
+    finally:
+        stream.close()
+    if not mapped:  # the run ended before its first map: it could choose nothing, and read no sign
+        if run["decisions"] or record["decisions"] or run["outcome"] == "found":
+            verdict.failed.append((name, f"the bag holds no map, and the run claims {len(run['decisions'])} decisions "
+                                   f"({len(record['decisions'])} recorded) and the outcome {run['outcome']}"))
+        else:
+            verdict.verified = 1
+        return verdict
     with tempfile.TemporaryDirectory(prefix="semsearch-verify-live-") as tmp:
         try:
             rep = replay_bag(loaded, bag, Variant(run["planner"], ()), Path(tmp) / "replayed", "mcap", run["goal"],

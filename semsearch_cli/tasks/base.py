@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import inspect
 import math
 import time
+from collections.abc import Generator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -235,7 +237,9 @@ class OpenEpisode:
         self.start_heading = self.state.heading
         self.seat.run = {"scenario": task.sc.name, "kind": task.planner_kind, "planner": self.variant.label,
                          "goal": str(ep.goal), "episode": int(ep.index), "seed": self.seed}
-        self._steps = task.search(self.variant, ep, self.seed, self.state, self.rng, self.seat, observer)
+        steps = task.search(self.variant, ep, self.seed, self.state, self.rng, self.seat, observer)
+        # a kind's search of before 0.4.0 returns its Outcome, having run whole (the seat answered)
+        self._steps = steps if isinstance(steps, Generator) else _ran(steps)
         self.session: Session | None = None
         self.point: DecisionPoint | None = None
         self.outcome: str | None = None
@@ -269,7 +273,10 @@ class OpenEpisode:
         self._started = True
         if not primitive:
             return self._advance()
-        item = self._steps.send(None)  # a search shows its loop first (tasks.loop.drive)
+        try:
+            item = self._steps.send(None)  # a search shows its loop first (tasks.loop.drive)
+        except StopIteration:
+            item = None
         if not isinstance(item, Session):
             raise RuntimeError(f"a {self.task.kind} search has no step loop to take primitive steps in")
         self.session = item
@@ -479,10 +486,11 @@ class Task:
         raise NotImplementedError
 
     def episode(self, state: RobotState, planner, goal, rng: np.random.Generator,
-                observer: Observer | None = None, decide=ask) -> tuple[Outcome, RobotState]:
+                observer: Observer | None = None, decide=ask, **options) -> tuple[Outcome, RobotState]:
         """One search for ``goal`` by ``planner`` from ``state``, its decisions answered by
-        ``decide`` (by default the planner's; :mod:`.decisions`): :meth:`steps` run to its end."""
-        return answer_all(self.steps(state, planner, goal, rng, observer), decide)
+        ``decide`` (by default the planner's; :mod:`.decisions`): :meth:`steps` run to its end
+        (``options``: the kind's own, e.g. door search's ``reuse_reads``, indirect search's ``room``)."""
+        return answer_all(self.steps(state, planner, goal, rng, observer, **options), decide)
 
     def open(self, variant: Variant | None, ep, seed: int, *, seat: Seat | None = None,
              observer: Observer | None = None) -> "OpenEpisode":
@@ -510,7 +518,7 @@ class Task:
         """One run's search from ``st`` (changed in place), as a generator of its decision points
         that returns the :class:`Outcome`: by default one :meth:`steps` of the variant's planner
         (as ``seat`` seats it) for the episode's goal."""
-        if type(self).steps is Task.steps:  # a kind of before 0.4.0: its episode() answers its own decisions
+        if answers_itself(type(self)):  # a kind of before 0.4.0: its episode() answers its own decisions
             out, _ = self.episode(st, seat.planner(variant), ep.goal, rng, observer, decide=seat.decide)
             return out
         out, _ = yield from self.steps(st, seat.planner(variant), ep.goal, rng, observer)
@@ -729,15 +737,34 @@ class OnMapTask(Task):
 TASKS = Registry("task", Task)  # kind -> its Task subclass
 
 
+def _ran(out: Outcome):
+    """A search that has run whole (a kind's ``search`` of before 0.4.0): no decision left, its outcome."""
+    return out
+    yield  # a generator, which returns at once
+
+
+def answers_itself(cls) -> bool:
+    """Whether kind ``cls`` is written as before 0.4.0: an ``episode(..., decide)`` of its own that
+    is newer (in its class hierarchy) than the ``steps`` it has, so that the batch must call it."""
+    mro = cls.__mro__
+    ep = next(k for k in mro if "episode" in vars(k))
+    st = next(k for k in mro if "steps" in vars(k))
+    return ep is not Task and mro.index(ep) < mro.index(st)
+
+
 def register_task(cls):
     """Class decorator: the task answers scenarios of kind ``cls.kind`` (a :class:`Task` subclass,
     one per kind). A kind that defines ``episode(..., decide)`` answering its own decisions, and
     no :meth:`Task.steps`, runs with a warning: it cannot be opened decision by decision."""
-    if isinstance(cls, type) and issubclass(cls, Task) and cls.steps is Task.steps and cls.episode is not Task.episode:
+    if isinstance(cls, type) and issubclass(cls, Task) and answers_itself(cls):
         warn(f"a kind whose episode(..., decide) answers its own decisions (kind {getattr(cls, 'kind', '')!r}, "
              f"{cls.__module__}.{cls.__qualname__})", "write its steps(state, planner, goal, rng, observer) as a generator "
              "over tasks.loop.drive (yield from drive(search, ...)) and drop episode(); Task.episode answers it",
              since="0.4.0", until="0.5.0")
+    if isinstance(cls, type) and issubclass(cls, Task) and not inspect.isgeneratorfunction(cls.search):
+        warn(f"a kind whose search() runs whole and returns its Outcome (kind {getattr(cls, 'kind', '')!r}, "
+             f"{cls.__module__}.{cls.__qualname__})", "write search as a generator that yields from steps() "
+             "(out, _ = yield from self.steps(...)) and returns the Outcome", since="0.4.0", until="0.5.0")
     return TASKS.add(getattr(cls, "kind", ""), cls)
 
 
