@@ -25,6 +25,7 @@ from semsearch_cli.ros2.live import INPUTS, Live, LiveRun, _Repro, rosbridge_add
 from semsearch_cli.ros2.robot import (DETECTIONS, GOAL_STATUS, MAP, MAX_MAP_CELLS, POSE_TOPICS, RESUME, RobotSession,  # noqa: E402
                                       RobotTask, fold_map, goal_ended, map_frame, refusal)
 from semsearch_cli.errors import ScenarioError  # noqa: E402
+from semsearch_cli.tasks.decisions import Agent, DecisionPoint  # noqa: E402
 
 M = Messages()
 T = M.T
@@ -297,3 +298,29 @@ def test_a_pose_of_strings_a_map_that_is_a_string_and_a_stamp_of_2_70_are_droppe
     with Reader(kept) as r:
         topics = [c.topic for c, _, _ in r.messages()]
     assert topics[:2] == [MAP, POSE_TOPICS[0]] and topics.count(MAP) == 1 and topics.count(POSE_TOPICS[0]) == 1
+
+
+def test_a_front_end_answers_a_robots_decisions_as_the_planner_would():
+    """RobotSession's re-plan stepped from outside (replan, answer), an Agent in the planner's
+    seat answering with greedy's own choices, makes the re-plans the seated planner makes."""
+    greedy = Variant("greedy", ()).build()
+    seated, by_hand = session(), RobotSession(RobotTask(map_frame(room(), margin=1.0)), Variant("agent", ()), GOAL,
+                                              seat=Agent(replan_on_signs=greedy.replan_on_signs))
+    plans = {"seated": [], "by hand": []}
+    for t, (x, y) in enumerate([(1.0, 1.0), (1.5, 1.0), (2.0, 1.2), (2.5, 1.5)], 1):
+        for name, s in (("seated", seated), ("by hand", by_hand)):
+            if t == 1:
+                s.take(MAP, room(t_ns=t))
+            if s.take(POSE_TOPICS[0], M.pose_stamped(10 * t, x, y, 0.0)) != "plan":
+                continue
+            if name == "seated":
+                plan = s.plan()
+            else:
+                point = s.replan()
+                while isinstance(point, DecisionPoint):
+                    point = s.answer(greedy.choose(point.observation, point.choices))
+                plan = point
+            plans[name].append(plan if isinstance(plan, str) else [np.round(plan[0], 6).tolist(), np.round(plan[1], 6).tolist()])
+    assert plans["seated"] == plans["by hand"] and len(plans["seated"]) >= 1
+    with pytest.raises(RuntimeError, match="no decision is pending"):
+        by_hand.answer(None)

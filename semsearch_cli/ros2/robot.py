@@ -47,9 +47,8 @@ from ..world.images import MAX_CELLS
 from ..errors import BudgetSpent
 from ..planners import Variant
 from ..tasks.base import Observer, RobotState
-from ..tasks.decisions import Recording, Seat
+from ..tasks.decisions import DecisionPoint, Recording, Seat
 from ..tasks.doors import DoorDecision, DoorSearch
-from ..tasks.loop import answer_all
 
 MAP, DETECTIONS, RESUME = "/map", "/semsearch/detections", "/explore/resume"
 GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray: Nav2's goals and how they ended
@@ -503,15 +502,43 @@ class RobotSession:
         return (self.have_map and self.posed and self.inside and not self.paused
                 and self.search.replan_due(self.done, self.since, self.event))
 
+    def replan(self):
+        """Start a re-plan: its first decision point (returned: a
+        :class:`~semsearch_cli.tasks.decisions.DecisionPoint`, answered by :meth:`answer`), or the
+        plan itself when it asks none (waypoints ``(xs, ys)`` m, or an outcome). A front end that
+        answers a robot's decisions itself (an operator choosing the frontier) drives these two; the
+        bridges answer with the seat (:meth:`plan`)."""
+        self.since, self.event, self.done = 0.0, False, False
+        self._plan = self.search.plan(self.st)
+        return self._go(None)
+
+    def answer(self, choice):
+        """Take ``choice`` at the pending decision point of a re-plan; its next point or its plan."""
+        if getattr(self, "_plan", None) is None:
+            raise RuntimeError("no decision is pending: start a re-plan first (replan)")
+        return self._go(choice)
+
+    def _go(self, choice):
+        try:
+            return self._plan.send(choice)
+        except StopIteration as stop:
+            self._plan = None
+            return stop.value
+
     def plan(self):
         """One re-plan, each decision point answered by the seat (the planner): waypoints
         ``(xs, ys)`` (m), or an outcome (``stuck``: nowhere left to go; ``budget``: the planner's
         own budget, a language model's calls, is spent)."""
-        self.since, self.event, self.done = 0.0, False, False
-        try:
-            return answer_all(self.search.plan(self.st), self.seat.decide)
-        except BudgetSpent:
-            return "budget"
+        point = self.replan()
+        while isinstance(point, DecisionPoint):
+            try:
+                choice = self.seat.decide(point)
+            except BudgetSpent:
+                self._plan.close()
+                self._plan = None
+                return "budget"
+            point = self.answer(choice)
+        return point
 
     def seated(self) -> dict:
         """What the seat kept of the run's planner: ``costs`` (column -> number, as a batch row's
