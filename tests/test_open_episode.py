@@ -12,7 +12,7 @@ import pytest
 from semsearch_cli.envs.base import compass_move, compass_step
 from semsearch_cli.planners import Variant
 from semsearch_cli.runner import Loaded
-from semsearch_cli.tasks import TASKS, OpenEpisode, Outcome, Task, register_task
+from semsearch_cli.tasks import TASKS, OpenEpisode, Outcome, register_task
 from semsearch_cli.tasks.decisions import Agent, DecisionPoint, Recording, Replay
 from semsearch_cli.tasks.doors import DoorSearch, DoorTask
 from semsearch_cli.tasks.loop import run_loop

@@ -30,7 +30,7 @@ from ..sensors import DoorCamera, Laser
 from ..world.ground_truth import check_goals_reachable
 from ..world.buildings.demo import write_demo
 from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_cell, register_task
-from .decisions import Codec, DecisionPoint, ask, rng_word
+from .decisions import Codec, DecisionPoint, rng_word
 from .loop import drive
 
 MAX_RETRIES = 5

@@ -38,7 +38,7 @@ from ..sensors.indirect import SemanticCamera, YawMemory
 from ..world.rooms import OBJECT_GAP, WALL_MARGIN, Room, estimate_relations, generate_rooms, read_rooms
 from .base import Event, Observer, Outcome, RobotState, RunResult, Task, checked_point, register_task
 from .episodes import Episode, check_hash, draw_starts, given_episodes, label_words
-from .decisions import Codec, DecisionPoint, ask
+from .decisions import Codec, DecisionPoint
 from .loop import drive
 
 

@@ -50,7 +50,7 @@ from ..planners import ObjectContext
 from ..sensors import PlaceCamera
 from ..world.buildings.office import office_image, office_scenario
 from .base import Event, Observer, Outcome, RobotState, OnMapTask, checked_point, register_task
-from .decisions import Codec, DecisionPoint, ask
+from .decisions import Codec, DecisionPoint
 from .loop import drive, run_loop
 from ..files import read_user_text, temp_path, user_file
 
