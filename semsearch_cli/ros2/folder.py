@@ -23,6 +23,7 @@ from pathlib import Path
 
 from ..engine import ENGINE
 from ..errors import ScenarioError
+from ..files import atomic_text
 from ..planners import Variant
 from ..runner.store import read_decisions, write_decisions, write_jsonl
 from ..runner.verify import Verdict
@@ -56,9 +57,7 @@ def write_live_folder(folder: Path, res, *, planner: str, goal: str, scenario: P
            "distance_m": res.distance, "poses": res.poses, "goals": res.goals, "dropped": res.dropped,
            "costs": res.costs, "decisions": res.decisions}
     path = folder / "run.json"
-    tmp = path.with_name(".run.json.partial")
-    tmp.write_text(json.dumps(run, allow_nan=False, default=float) + "\n", encoding="utf-8")
-    tmp.replace(path)
+    atomic_text(path, json.dumps(run, allow_nan=False, default=float) + "\n")
     return path
 
 

@@ -47,8 +47,9 @@ from ..world.images import MAX_CELLS
 from ..errors import BudgetSpent
 from ..planners import Variant
 from ..tasks.base import Observer, RobotState
-from ..tasks.decisions import DecisionPoint, Recording, Seat
+from ..tasks.decisions import Recording, Seat
 from ..tasks.doors import DoorDecision, DoorSearch
+from ..tasks.loop import answer_all
 
 MAP, DETECTIONS, RESUME = "/map", "/semsearch/detections", "/explore/resume"
 GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray: Nav2's goals and how they ended
@@ -529,16 +530,11 @@ class RobotSession:
         """One re-plan, each decision point answered by the seat (the planner): waypoints
         ``(xs, ys)`` (m), or an outcome (``stuck``: nowhere left to go; ``budget``: the planner's
         own budget, a language model's calls, is spent)."""
-        point = self.replan()
-        while isinstance(point, DecisionPoint):
-            try:
-                choice = self.seat.decide(point)
-            except BudgetSpent:
-                self._plan.close()
-                self._plan = None
-                return "budget"
-            point = self.answer(choice)
-        return point
+        self.since, self.event, self.done = 0.0, False, False
+        try:
+            return answer_all(self.search.plan(self.st), self.seat.decide)
+        except BudgetSpent:  # thrown back into the re-plan, which does not take it: the run's end
+            return "budget"
 
     def seated(self) -> dict:
         """What the seat kept of the run's planner: ``costs`` (column -> number, as a batch row's
