@@ -10,7 +10,7 @@ of ``info["action_mask"]``), no rendering, environments made with ``gymnasium.ma
 ``--repeat`` timed runs of ``--steps`` steps; the ratios are against Minigrid's FourRooms in the
 same run, since this machine's speed varies from day to day.
 
-- semsearch primitive: ``semsearch/DoorSearch-v0`` on configs/hotel.yaml in the primitive mode
+- semsearch primitive: ``semsearch/DoorSearch-v1`` on configs/hotel.yaml in the primitive mode
   (laser into HIMM, door cameras, visited kernel and the observation at every step);
 - semsearch macro: the same in the macro mode (a step is a re-plan: about a metre of travel, the
   skeleton and candidates refreshed);
@@ -107,8 +107,8 @@ def main() -> int:
     ap.add_argument("--md", type=Path, default=None, help="also write the table as Markdown")
     a = ap.parse_args()
     hotel = str(ROOT / "configs/hotel.yaml")
-    cases = {"semsearch primitive (hotel)": (lambda: gym.make("semsearch/DoorSearch-v0", scenario=hotel, action_mode="primitive"), a.steps, False),
-             "semsearch macro (hotel)": (lambda: gym.make("semsearch/DoorSearch-v0", scenario=hotel), a.macro_steps, True)}
+    cases = {"semsearch primitive (hotel)": (lambda: gym.make("semsearch/DoorSearch-v1", scenario=hotel, action_mode="primitive"), a.steps, False),
+             "semsearch macro (hotel)": (lambda: gym.make("semsearch/DoorSearch-v1", scenario=hotel), a.macro_steps, True)}
     try:
         import minigrid  # noqa: F401
         cases["Minigrid FourRooms"] = (lambda: gym.make("MiniGrid-FourRooms-v0"), a.steps, False)

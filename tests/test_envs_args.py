@@ -19,8 +19,8 @@ from semsearch_cli.envs.doors import MAX_CANDIDATES, MAX_SIGNS, MAX_WINDOW  # no
 from .test_envs import KWARGS, MODES, ROOT, make  # noqa: E402
 
 ENV_IDS = sorted(KWARGS)
-DOORS = "semsearch/DoorSearch-v0"
-GENERATED = "semsearch/DoorSearch-Generated-v0"
+DOORS = "semsearch/DoorSearch-v1"
+GENERATED = "semsearch/DoorSearch-Generated-v1"
 INDIRECT = "semsearch/IndirectSearch-v0"
 _READY: dict = {}  # (env id, mode) -> an environment just reset (refused actions leave it as it is)
 

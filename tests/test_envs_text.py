@@ -12,7 +12,7 @@ import pytest
 gym = pytest.importorskip("gymnasium")
 
 from semsearch_cli.envs.base import TEXT_CHARSET, TEXT_LENGTH, clip_text  # noqa: E402
-from semsearch_cli.planners.text import FRAME_TEXT, deg, spell  # noqa: E402
+from semsearch_cli.planners.text import ANGLES_TEXT, FRAME_TEXT, deg, spell  # noqa: E402
 
 from .test_envs import KWARGS, MODES, make  # noqa: E402
 
@@ -58,7 +58,7 @@ def test_the_text_states_its_frame_and_offers_exactly_the_valid_actions(env_id, 
     env = make(env_id, action_mode=mode, observation_mode="text")
     obs, info = env.reset(seed=0)
     for _ in range(4):
-        assert FRAME_TEXT in obs and "leading" not in obs
+        assert ("Frame: x points east and y north, in metres" in obs and ANGLES_TEXT in obs and "leading" not in obs)
         assert set(obs) <= TEXT_CHARSET and len(obs) <= TEXT_LENGTH
         valid = np.flatnonzero(info["action_mask"]).tolist()
         assert offered(obs) == valid
@@ -88,8 +88,26 @@ def test_a_seeded_door_reset_reads_as_pinned():
     assert np.flatnonzero(info["action_mask"]).tolist() == [0, 64]
 
 
+def test_a_seeded_v1_door_reset_reads_as_the_llm_planner_reads_it():
+    """v1: the llm planner's text (path lengths, the wall numbered after the last target)."""
+    env = make("semsearch/DoorSearch-Hotel-v1", observation_mode="text")
+    obs, info = env.reset(seed=1)
+    assert obs == (
+        "Goal: read the door sign 135.\n"
+        "Frame: x points east and y north, in metres; a target's distance is the length of the robot's path to it, "
+        "every other distance a straight line. " + ANGLES_TEXT + "\n"
+        "You are at x 111.8 m, y 50.5 m, heading 30 deg; travelled 0.0 m.\n"
+        "No sign read yet.\n"
+        "Targets: frontier points on the edge of the explored area, nearest first along the path, each with the "
+        "direction in which unexplored space goes on beyond it, or look at a wall:\n"
+        "[0] 1.4 m along the path, bearing -9 deg, unexplored space towards -21 deg\n"
+        "[1] look at the nearest wall face no camera has read yet\n"
+        "Answer with one number: 0 or 1.")
+    assert np.flatnonzero(info["action_mask"]).tolist() == [0, 1]
+
+
 def test_the_answer_lines_of_the_other_kinds_on_seeded_cases():
-    env = make("semsearch/DoorSearch-v0", action_mode="primitive", observation_mode="text")
+    env = make("semsearch/DoorSearch-v1", action_mode="primitive", observation_mode="text")
     obs, _ = env.reset(seed=0)
     assert obs.splitlines()[-2:] == [
         "Moves (a move into a wall leaves you where you are): [0] 0.1 m east; [1] 0.1 m north-east; [2] 0.1 m north; "

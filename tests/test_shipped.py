@@ -110,7 +110,7 @@ def test_a_wheel_installed_outside_the_checkout_finds_the_scenarios_the_gym_ids_
     elsewhere.mkdir()
     code = ("import gymnasium, semsearch_cli, semsearch_cli.envs\n"
             "from semsearch_cli.provenance import git_commit\n"
-            "env = gymnasium.make('semsearch/DoorSearch-Hotel-v0')\n"
+            "env = gymnasium.make('semsearch/DoorSearch-Hotel-v1')\n"
             "obs, info = env.reset(seed=0)\n"
             "print(semsearch_cli.__file__); print(git_commit()); print(env.unwrapped.task.kind)\n")
     env = {**os.environ, "PYTHONPATH": str(site)}

@@ -1,5 +1,5 @@
 """A learned door-search baseline: MaskablePPO (sb3-contrib) in the macro mode of
-``semsearch/DoorSearch-Generated-v0``, trained on generated buildings and evaluated on held-out
+``semsearch/DoorSearch-Generated-v1``, trained on generated buildings and evaluated on held-out
 ones against greedy and nsos, on the same episodes.
 
     pip install torch==2.13.0   # a CPU build; see the README of this folder
@@ -42,7 +42,7 @@ from semsearch_cli.envs import PlannerPolicy
 from semsearch_cli.report.document import markdown_table
 from semsearch_cli.report.stats import mean_ci
 
-ENV = "semsearch/DoorSearch-Generated-v0"
+ENV = "semsearch/DoorSearch-Generated-v1"
 LAYOUT = {"layout": "wings", "numbering": "odd-even-out", "spacing": 3.0}
 
 
@@ -57,7 +57,7 @@ class Features(gym.ObservationWrapper):
         self.observation_space = gym.spaces.Box(-1.0, 1.0, (n,), np.float32)
 
     def observation(self, obs):
-        t = obs["targets"].copy()
+        t = obs["targets"][:, :4].copy()  # the first four columns (v1 adds the path length, fifth)
         t[:, 1:3] = np.clip(t[:, 1:3] / 20.0, -1, 1)
         t[:, 3] /= np.pi
         s = obs["signs"]

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 import string
 from collections.abc import Mapping
 from pathlib import Path
@@ -380,7 +381,9 @@ class SearchEnv(gym.Env):
                 "reset": getattr(self, "_reset_options", None), "actions": list(self._actions)}
 
     def __setstate__(self, state):
-        self.__init__(**state["args"])
+        with warnings.catch_warnings():  # a deprecated version warned when it was made, not again at each copy
+            warnings.simplefilter("ignore", DeprecationWarning)
+            self.__init__(**state["args"])
         if state["reset"] is not None:
             self.reset(options=state["reset"])
             for a in state["actions"]:

@@ -1,4 +1,4 @@
-"""``semsearch/DoorSearch-Generated-v0``: door search in a building generated at each reset.
+"""``semsearch/DoorSearch-Generated-v1`` (and the deprecated ``-v0``): door search in a building generated at each reset.
 
 Each reset draws a building seed among ``first_building .. first_building + buildings - 1`` (or
 takes ``options["building"]``), generates that building as ``semsearch generate building --layout
@@ -58,6 +58,7 @@ class GeneratedDoorSearchEnv(DoorSearchEnv):
     """:class:`DoorSearchEnv` over generated buildings (see the module docstring)."""
 
     reset_keys = ("building", "episode", "repeat")
+    id_name = "DoorSearch-Generated"
 
     def __init__(self, layout: str = "wings", numbering: str = "odd-even-out", buildings: int = 100,
                  first_building: int = 0, spacing: float = 3.0, **kwargs):
@@ -70,8 +71,8 @@ class GeneratedDoorSearchEnv(DoorSearchEnv):
         self.layout, self.numbering, self.spacing = layout, numbering, spacing
         self.buildings, self.first = buildings, first_building
         if "scenario" in kwargs:  # was dropped without a word
-            raise ValueError("scenario: DoorSearch-Generated-v0 generates its buildings (layout, numbering, buildings, "
-                             "first_building, spacing); run a scenario file with semsearch/DoorSearch-v0")
+            raise ValueError("scenario: DoorSearch-Generated-v1 generates its buildings (layout, numbering, buildings, "
+                             "first_building, spacing); run a scenario file with semsearch/DoorSearch-v1")
         super().__init__(building(layout, numbering, self.first, spacing), **kwargs)
         self._init_args = {k: v for k, v in self._init_args.items() if k != "scenario"}
         self._init_args.update(layout=layout, numbering=numbering, buildings=buildings, first_building=first_building,

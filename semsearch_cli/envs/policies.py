@@ -1,6 +1,6 @@
 """The built-in door planners as policies of the macro environment.
 
-    env = gymnasium.make("semsearch/DoorSearch-v0", scenario="configs/hotel.yaml", **policy.env_kwargs)
+    env = gymnasium.make("semsearch/DoorSearch-v1", scenario="configs/hotel.yaml", **policy.env_kwargs)
     policy = PlannerPolicy("nsos", alpha=0.9)
     obs, info = env.reset(options={"episode": 3, "repeat": 0}); policy.reset()
     while not done:
@@ -72,13 +72,14 @@ class PlannerPolicy:
         if not getattr(self, "_started", False):
             self._start(u)
         ctx, cands = u.decision
+        u.rewind()  # the run's generator as the planner finds it in the batch (v1 drew greedy's tie to order the targets)
         dec = self.planner.choose(ctx, cands)
         if dec is None:
             return u.sweep_action
         k = np.flatnonzero((cands.rows[u.slots] == dec.row) & (cands.cols[u.slots] == dec.col))
         if k.size == 0:
             inside = ((cands.rows == dec.row) & (cands.cols == dec.col)).any()
-            where = (f"is not among the {u.K} nearest candidates the environment shows (max_candidates)" if inside
+            where = (f"is not among the {len(u.slots)} candidates the environment shows (max_candidates {u.K})" if inside
                      else "is not a frontier candidate (a planner that picks cells of its own, as bvp does, cannot run "
                           "as a policy of the macro environment)")
             raise PlannerError(f"planner {self.variant.label!r} chose the cell ({dec.row}, {dec.col}), which {where}")

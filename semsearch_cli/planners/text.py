@@ -1,6 +1,8 @@
-"""The wording every text a language model reads shares: the Gymnasium environments' text
-observations (``semsearch_cli.envs``) and the ``llm`` planner's prompts
-(:mod:`semsearch_cli.planners.llm`) state the frame, the angles and the answer line alike."""
+"""The text of a decision, one per kind: the Gymnasium environments' text observations
+(``semsearch_cli.envs``) and the ``llm`` planner's prompts (:mod:`semsearch_cli.planners.llm`)
+are made by the same functions here (:func:`door_fields`, :func:`object_fields`,
+:func:`indirect_fields`), so an agent in an environment reads what the planner's model reads;
+they state the frame, the angles and the answer line alike."""
 
 from __future__ import annotations
 
@@ -38,6 +40,54 @@ def spell(numbers) -> str:
 def answer_line(mask: np.ndarray) -> str:
     """The text observation's last line: the actions ``mask`` allows, and only those."""
     return f"Answer with one number: {spell(np.flatnonzero(mask))}."
+
+
+# ---- door search ------------------------------------------------------------------------------
+def door_targets(ctx, dist: np.ndarray, order: np.ndarray, cands) -> list[tuple[float, float, float, float]]:
+    """The targets :func:`door_fields` shows: per candidate of ``order`` (indices into
+    ``cands``), its path length (m, ``dist`` by candidate), its world x, y (m) and its branch
+    direction theta_f (rad)."""
+    xs, ys = ctx.belief.frame.to_world(cands.rows[order], cands.cols[order])
+    return [(float(dist[i]), float(x), float(y), float(cands.theta[i])) for i, x, y in zip(order, xs, ys)]
+
+
+def door_fields(goal, pose: tuple, travelled: float, belief, targets: list, mode: str = "actor",
+                moves: str | None = None) -> dict:
+    """A door-search decision as text, field by field: the llm planner's prompt and
+    ``semsearch/DoorSearch-v1``'s text observation, one text. ``goal`` (the label), ``frame``,
+    ``pose`` (``pose``: x, y m, heading rad; ``travelled`` m, left out when not finite),
+    ``signs`` (the belief's signs read, where the robot stood to read each, nearest first),
+    ``targets`` (:func:`door_targets`, numbered in their order; in the ``actor`` mode the last
+    number looks at a wall; ``moves``, the primitive moves, in their place when given) and
+    ``answer``; ``label`` the goal's label, and ``observation``, the fields in that order."""
+    x, y, heading = pose
+    b = belief
+    label = str(goal)
+    travelled_text = "" if not math.isfinite(travelled) else f"; travelled {travelled:.1f} m"
+    f = {"goal": f"Goal: read the door sign {label}.", "label": label,
+         "frame": ("Frame: x points east and y north, in metres; a target's distance is the length of the robot's path "
+                   "to it, every other distance a straight line. " + ANGLES_TEXT),
+         "pose": f"You are at x {x:.1f} m, y {y:.1f} m, heading {deg(heading)} deg{travelled_text}."}
+    reads = b.reads.lists(np.arange(b.reads.n), b.spec.min_reads)
+    signs = sorted(((str(lab), sx - x, sy - y) for lab, (_, sx, sy) in reads.items()), key=lambda s: s[1] ** 2 + s[2] ** 2)
+    f["signs"] = ("Signs read so far, nearest first (where you stood when you read each): " + "; ".join(
+        f"{lab} read {math.hypot(dx, dy):.1f} m away, bearing {deg(math.atan2(dy, dx))} deg" for lab, dx, dy in signs) + "."
+        if signs else "No sign read yet.")
+    n = len(targets)
+    if moves is not None:
+        f["targets"], f["answer"] = moves, answer_line(np.ones(10, bool))
+    else:
+        lines = [("Targets: frontier points on the edge of the explored area, nearest first along the path, each with the "
+                  "direction in which unexplored space goes on beyond it" + (", or look at a wall:" if mode == "actor" else ":"))]
+        lines += [f"[{k}] {dm:.1f} m along the path, bearing {deg(math.atan2(ty - y, tx - x))} deg, unexplored space "
+                  f"towards {deg(theta)} deg" for k, (dm, tx, ty, theta) in enumerate(targets)]
+        if mode == "actor":
+            lines.append(f"[{n}] look at the nearest wall face no camera has read yet")
+        f["targets"] = "\n".join(lines)
+        f["answer"] = (answer_line(np.ones(n + 1, bool)) if mode == "actor" else
+                       f"Answer with one JSON object mapping target numbers ({spell(range(n))}) to probabilities from 0 to 1.")
+    f["observation"] = "\n".join(f[k] for k in ("goal", "frame", "pose", "signs", "targets", "answer"))
+    return f
 
 
 # ---- object search ------------------------------------------------------------------------------

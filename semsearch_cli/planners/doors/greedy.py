@@ -20,6 +20,28 @@ def nearest_candidate(ctx, cands) -> Decision | None:
     return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k])})
 
 
+def path_order(ctx, cands, limit: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The frontier targets as the llm planner and ``semsearch/DoorSearch-v1`` show them: the
+    reachable candidates ordered by their path length from the robot, greedy's choice first
+    (:func:`nearest_candidate`'s search and its tie drawn from the run's generator, exactly as
+    greedy draws it), at most ``limit`` of them. Returns ``(d, order)``: ``d`` (m) the path length
+    to every candidate (inf where there is none), ``order`` the candidates shown (indices into
+    ``cands``); None when no candidate is reachable (nothing drawn). Greedy's search runs last, so
+    that the path to the target chosen reuses it as greedy's does."""
+    b, res = ctx.belief, ctx.belief.frame.res
+    d = b.search(ctx.row, ctx.col, cands.rows, cands.cols, 0).lengths(cands.rows, cands.cols) * res  # every target
+    near = b.search(ctx.row, ctx.col, cands.rows, cands.cols, 1).lengths(cands.rows, cands.cols)
+    if not np.isfinite(near).any():
+        return None
+    best = np.flatnonzero(near == near.min())
+    first = int(best[0] if best.size == 1 else ctx.rng.choice(best))  # greedy's draw, exactly
+    if not np.isfinite(d[first]):
+        d[first] = near[first] * res
+    ok = np.flatnonzero(np.isfinite(d))
+    rest = [int(i) for i in ok[np.lexsort((ok, d[ok]))] if i != first]
+    return d, np.asarray([first, *rest][:limit], np.int64)
+
+
 @register_planner("greedy")
 class Greedy(DoorPlanner):
     """The nearest frontier candidate (the thesis' geometric baseline)."""
