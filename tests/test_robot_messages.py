@@ -317,10 +317,14 @@ def test_a_front_end_answers_a_robots_decisions_as_the_planner_would():
                 plan = s.plan()
             else:
                 point = s.replan()
-                while isinstance(point, DecisionPoint):
+                while isinstance(point, DecisionPoint):  # the handle's view of the pending decision, as OpenEpisode's
+                    assert s.point is point and s.observation is point.observation and s.mask is point.mask
                     point = s.answer(greedy.choose(point.observation, point.choices))
                 plan = point
+                assert s.point is None and s.observation is None
             plans[name].append(plan if isinstance(plan, str) else [np.round(plan[0], 6).tolist(), np.round(plan[1], 6).tolist()])
     assert plans["seated"] == plans["by hand"] and len(plans["seated"]) >= 1
     with pytest.raises(RuntimeError, match="no decision is pending"):
         by_hand.answer(None)
+    with pytest.raises(RuntimeError, match="no decision is pending"):
+        by_hand.ask()

@@ -47,9 +47,8 @@ from ..world.images import MAX_CELLS
 from ..errors import BudgetSpent
 from ..planners import Variant
 from ..tasks.base import Observer, RobotState
-from ..tasks.decisions import Recording, Seat
+from ..tasks.decisions import DecisionPoint, Recording, Seat
 from ..tasks.doors import DoorDecision, DoorSearch
-from ..tasks.loop import answer_all
 
 MAP, DETECTIONS, RESUME = "/map", "/semsearch/detections", "/explore/resume"
 GOAL_STATUS = "/navigate_to_pose/_action/status"  # action_msgs/GoalStatusArray: Nav2's goals and how they ended
@@ -397,6 +396,8 @@ class RobotSession:
         planner = self.seat.planner(planner) if isinstance(planner, Variant) else self.seat.seat(planner)
         self.search = RobotSearch(task, planner, self.goal, np.random.default_rng(0), observer)
         self.pose_topic = pose_topic  # None: the first of POSE_TOPICS that speaks
+        self.point = None  # the decision point a re-plan waits at (None when none is pending)
+        self._plan = None  # the re-plan under way (a kind's search generator)
         self.pending: list = []  # labels read since the last pose
         self.have_map = self.posed = self.paused = self.clipped = self.inside = False
         self.since, self.event, self.done = 0.0, False, True  # done: the last goal ended (none yet at the start)
@@ -504,37 +505,69 @@ class RobotSession:
                 and self.search.replan_due(self.done, self.since, self.event))
 
     def replan(self):
-        """Start a re-plan: its first decision point (returned: a
-        :class:`~semsearch_cli.tasks.decisions.DecisionPoint`, answered by :meth:`answer`), or the
-        plan itself when it asks none (waypoints ``(xs, ys)`` m, or an outcome). A front end that
-        answers a robot's decisions itself (an operator choosing the frontier) drives these two; the
-        bridges answer with the seat (:meth:`plan`)."""
+        """Start a re-plan: its first decision point (returned, and kept as :attr:`point`: a
+        :class:`~semsearch_cli.tasks.decisions.DecisionPoint`, answered by :meth:`answer` or
+        :meth:`ask`), or the plan itself when it asks none (waypoints ``(xs, ys)`` m, or an
+        outcome). The episode is stepped as an :class:`~semsearch_cli.tasks.base.OpenEpisode` is,
+        fed by messages (:meth:`take`) instead of a simulator: ``ros live`` and ``ros replay`` step
+        it with :meth:`ask` (:meth:`plan`); a front end that answers a robot's decisions itself (an
+        operator choosing the frontier) with :meth:`answer`."""
         self.since, self.event, self.done = 0.0, False, False
         self._plan = self.search.plan(self.st)
         return self._go(None)
 
+    @property
+    def observation(self):
+        """What a planner reads at the pending decision (None when none is pending)."""
+        return None if self.point is None else self.point.observation
+
+    @property
+    def mask(self):
+        """The legal choices of the pending decision (None when none is pending)."""
+        return None if self.point is None else self.point.mask
+
     def answer(self, choice):
         """Take ``choice`` at the pending decision point of a re-plan; its next point or its plan."""
-        if getattr(self, "_plan", None) is None:
-            raise RuntimeError("no decision is pending: start a re-plan first (replan)")
+        self._pending()
         return self._go(choice)
 
-    def _go(self, choice):
+    def ask(self):
+        """Have the seat answer the pending decision point (the planner's answer, or a record's);
+        its next point or its plan, as :meth:`answer`. A planner whose own budget is spent
+        (:class:`~semsearch_cli.errors.BudgetSpent`) ends the re-plan as ``budget``."""
+        point = self._pending()
         try:
-            return self._plan.send(choice)
+            choice = self.seat.decide(point)
+        except BudgetSpent as exc:
+            return self._go(None, spent=exc)
+        return self._go(choice)
+
+    def _pending(self):
+        if getattr(self, "_plan", None) is None or self.point is None:
+            raise RuntimeError("no decision is pending: start a re-plan first (replan)")
+        return self.point
+
+    def _go(self, choice, spent: BaseException | None = None):
+        self.point = None
+        try:
+            item = self._plan.throw(spent) if spent is not None else self._plan.send(choice)
         except StopIteration as stop:
             self._plan = None
             return stop.value
+        except BudgetSpent:  # thrown back into the re-plan, which does not take it: the run's end
+            self._plan = None
+            return "budget"
+        self.point = item
+        return item
 
     def plan(self):
-        """One re-plan, each decision point answered by the seat (the planner): waypoints
-        ``(xs, ys)`` (m), or an outcome (``stuck``: nowhere left to go; ``budget``: the planner's
-        own budget, a language model's calls, is spent)."""
-        self.since, self.event, self.done = 0.0, False, False
-        try:
-            return answer_all(self.search.plan(self.st), self.seat.decide)
-        except BudgetSpent:  # thrown back into the re-plan, which does not take it: the run's end
-            return "budget"
+        """One re-plan, stepped to its end with each decision point answered by the seat (the
+        planner): waypoints ``(xs, ys)`` (m), or an outcome (``stuck``: nowhere left to go;
+        ``budget``: the planner's own budget, a language model's calls, is spent)."""
+        item = self.replan()
+        while isinstance(item, DecisionPoint):
+            item = self.ask()
+        return item
 
     def seated(self) -> dict:
         """What the seat kept of the run's planner: ``costs`` (column -> number, as a batch row's
