@@ -606,3 +606,79 @@ def test_a_batch_and_the_board_say_the_share_of_decisions_that_fell_back(tmp_pat
     assert f"| {n / asked:.1%} of {asked:,} |" in row and f"| not verified, {n / asked:.1%} of decisions fell back |" in row
     greedy = next(line for line in md.splitlines() if line.startswith("| greedy |"))
     assert "fell back" not in greedy
+
+
+# ---- replies a model can keep to ------------------------------------------------------------------
+def keeps_to(request: dict, n: int) -> Answer:
+    """A server that honours what it is asked to keep to: the first choice its JSON schema's enum
+    (or its grammar's first alternative) names, written as the schema (or grammar) asks; the
+    estimator's table with all its weight on the first target."""
+    fmt = request.get("response_format")
+    if fmt is not None:
+        props = fmt["json_schema"]["schema"]["properties"]
+        if "choice" in props:
+            return Answer(json.dumps({"choice": props["choice"]["enum"][0]}))
+        return Answer(json.dumps({k: (1.0 if i == 0 else 0.0) for i, k in enumerate(props)}))
+    g = request.get("grammar")
+    if g is not None and not g.startswith('root ::= "{"'):
+        return Answer(re.match(r'root ::= "(\d+)"', g).group(1))
+    if g is not None:
+        keys = re.findall(r'\\"(\d+)\\":', g)
+        return Answer("{" + ", ".join(f'"{k}": {1 if i == 0 else 0}' for i, k in enumerate(keys)) + "}")
+    return first_target(request, n)
+
+
+@pytest.mark.parametrize("reply_format", ["json_schema", "grammar"])
+@pytest.mark.parametrize("mode", ["actor", "estimator"])
+def test_a_constrained_reply_names_only_the_choices_offered_and_is_read(tmp_path, reply_format, mode):
+    with ChatServer(keeps_to) as srv:
+        sc = scenario(tmp_path, [{"name": "greedy"}, llm(srv, mode=mode, reply_format=reply_format, seed=7)], seeds=1,
+                      goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, transcripts=True), plots=False)
+    greedy, model = rows_of(tmp_path / "out", "greedy"), rows_of(tmp_path / "out", "llm")
+    assert model["invalid_replies"].sum() == 0 and model["fallbacks"].sum() == 0
+    if mode == "actor":  # the first choice, every time: greedy's runs
+        pd.testing.assert_frame_equal(greedy[SAME], model[SAME])
+    calls = [c for p in sorted((tmp_path / "out" / "transcripts").glob("*.jsonl")) for c in map(json.loads, p.open())
+             if c["type"] == "call"]
+    assert len(calls) == len(srv.requests) > 0
+    for call, req in zip(calls, srv.requests):
+        assert (call["reply_format"], call["seed"], call["temperature"]) == (reply_format, 7, 0.0)
+        assert req["seed"] == 7 and req["messages"] == call["messages"]
+        offered = offered_numbers(call["observation"], mode)
+        if reply_format == "json_schema":
+            schema = req["response_format"]["json_schema"]["schema"]
+            named = schema["properties"]["choice"]["enum"] if mode == "actor" else [int(k) for k in schema["required"]]
+        else:
+            named = [int(v) for v in re.findall(r'"(\d+)"' if mode == "actor" else r'\\"(\d+)\\"', req["grammar"])]
+        assert named == offered
+
+
+def offered_numbers(observation: str, mode: str) -> list[int]:
+    """The numbers an observation's answer line offers (actor), or its targets' (estimator)."""
+    last = observation.rsplit("\n", 1)[-1]
+    words = re.search(r"one number: (.+)\.$", last).group(1) if mode == "actor" else re.search(r"numbers \((.+)\)", last).group(1)
+    out = []
+    for item in re.split(r", | or ", words):
+        a, _, b = item.partition("-")
+        out += range(int(a), int(b or a) + 1)
+    return out
+
+
+def test_a_server_that_ignores_the_schema_is_read_as_text(tmp_path):
+    with ChatServer(first_target) as srv:  # answers a bare number whatever it is asked to keep to
+        sc = scenario(tmp_path, [{"name": "greedy"}, llm(srv, reply_format="json_schema")], seeds=1, goals=[304])
+        api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
+    greedy, model = rows_of(tmp_path / "out", "greedy"), rows_of(tmp_path / "out", "llm")
+    assert model["invalid_replies"].sum() == 0
+    pd.testing.assert_frame_equal(greedy[SAME], model[SAME])
+    assert all("response_format" in r for r in srv.requests)
+
+
+@pytest.mark.parametrize("reply,valid", [('{"choice": 1}', 1), ('```json\n{"choice": 0}\n```', 0), ("1", 1),
+                                         ('{"choice": 9}', None), ('{"choice": "1"}', None), ('{"choice": true}', None),
+                                         ('{"choice": 1, "why": "near"}', None), ('{"choice": 1', None), ("", None)])
+def test_parse_choice_takes_the_schemas_object_or_a_plain_number(reply, valid):
+    from semsearch_cli.planners.llm.replies import parse_choice
+    choice, why = parse_choice(reply, frozenset({0, 1, 2}))
+    assert choice == valid and (why == "") == (valid is not None)

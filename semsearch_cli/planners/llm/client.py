@@ -171,22 +171,24 @@ class Chat:
     :class:`Reply`, whatever happens."""
 
     def __init__(self, base_url: str, model: str, api_key_env: str, temperature: float, max_tokens: int, timeout_s: float,
-                 retries: int, max_concurrent: int):
+                 retries: int, max_concurrent: int, seed: int | None = None):
         require_openai()
-        self.model, self.temperature, self.max_tokens = model, temperature, max_tokens
+        self.model, self.temperature, self.max_tokens, self.seed = model, temperature, max_tokens, seed
         self.client = openai.OpenAI(base_url=base_url, api_key=os.environ.get(api_key_env) or NO_KEY, timeout=timeout_s,
                                     max_retries=retries)
         self.slots = Slots(base_url, max_concurrent)
 
-    def ask(self, messages: list[dict]) -> Reply:
+    def ask(self, messages: list[dict], keep_to: dict | None = None) -> Reply:
         """The reply to ``messages``; its seconds count from when a request slot was free (the wait
-        for one is not the model's)."""
+        for one is not the model's). ``keep_to``: what the reply is asked to keep to, as the
+        request's fields (:func:`constraint`)."""
         t0 = time.perf_counter()
+        extra = {} if self.seed is None else {"seed": self.seed}
         try:
             with self.slots:
                 t0 = time.perf_counter()
                 resp = self.client.chat.completions.create(model=self.model, messages=messages, temperature=self.temperature,
-                                                           max_tokens=self.max_tokens)
+                                                           max_tokens=self.max_tokens, **extra, **(keep_to or {}))
             usage = getattr(resp, "usage", None)
             tin = _count(getattr(usage, "prompt_tokens", 0))
             tout = _count(getattr(usage, "completion_tokens", 0))
@@ -207,6 +209,18 @@ class Chat:
         except Exception as exc:  # noqa: BLE001  (a body that is not a chat completion: not JSON, another shape, nested too deep)
             return Reply(None, f"the server's reply is not a chat completion ({type(exc).__name__})",
                          latency_s=time.perf_counter() - t0)
+
+
+def constraint(reply_format: str, schema: dict, grammar: str) -> dict | None:
+    """The request's fields that ask the server to keep its reply to the choices offered:
+    ``json_schema``, OpenAI's structured outputs (``response_format`` of type ``json_schema``,
+    which OpenAI, vLLM and llama.cpp's ``llama-server`` take); ``grammar``, a GBNF grammar in the
+    request's body (llama.cpp's ``llama-server`` and ``llama_cpp.server``); ``text``: none."""
+    if reply_format == "json_schema":
+        return {"response_format": {"type": "json_schema", "json_schema": {"name": "reply", "strict": True, "schema": schema}}}
+    if reply_format == "grammar":
+        return {"extra_body": {"grammar": grammar}}
+    return None
 
 
 def _count(v) -> int:

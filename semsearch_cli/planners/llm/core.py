@@ -41,9 +41,9 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 from ...credentials import looks_like_key
 from ...errors import BudgetSpent, PlannerError, ScenarioError, Unavailable
 from ..base import COST_COLUMNS, Planner
-from .client import MISSING, Chat, Reply, openai_installed, prompt_path, require_openai, url_fault
+from .client import MISSING, Chat, Reply, constraint, openai_installed, prompt_path, require_openai, url_fault
 from .client import preflight as look_at_endpoint
-from .replies import parse_number, parse_probabilities
+from .replies import grammar, parse_choice, parse_number, parse_probabilities, schema
 from .transcript import files, folder_text, header, index, read, replan_on_signs, run_key
 
 FIELDS = {  # kind -> the fields a prompt template may use ($name), each documented in docs/llm.md
@@ -92,6 +92,11 @@ class LlmParams(BaseModel):
                                                 "(door and object search)")
     api_key_env: str = Field("OPENAI_API_KEY", description="the environment variable that holds the key (never written)")
     temperature: float = Field(0.0, ge=0.0, le=2.0)
+    seed: int | None = Field(None, ge=0, le=2**31 - 1, description="sent with every request, for servers that sample "
+                             "with one; kept with each call in the transcript")
+    reply_format: Literal["text", "json_schema", "grammar"] = Field(
+        "text", description="text: the reply read as written, re-asked when invalid; json_schema or grammar: the server "
+        "asked to keep the reply to the choices offered (response_format, or a GBNF grammar: llama.cpp)")
     max_tokens: int = Field(512, ge=1, le=1_000_000, description="tokens a reply may take")
     timeout_s: float = Field(60.0, gt=0.0, le=3600.0, description="s a request may take before it is retried")
     retries: int = Field(2, ge=0, le=10, description="retries of a request (timeouts, 429, 5xx), with backoff")
@@ -333,6 +338,10 @@ class LlmCore(Planner):
         else:
             messages = []
         reason, last = "", None
+        keep_to = None
+        if live.reply_format != "text" and self._replay is None:
+            offered = allowed if live.mode == "actor" else range(len(dist))
+            keep_to = constraint(live.reply_format, schema(live.mode, offered), grammar(live.mode, offered))
         for attempt in range(live.reasks + 1):
             self.check_budget()
             if attempt and self._replay is None and last is not None:  # after no reply at all (an HTTP error): the same messages again
@@ -340,12 +349,13 @@ class LlmCore(Planner):
                                        {"role": "user", "content": f"Your reply could not be used: {reason}. {fields['answer']}"}]
             if self.dry_run:
                 raise FirstPrompt(messages)
-            reply, messages = self.call(k, attempt, fields["observation"], messages)
+            reply, messages = self.call(k, attempt, fields["observation"], messages, keep_to)
             last = reply.text
             if reply.text is None:
                 choice, reason = None, reply.error or "the reply is empty"
             elif live.mode == "actor":
-                choice, reason = parse_number(reply.text, frozenset(allowed))
+                parse = parse_choice if live.reply_format == "json_schema" else parse_number
+                choice, reason = parse(reply.text, frozenset(allowed))
             else:
                 choice, reason = parse_probabilities(reply.text, range(len(dist)))  # any choice listed; chosen among allowed
             self.log_call(k, attempt, fields["observation"], messages, reply, choice, reason)
@@ -370,15 +380,16 @@ class LlmCore(Planner):
         if self.spent:
             raise BudgetSpent(self.spent)
 
-    def call(self, k: int, attempt: int, obs: str, messages: list) -> tuple[Reply, list]:
+    def call(self, k: int, attempt: int, obs: str, messages: list, keep_to: dict | None = None) -> tuple[Reply, list]:
         """One call to the model (or, in a replay, the transcript's call ``attempt`` of decision
-        ``k``, its observation checked against this run's)."""
+        ``k``, its observation checked against this run's); ``keep_to``: the request's fields
+        that constrain the reply (:func:`.client.constraint`)."""
         if self._replay is None:
             if self._chat is None:
                 live = self._live
                 self._chat = Chat(live.base_url, live.model, live.api_key_env, live.temperature, live.max_tokens,
-                                  live.timeout_s, live.retries, live.max_concurrent)
-            reply = self._chat.ask(messages)
+                                  live.timeout_s, live.retries, live.max_concurrent, live.seed)
+            reply = self._chat.ask(messages, keep_to)
             reply.latency_s = round(reply.latency_s, 6)  # as the transcript keeps it: a replay sums the same seconds
         else:
             item = next((x for x in self._replay if x.get("decision") == k and x.get("attempt") == attempt), None)
@@ -403,7 +414,9 @@ class LlmCore(Planner):
                                 "reply": reply.text, "error": reply.error,
                                 "choice": ({str(t): v for t, v in choice.items()} if isinstance(choice, dict) else choice),
                                 "valid": choice is not None, "reason": reason, "tokens_in": reply.tokens_in,
-                                "tokens_out": reply.tokens_out, "latency_s": round(reply.latency_s, 6), "model": reply.model})
+                                "tokens_out": reply.tokens_out, "latency_s": round(reply.latency_s, 6), "model": reply.model,
+                                "temperature": self._live.temperature, "seed": self._live.seed,
+                                "reply_format": self._live.reply_format})
 
 
 def by_expected_cost(p: dict[int, float], dist: np.ndarray, allowed: list[int]) -> int:

@@ -8,7 +8,14 @@ legal choice is invalid, never mapped to a default.
   aside; a number of more than 9 digits names no choice; a reply longer than 20,000 characters
   is not read;
 - an estimator's reply is one JSON object (bare, or in a ```json fence) mapping shown choices'
-  numbers to probabilities in [0, 1]; a target it leaves out counts as 0.
+  numbers to probabilities in [0, 1]; a target it leaves out counts as 0;
+- a reply asked for under a JSON schema (``reply_format: json_schema``, :func:`schema`) is the
+  object ``{"choice": N}`` (actor) or the probability table (estimator); an actor's reply that is
+  not that object is read as above (a server that ignores the schema answers in words).
+
+What a server is asked to keep to (:func:`schema`, :func:`grammar`) names only the choices
+offered: a server that honours it cannot give an invalid reply, bar one cut short by
+``max_tokens``.
 """
 
 from __future__ import annotations
@@ -82,6 +89,54 @@ def parse_number(reply, allowed) -> tuple[int | None, str]:
     if n not in allowed:
         return None, f"{n} is not one of the choices offered"
     return n, ""
+
+
+def parse_choice(reply, allowed) -> tuple[int | None, str]:
+    """An actor's reply asked for under :func:`schema`: the object ``{"choice": N}``; a reply
+    that is not a JSON object is read by :func:`parse_number` (a server that ignored the schema)."""
+    text, why = _text(reply)
+    if text is None:
+        return None, why
+    body = _fenced(text).strip()
+    if not body.startswith("{"):
+        return parse_number(reply, allowed)
+    try:
+        obj = json.loads(body)
+    except (ValueError, RecursionError):
+        return None, "the reply is not one JSON object {\"choice\": N}"
+    if not isinstance(obj, dict) or set(obj) != {"choice"}:
+        return None, "the reply is not the JSON object {\"choice\": N}"
+    n = obj["choice"]
+    if isinstance(n, bool) or not isinstance(n, int):
+        return None, f"the choice {str(n)[:20]} is not a whole number"
+    if n not in allowed:
+        return None, f"{n} is not one of the choices offered"
+    return n, ""
+
+
+def schema(mode: str, allowed) -> dict:
+    """The JSON schema of a reply that names only the choices offered: an actor's
+    ``{"choice": N}``, N one of ``allowed``; an estimator's table, every choice of ``allowed`` a
+    key with a probability from 0 to 1."""
+    allowed = [int(a) for a in allowed]
+    if mode == "actor":
+        return {"type": "object", "properties": {"choice": {"type": "integer", "enum": allowed}}, "required": ["choice"],
+                "additionalProperties": False}
+    return {"type": "object", "properties": {str(a): {"type": "number", "minimum": 0, "maximum": 1} for a in allowed},
+            "required": [str(a) for a in allowed], "additionalProperties": False}
+
+
+def grammar(mode: str, allowed) -> str:
+    """A GBNF grammar (llama.cpp's) of a reply that names only the choices offered: an actor's
+    bare number, one of ``allowed``; an estimator's JSON table of every choice, each a
+    probability written 0, 1, or 0. and up to four digits."""
+    allowed = [int(a) for a in allowed]
+    if mode == "actor":
+        return "root ::= " + " | ".join(f'"{a}"' for a in allowed) + "\n"
+    keys = ' "," ws '.join(f'"\\"{a}\\":" ws p' for a in allowed)
+    return (f'root ::= "{{" ws {keys} ws "}}"\n'
+            'p ::= "0" ("." [0-9] [0-9]? [0-9]? [0-9]?)? | "1" ("." "0" "0"? "0"? "0"?)?\n'
+            'ws ::= " "?\n')
 
 
 def parse_probabilities(reply, allowed) -> tuple[dict[int, float] | None, str]:
