@@ -13,7 +13,8 @@ offline (``{name: llm, replay: DIR}``).
   simulator's): reading it names the release that replays it;
 - one ``{"type": "call", "decision": k, "attempt": a, "observation": "...", "messages": [...],
   "reply": "..." or null, "error": "", "choice": ..., "valid": true, "reason": "", "tokens_in":
-  n, "tokens_out": n, "latency_s": s, "model": "..."}`` per call to the model: decision ``k``
+  n, "tokens_out": n, "latency_s": s, "model": "...", "temperature": t, "seed": s or null,
+  "reply_format": "text"}`` per call to the model (the last three since 0.4.0): decision ``k``
   (0, 1, ... in the order the run asked), its attempt ``a`` (0, then each re-ask), the
   observation, every message sent, the raw reply (null when there was none, ``error`` saying
   why), the parsed choice (a target's number; the estimator's probabilities by target), whether
