@@ -36,11 +36,16 @@ class Answer:
     model: str = "scripted-1"
 
 
+def decision_text(messages: list[dict]) -> str:
+    """The decision a request asks about: its last user message that is not a re-ask (a prompt's
+    worked examples come before it, the replies and re-asks after)."""
+    return next(m["content"] for m in reversed(messages) if m["role"] == "user"
+                and "Your reply could not be used" not in m["content"])
+
+
 def first_target(request: dict, n: int) -> Answer:
-    """The "nearest target" model: the number of the first choice the last user message lists."""
-    text = request["messages"][-1]["content"]
-    if "Your reply could not be used" in text:
-        text = next(m["content"] for m in request["messages"] if m["role"] == "user")
+    """The "nearest target" model: the number of the first choice the decision lists."""
+    text = decision_text(request["messages"])
     m = re.search(r"^\[(\d+)\]", text, re.M)
     return Answer(m.group(1) if m else "0")
 

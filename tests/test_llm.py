@@ -33,7 +33,7 @@ from semsearch_cli.planners.llm.replies import parse_number, parse_probabilities
 from semsearch_cli.runner import BatchOptions, Loaded  # noqa: E402
 from semsearch_cli.tasks.decisions import Seat  # noqa: E402
 
-from .llm_server import Answer, ChatServer, first_target  # noqa: E402
+from .llm_server import Answer, ChatServer, decision_text, first_target  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SAME = ["goal", "episode", "seed", "outcome", "distance_m", "steps", "decisions", "spl"]
@@ -104,8 +104,8 @@ def test_a_replay_from_transcripts_gives_the_live_rows_with_no_server(tmp_path):
     head, calls = lines[0], [x for x in lines if x["type"] == "call"]
     assert head["format"] == "semsearch-transcript" and head["version"] == 1 and head["run"]["planner"] == label
     assert set(calls[0]) == {"type", "decision", "attempt", "observation", "messages", "reply", "error", "choice", "valid",
-                             "reason", "tokens_in", "tokens_out", "latency_s", "model"}
-    assert calls[0]["model"] == "scripted-1" and calls[0]["messages"][1]["content"] == calls[0]["observation"]
+                             "reason", "tokens_in", "tokens_out", "latency_s", "model", "temperature", "seed", "reply_format"}
+    assert calls[0]["model"] == "scripted-1" and decision_text(calls[0]["messages"]) == calls[0]["observation"]
     # the server is gone: a replay calls nothing
     rp = scenario(tmp_path, [{"name": "llm", "replay": str(tmp_path / "live")}])
     api.run(rp, BatchOptions(out=tmp_path / "replay", workers=1, transcripts=True), plots=False)
@@ -191,7 +191,7 @@ def kind_of(n: int) -> str:
 
 def fuzz(request, n):
     kind = kind_of(n)
-    prompt = request["messages"][1]["content"]
+    prompt = decision_text(request["messages"])
     offered = re.findall(r"^\[(\d+)\]", prompt, re.M)
     first = offered[0]
     if "JSON object" in prompt and kind.startswith("valid"):  # an estimator's valid replies
@@ -306,13 +306,13 @@ def test_the_estimator_chooses_by_expected_cost():
 
 def test_an_estimator_run_reads_json_probabilities(tmp_path):
     def estimate(request, n):
-        k = len(re.findall(r"^\[(\d+)\]", request["messages"][1]["content"], re.M))
+        k = len(re.findall(r"^\[(\d+)\]", decision_text(request["messages"]), re.M))
         return Answer("```json\n" + json.dumps({str(i): round(1 / (i + 1), 3) for i in range(k)}) + "\n```")
 
     with ChatServer(estimate) as srv:
         sc = scenario(tmp_path, [llm(srv, mode="estimator")], seeds=1, goals=[304])
         api.run(sc, BatchOptions(out=tmp_path / "out", workers=1), plots=False)
-        assert "JSON object" in srv.requests[0]["messages"][1]["content"]
+        assert "JSON object" in decision_text(srv.requests[0]["messages"])
     row = rows_of(tmp_path / "out", "llm").iloc[0]
     assert row["outcome"] == "found" and row["invalid_replies"] == 0 and row["fallbacks"] == 0
 

@@ -23,7 +23,7 @@ from semsearch_cli import api  # noqa: E402
 from semsearch_cli.cli import app  # noqa: E402
 from semsearch_cli.runner import BatchOptions  # noqa: E402
 
-from .llm_server import Answer, ChatServer  # noqa: E402
+from .llm_server import Answer, ChatServer, decision_text  # noqa: E402
 
 COSTS = ["llm_calls", "tokens_in", "tokens_out", "invalid_replies", "fallbacks", "llm_s"]
 SAME = ["goal", "episode", "seed", "outcome", "distance_m", "steps", "decisions"]
@@ -63,7 +63,7 @@ def toward_the_likeliest_cell(text: str) -> int:
 
 
 def serve(policy):
-    return lambda request, n: Answer(str(policy(request["messages"][1]["content"])))
+    return lambda request, n: Answer(str(policy(decision_text(request["messages"]))))
 
 
 # ---- the scenarios ----------------------------------------------------------------------------------
@@ -150,7 +150,7 @@ def test_an_object_estimator_reads_probabilities_by_place(tmp_path):
     def likely(request, n):  # all weight on the places the log saw the mug at within the hour (first, some prose)
         if n == 0:
             return Answer("The mug is probably in the kitchen.")
-        text = request["messages"][1]["content"]
+        text = decision_text(request["messages"])
         near = {k: int(w) for k, w in re.findall(r"^\[(\d+)\] .*detections, (\d+) within the hour$", text, re.M)}
         total = sum(near.values()) or 1
         return Answer(json.dumps({k: round(w / total, 3) for k, w in near.items()}))
@@ -158,7 +158,7 @@ def test_an_object_estimator_reads_probabilities_by_place(tmp_path):
     with ChatServer(likely) as srv:
         sc = object_scenario(tmp_path, [llm(srv, mode="estimator")])
         api.run(sc, BatchOptions(out=tmp_path / "out", workers=1, seeds=1), plots=False)
-        assert "JSON object" in srv.requests[0]["messages"][1]["content"]
+        assert "JSON object" in decision_text(srv.requests[0]["messages"])
         again = srv.requests[1]["messages"][-1]["content"]  # the re-ask asks for what the mode answers
         assert again == ("Your reply could not be used: the reply is not one JSON object. Answer with one JSON object "
                          "mapping place numbers (0-9) to probabilities from 0 to 1.")
@@ -189,7 +189,7 @@ def test_a_dry_run_prints_an_object_searchs_first_prompt(tmp_path):
 @pytest.mark.parametrize("suite", ["objects-v1", "indirect-v1"])
 def test_the_bench_runs_and_verifies_a_model_on_object_and_indirect_suites(tmp_path, suite):
     def script(request, n):
-        text = request["messages"][1]["content"]
+        text = decision_text(request["messages"])
         return Answer(str((toward_the_likeliest_cell if "lattice point" in text else nearest_unviewed_place)(text)))
 
     with ChatServer(script) as srv:

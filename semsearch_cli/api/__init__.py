@@ -1,5 +1,5 @@
 """The commands as Python functions, one module per feature (runs, reports, verify, ros, info,
-make, suites); the CLI only parses, calls these and prints. Every name is importable from here, as
+make, suites, llm); the CLI only parses, calls these and prints. Every name is importable from here, as
 before the split."""
 
 from ..errors import MissingExtra, ScenarioError
@@ -12,6 +12,7 @@ from .info import schema_text, schema, validate, show, episodes, planners, scena
 from .make import (imported, LAYOUTS, SCHEMES, KTH_CORRIDOR_TYPES, generate_building, generate_batch, generate_rooms,
     import_mobilesim, import_ros, import_kth)
 from .suites import bench_run, bench_list, bench_board, bench_fetch, bench_hash
+from .llm import llm_serve, model_identity
 
 __all__ = [
     "MissingExtra", "ScenarioError", "RunOutput", "default_out", "RECORDED", "run", "first_prompt",
@@ -20,5 +21,5 @@ __all__ = [
     "validate", "show", "episodes", "planners", "scenarios", "init", "planner_spec", "imported", "LAYOUTS",
     "SCHEMES", "KTH_CORRIDOR_TYPES", "generate_building", "generate_batch", "generate_rooms",
     "import_mobilesim", "import_ros", "import_kth", "bench_run", "bench_list", "bench_board", "bench_fetch",
-    "bench_hash"
+    "bench_hash", "llm_serve", "model_identity"
 ]

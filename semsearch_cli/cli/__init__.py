@@ -5,7 +5,7 @@ planners), bench, generate and imports; common.py holds the app, the consoles an
 share, entry.py the ``--version`` callback and :func:`main`."""
 
 from .common import app
-from . import runs, reports, verify, ros, info, bench, generate, imports, entry  # noqa: F401  (each registers its commands, in the help's order)
+from . import runs, reports, verify, ros, info, bench, generate, imports, llm, entry  # noqa: F401  (each registers its commands, in the help's order)
 from .entry import main
 
 __all__ = ["app", "main"]

@@ -214,10 +214,14 @@ class Chat:
 def constraint(reply_format: str, schema: dict, grammar: str) -> dict | None:
     """The request's fields that ask the server to keep its reply to the choices offered:
     ``json_schema``, OpenAI's structured outputs (``response_format`` of type ``json_schema``,
-    which OpenAI, vLLM and llama.cpp's ``llama-server`` take); ``grammar``, a GBNF grammar in the
-    request's body (llama.cpp's ``llama-server`` and ``llama_cpp.server``); ``text``: none."""
+    which OpenAI, vLLM and llama.cpp's ``llama-server`` take); ``json_object``, llama.cpp's form
+    (``response_format`` of type ``json_object`` with the ``schema``: ``llama-server`` and
+    ``llama_cpp.server``, which refuses the first); ``grammar``, a GBNF grammar in the request's
+    body (llama.cpp's two servers); ``text``: none."""
     if reply_format == "json_schema":
         return {"response_format": {"type": "json_schema", "json_schema": {"name": "reply", "strict": True, "schema": schema}}}
+    if reply_format == "json_object":
+        return {"response_format": {"type": "json_object", "schema": schema}}
     if reply_format == "grammar":
         return {"extra_body": {"grammar": grammar}}
     return None

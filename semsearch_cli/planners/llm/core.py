@@ -78,6 +78,7 @@ FIELDS = {  # kind -> the fields a prompt template may use ($name), each documen
 }
 MODES = {"doors": ("actor", "estimator"), "objects": ("actor", "estimator"), "indirect": ("actor",)}
 SPLIT = ("=== system ===", "=== user ===")
+EXAMPLE = ("=== example user ===", "=== example assistant ===")  # a worked exchange, between the two (optional, repeatable)
 ENV_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}")  # an environment variable's name, as api_key_env takes it
 REPEAT_CHARS = 2000  # characters of an invalid reply sent back with the re-ask (a reply of 20,000 is not sent back whole)
 
@@ -94,9 +95,10 @@ class LlmParams(BaseModel):
     temperature: float = Field(0.0, ge=0.0, le=2.0)
     seed: int | None = Field(None, ge=0, le=2**31 - 1, description="sent with every request, for servers that sample "
                              "with one; kept with each call in the transcript")
-    reply_format: Literal["text", "json_schema", "grammar"] = Field(
-        "text", description="text: the reply read as written, re-asked when invalid; json_schema or grammar: the server "
-        "asked to keep the reply to the choices offered (response_format, or a GBNF grammar: llama.cpp)")
+    reply_format: Literal["text", "json_schema", "json_object", "grammar"] = Field(
+        "text", description="text: the reply read as written, re-asked when invalid; json_schema, json_object or grammar: "
+        "the server asked to keep the reply to the choices offered (OpenAI's structured outputs; llama.cpp's JSON schema "
+        "or GBNF grammar)")
     max_tokens: int = Field(512, ge=1, le=1_000_000, description="tokens a reply may take")
     timeout_s: float = Field(60.0, gt=0.0, le=3600.0, description="s a request may take before it is retried")
     retries: int = Field(2, ge=0, le=10, description="retries of a request (timeouts, 429, 5xx), with backoff")
@@ -131,7 +133,21 @@ class LlmParams(BaseModel):
 def load_prompt(path: str | None, kind: str, mode: str) -> tuple[str, str, str]:
     """(system template, user template, SHA-256 of the file) of a prompt template file for ``kind``
     (the shipped ``<kind>-<mode>.txt`` when None); a :class:`ScenarioError` naming the file for a
-    file without the two sections or with a field that is not one of ``FIELDS[kind]``."""
+    file without the two sections or with a field that is not one of ``FIELDS[kind]``. Its worked
+    examples: :func:`load_examples`."""
+    system, user, _, sha = _read_prompt(path, kind, mode)
+    return system, user, sha
+
+
+def load_examples(path: str | None, kind: str, mode: str) -> list[dict]:
+    """The worked exchanges of a prompt template, as chat messages sent between the system message
+    and the decision (``=== example user ===`` then ``=== example assistant ===``, each pair once or
+    more, between the two sections; since 0.4.0): a small model that only echoes the text it is
+    given answers in the format asked once it has seen one answer (docs/llm.md)."""
+    return _read_prompt(path, kind, mode)[2]
+
+
+def _read_prompt(path: str | None, kind: str, mode: str) -> tuple[str, str, list[dict], str]:
     p = Path(path) if path else prompt_path(f"{kind}-{mode}")
     try:
         raw = p.read_bytes()
@@ -142,8 +158,16 @@ def load_prompt(path: str | None, kind: str, mode: str) -> tuple[str, str, str]:
     if lines.count(SPLIT[0]) != 1 or lines.count(SPLIT[1]) != 1 or lines.index(SPLIT[0]) > lines.index(SPLIT[1]):
         raise ScenarioError(str(p), "prompt", f"a prompt template holds a line '{SPLIT[0]}' and, after it, a line "
                             f"'{SPLIT[1]}', each once; the text under each is that message")
-    a, b = lines.index(SPLIT[0]), lines.index(SPLIT[1])
-    system, user = "\n".join(lines[a + 1:b]).strip(), "\n".join(lines[b + 1:]).strip()
+    heads = [n for n, line in enumerate(lines) if line in (*SPLIT, *EXAMPLE)]
+    names = [lines[n] for n in heads]
+    middle = names[1:-1]
+    if names[0] != SPLIT[0] or names[-1] != SPLIT[1] or middle != list(EXAMPLE) * (len(middle) // 2) or len(middle) % 2:
+        raise ScenarioError(str(p), "prompt", f"the worked examples of a prompt template go between '{SPLIT[0]}' and "
+                            f"'{SPLIT[1]}', each a line '{EXAMPLE[0]}' and then a line '{EXAMPLE[1]}'")
+    bodies = ["\n".join(lines[a + 1:b]).strip() for a, b in zip(heads, heads[1:] + [len(lines)])]
+    system, user = bodies[0], bodies[-1]
+    examples = [{"role": "user" if name == EXAMPLE[0] else "assistant", "content": body}
+                for name, body in zip(middle, bodies[1:-1])]
     for part in (system, user):
         t = Template(part)
         if not t.is_valid():
@@ -152,7 +176,9 @@ def load_prompt(path: str | None, kind: str, mode: str) -> tuple[str, str, str]:
         if bad:
             raise ScenarioError(str(p), "prompt", f"no field ${bad[0]} in {kind} search; its fields: "
                                 f"{', '.join('$' + f for f in FIELDS[kind])}")
-    return system, user, hashlib.sha256(raw).hexdigest()
+    if any(not m["content"] for m in examples):
+        raise ScenarioError(str(p), "prompt", "a worked example's message is empty")
+    return system, user, examples, hashlib.sha256(raw).hexdigest()
 
 
 class LlmCore(Planner):
@@ -176,6 +202,7 @@ class LlmCore(Planner):
         self.spent = ""
         self.dry_run = False  # set by a dry run: the first prompt is raised (FirstPrompt), nothing is called
         self._prompt: tuple[str, str, str] | None = None
+        self._examples: list[dict] = []
         self._replay: list[dict] | None = None
         self._chat: Chat | None = None
         self._live = params  # the parameters the run behaves by (a replay's: its transcript's)
@@ -289,6 +316,7 @@ class LlmCore(Planner):
             raise PlannerError(f"the llm planner of a {self.kind} search was asked a {kind} decision")
         if self.params.replay is None and self._prompt is None:
             self._prompt = load_prompt(self.params.prompt, kind, self.params.mode)
+            self._examples = load_examples(self.params.prompt, kind, self.params.mode)
             self.transcript = [header(kind, self.run, self.public_params(), self._prompt[2])]
         if self.params.replay is not None and self._replay is None:
             raise PlannerError("a replay finds each run's transcript by the run (scenario, goal, episode, seed): replay "
@@ -334,7 +362,7 @@ class LlmCore(Planner):
         allowed = [int(a) for a in allowed]
         if self._replay is None:
             system, user = (Template(t).substitute(fields) for t in self._prompt[:2])
-            messages = [{"role": "system", "content": system}, {"role": "user", "content": user}]
+            messages = [{"role": "system", "content": system}, *self._examples, {"role": "user", "content": user}]
         else:
             messages = []
         reason, last = "", None
@@ -354,7 +382,7 @@ class LlmCore(Planner):
             if reply.text is None:
                 choice, reason = None, reply.error or "the reply is empty"
             elif live.mode == "actor":
-                parse = parse_choice if live.reply_format == "json_schema" else parse_number
+                parse = parse_choice if live.reply_format in ("json_schema", "json_object") else parse_number
                 choice, reason = parse(reply.text, frozenset(allowed))
             else:
                 choice, reason = parse_probabilities(reply.text, range(len(dist)))  # any choice listed; chosen among allowed
