@@ -3,7 +3,6 @@ extra; docs/llm.md)."""
 
 from __future__ import annotations
 
-import signal
 from pathlib import Path
 from typing import Optional
 
@@ -40,14 +39,12 @@ def llm_serve(
         raise typer.Exit(1)
     ident = api.model_identity(srv)
     out.print(f"serving {ident['file']} ({ident['bytes']:,} bytes, sha256 {ident['sha256'][:16]}) at {srv.base_url} as "
-              f"model {srv.alias!r}; ready in {srv.startup_s:.2f} s")
-    out.print(f"planner: {{name: llm, base_url: {srv.base_url}, model: {srv.alias}, reply_format: grammar}}   (Ctrl-C stops it)")
-    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
-    try:
+              f"model {srv.alias!r}; ready in {srv.startup_s:.2f} s", soft_wrap=True)
+    out.print(f"planner: {{name: llm, base_url: {srv.base_url}, model: {srv.alias}, reply_format: grammar}}   "
+              "(Ctrl-C stops it)", soft_wrap=True)
+    try:  # Ctrl-C and SIGTERM end the command (entry.main says how); the server goes with it, whatever ends it
         code = srv.proc.wait()
-    except KeyboardInterrupt:
+    finally:
         srv.stop()
-        out.print("stopped")
-        return
     err.print(f"error: the server ended by itself (status {code})")
     raise typer.Exit(1)
