@@ -16,6 +16,7 @@ with this server the planner's ``reply_format`` is ``grammar`` or ``json_object`
 
 from __future__ import annotations
 
+import ctypes
 import importlib.util
 import json
 import os
@@ -96,6 +97,15 @@ def server_command(model: Path, port: int, alias: str, threads: int = THREADS, c
             "--verbose", "False"]
 
 
+def _die_with_parent() -> None:
+    """In the server's process before it starts (Linux): SIGTERM when the process that started it
+    dies, however it dies (a test killed, a batch's SIGKILL), so that no server outlives its user."""
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: stop() and the context manager still end it
+        pass
+
+
 @dataclass
 class LocalServer:
     """llama.cpp's server on loopback, serving ``model`` (a GGUF path; None: the shipped one) as
@@ -130,7 +140,7 @@ class LocalServer:
         out = open(self.log, "ab") if self.log is not None else subprocess.DEVNULL
         t0 = time.perf_counter()
         self.proc = subprocess.Popen(server_command(self.path, self.port, self.alias, self.threads, self.context),
-                                     stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
+                                     stdout=out, stderr=subprocess.STDOUT, start_new_session=True, preexec_fn=_die_with_parent)
         while time.perf_counter() - t0 < timeout_s:
             if self.proc.poll() is not None:
                 raise RuntimeError(f"llama.cpp's server ended at start-up (status {self.proc.returncode})"
