@@ -10,7 +10,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 IMPORT_NAMES = {"scikit-learn": "sklearn", "mkdocs-material": "material", "import-linter": "importlinter",
-                "dask-jobqueue": "dask_jobqueue", "opencv-python-headless": "cv2", "pyyaml": "yaml"}
+                "dask-jobqueue": "dask_jobqueue", "opencv-python-headless": "cv2", "pyyaml": "yaml",
+                "llama-cpp-python": "llama_cpp"}
 
 
 def extra_packages() -> set[str]:

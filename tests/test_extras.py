@@ -58,6 +58,7 @@ def test_the_base_install_starts_and_lists(tmp_path):
      "error: semsearch ros live needs the ros extra: pip install 'semsearch[ros]'"),
     (["ros", "sim", "demo", "--goal", "304"], "error: semsearch ros sim needs the ros extra: pip install 'semsearch[ros]'"),
     (["run", "demo", "--seeds", "1", "--executor", "dask", "--out", "r"], "error: --executor dask needs the dask extra: pip install 'semsearch[dask]'"),
+    (["llm", "serve"], "error: semsearch llm serve needs the llm-local extra: pip install 'semsearch[llm-local]' (no module llama_cpp)"),
 ])
 def test_a_command_that_needs_an_extra_refuses_in_one_line_naming_it(tmp_path, args, line):
     res = bare(*args, cwd=tmp_path)

