@@ -51,6 +51,8 @@ API = {
     "bench_hash": ["suite", "split", "salt_file"],
     "bench_fetch": ["suite", "from_dirs", "mirror", "partial", "progress"],
     "bench_board": ["folders", "out"],
+    "llm_serve": ["model", "port", "threads", "context", "log"],
+    "model_identity": ["server"],
     "planner_spec": ["text", "module"],
     "presence": ["counts", "hours", "out"],
     "generate_building": ["layout", "numbering", "seed", "out", "spacing", "signs", "goals", "name", "scale", "skip", "letters",
