@@ -58,9 +58,10 @@ def startup(repeat: int) -> str:
 
 
 def test() -> str:
-    res = subprocess.run([sys.executable, "-m", "pytest", "-n", "0", "-q", "-rs", str(ROOT / "tests" / "test_llm_local.py")],
+    res = subprocess.run([sys.executable, "-m", "pytest", "-o", "addopts=", "-q", "-rs", str(ROOT / "tests" / "test_llm_local.py")],
                          cwd=ROOT, capture_output=True, text=True)
-    return res.stdout.strip().splitlines()[-1] if res.stdout.strip() else res.stderr
+    said = [ln for ln in res.stdout.splitlines() if re.search(r"\d+ (passed|failed|skipped|error)", ln)]
+    return "\n".join(said[-1:] or res.stdout.strip().splitlines()[-5:] or [res.stderr.strip()])
 
 
 def decisions() -> list[str]:

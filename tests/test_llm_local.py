@@ -58,7 +58,8 @@ def test_a_real_model_answers_a_door_episode_as_actor_and_estimator_and_replays_
         assert srv.listed() == [SHIPPED_ALIAS]
         model = {"name": "llm", "base_url": srv.base_url, "model": srv.alias, "reply_format": "grammar", "seed": 1}
         d["planners"] = [model, {**model, "mode": "estimator"}]
-        d["experiment"]["seeds"], d["goals"] = 1, [304]
+        # a short episode: a 135M model's choices wander, and its runs end at this budget as often as not
+        d["experiment"]["seeds"], d["experiment"]["max_distance"], d["goals"] = 1, 30.0, [304]
         sc = src.with_name("demo_local.yaml")
         sc.write_text(yaml.safe_dump(d))
         api.run(sc, BatchOptions(out=tmp_path / "live", workers=1, transcripts=True), plots=False)
@@ -66,11 +67,13 @@ def test_a_real_model_answers_a_door_episode_as_actor_and_estimator_and_replays_
     assert len(live) == 2 and set(live["outcome"]) <= {"found", "budget", "stuck", "not_found"}
     # a grammar of the choices offered: every reply is one of them, the first time
     assert (live["invalid_replies"] == 0).all() and (live["fallbacks"] == 0).all()
-    assert (live["llm_calls"] == live["decisions"]).all() and (live["llm_calls"] > 0).all()
+    # one call a question: a re-plan asks again when the chosen target has no path, so calls >= decisions
+    assert (live["llm_calls"] >= live["decisions"]).all() and (live["llm_calls"] > 0).all()
     assert (live["tokens_in"] > 100 * live["llm_calls"]).all() and (live["tokens_out"] >= live["llm_calls"]).all()
     assert (live["llm_s"] > 0).all()
     files = sorted((tmp_path / "live" / "transcripts").glob("*.jsonl"))
     assert len(files) == 2
+    assert sorted(sum(1 for ln in f.open() if '"type": "call"' in ln) for f in files) == sorted(live["llm_calls"])
     for f in files:
         calls = [c for c in map(json.loads, f.open()) if c["type"] == "call"]
         assert calls and all(c["model"] == SHIPPED_ALIAS and c["seed"] == 1 and c["temperature"] == 0.0
