@@ -7,16 +7,25 @@ import numpy as np
 from ..base import Decision, DoorPlanner, register_planner
 
 
+def greedy_draw(ctx, cands) -> tuple[np.ndarray, int] | None:
+    """Greedy's search over the candidates (path lengths in cells, inf where there is none) and
+    the candidate it takes: the nearest, ties drawn from the run's generator; None when none is
+    reachable (nothing drawn)."""
+    d = ctx.belief.search(ctx.row, ctx.col, cands.rows, cands.cols, 1).lengths(cands.rows, cands.cols)
+    if not np.isfinite(d).any():
+        return None
+    best = np.flatnonzero(d == d.min())
+    return d, int(best[0] if best.size == 1 else ctx.rng.choice(best))
+
+
 def nearest_candidate(ctx, cands) -> Decision | None:
     """The candidate nearest to the robot along the skeleton (ties: the run's generator)."""
     if len(cands) == 0:
         return None
-    gs = ctx.belief.search(ctx.row, ctx.col, cands.rows, cands.cols, 1)
-    d = gs.lengths(cands.rows, cands.cols)
-    if not np.isfinite(d).any():
+    drawn = greedy_draw(ctx, cands)
+    if drawn is None:
         return None
-    best = np.flatnonzero(d == d.min())
-    k = int(best[0] if best.size == 1 else ctx.rng.choice(best))
+    d, k = drawn
     return Decision(int(cands.rows[k]), int(cands.cols[k]), {"D": float(d[k])})
 
 
@@ -30,11 +39,10 @@ def path_order(ctx, cands, limit: int) -> tuple[np.ndarray, np.ndarray] | None:
     that the path to the target chosen reuses it as greedy's does."""
     b, res = ctx.belief, ctx.belief.frame.res
     d = b.search(ctx.row, ctx.col, cands.rows, cands.cols, 0).lengths(cands.rows, cands.cols) * res  # every target
-    near = b.search(ctx.row, ctx.col, cands.rows, cands.cols, 1).lengths(cands.rows, cands.cols)
-    if not np.isfinite(near).any():
+    drawn = greedy_draw(ctx, cands)  # greedy's own search and draw, exactly
+    if drawn is None:
         return None
-    best = np.flatnonzero(near == near.min())
-    first = int(best[0] if best.size == 1 else ctx.rng.choice(best))  # greedy's draw, exactly
+    near, first = drawn
     if not np.isfinite(d[first]):
         d[first] = near[first] * res
     ok = np.flatnonzero(np.isfinite(d))

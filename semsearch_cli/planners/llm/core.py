@@ -315,8 +315,8 @@ class LlmCore(Planner):
         elif self.kind != kind:
             raise PlannerError(f"the llm planner of a {self.kind} search was asked a {kind} decision")
         if self.params.replay is None and self._prompt is None:
-            self._prompt = load_prompt(self.params.prompt, kind, self.params.mode)
-            self._examples = load_examples(self.params.prompt, kind, self.params.mode)
+            system, user, self._examples, sha = _read_prompt(self.params.prompt, kind, self.params.mode)
+            self._prompt = (system, user, sha)
             self.transcript = [header(kind, self.run, self.public_params(), self._prompt[2])]
         if self.params.replay is not None and self._replay is None:
             raise PlannerError("a replay finds each run's transcript by the run (scenario, goal, episode, seed): replay "

